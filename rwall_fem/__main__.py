@@ -1,0 +1,3 @@
+from rwall_fem.cli import main
+
+raise SystemExit(main())

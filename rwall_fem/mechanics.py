@@ -1,0 +1,120 @@
+"""The discretised solid: P1/Q1 displacement space, lumped mass, stiffness, stable step.
+
+All arrays returned here hold the rank's *owned* nodes only, shape (n, 3) for
+vectors, in the order of the function space's index map. PETSc vectors that
+wrap them share the row layout of the stiffness matrix.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from rwall_fem import _compat
+from rwall_fem.scene import Material
+
+__all__ = [
+    "critical_time_step",
+    "element_time_step",
+    "lumped_mass",
+    "stiffness_matrix",
+    "strain",
+    "stress",
+]
+
+# Vertices joined by an edge, in DOLFINx's reference-cell numbering.
+_EDGES = {
+    "tetrahedron": [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)],
+    "hexahedron": [
+        (0, 1), (2, 3), (4, 5), (6, 7),  # x
+        (0, 2), (1, 3), (4, 6), (5, 7),  # y
+        (0, 4), (1, 5), (2, 6), (3, 7),  # z
+    ],
+}
+
+
+def strain(u):
+    """Small-strain tensor sym(grad u)."""
+    return ufl.sym(ufl.grad(u))
+
+
+def stress(u, material: Material):
+    """Linear elastic (Hooke) Cauchy stress in Pa."""
+    lmbda, mu = material.lame
+    eps = strain(u)
+    return 2.0 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(len(u))
+
+
+def lumped_mass(V, density: float) -> np.ndarray:
+    """Row-sum lumped nodal masses (kg) of the owned nodes of ``V``, shape (n,).
+
+    Row sum equals vertex quadrature (HRZ) for P1 tetrahedra and Q1 hexahedra,
+    so every mass is positive; anything else is refused.
+    """
+    w = ufl.TestFunction(V)
+    ones = ufl.as_vector([1.0] * V.mesh.geometry.dim)
+    b = fem.petsc.assemble_vector(fem.form(density * ufl.inner(ones, w) * ufl.dx))
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    mass = b.array.reshape(-1, V.dofmap.index_map_bs)[:, 0].copy()
+    b.destroy()
+    lowest = V.mesh.comm.allreduce(mass.min(initial=np.inf), op=MPI.MIN)
+    if not lowest > 0.0:
+        raise ValueError(
+            f"lumped mass is not positive (min {lowest:g} kg): the element "
+            f"{V.mesh.topology.cell_type.name} P1 is the only supported choice"
+        )
+    return mass
+
+
+def stiffness_matrix(V, material: Material) -> PETSc.Mat:
+    """Assembled small-strain stiffness K (N/m), a PETSc matrix of block size 3."""
+    u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+    K = fem.petsc.assemble_matrix(fem.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx))
+    K.assemble()
+    return K
+
+
+def critical_time_step(K: PETSc.Mat, mass: np.ndarray, coords: np.ndarray) -> float:
+    """Stable central-difference step 2/omega_max (s), omega_max^2 = lambda_max(M^-1 K).
+
+    The eigenvalue of the symmetric M^-1/2 K M^-1/2 comes from SLEPc, started
+    from a vector that depends only on the node coordinates so that every
+    partitioning finds the same value.
+    """
+    from slepc4py import SLEPc
+
+    scale = K.createVecRight()
+    scale.array[:] = np.repeat(1.0 / np.sqrt(mass), 3)
+    A = K.copy()
+    A.diagonalScale(scale, scale)
+    start = K.createVecRight()
+    start.array[:] = np.sin(coords @ np.array([12.9898, 78.233, 37.719]) * 1e3).repeat(3) + 1.5
+    eps = SLEPc.EPS().create(K.comm)
+    eps.setOperators(A)
+    eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
+    eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
+    eps.setDimensions(1)
+    eps.setTolerances(1e-8, 2000)
+    eps.setInitialSpace([start])
+    eps.solve()
+    if eps.getConverged() < 1:
+        raise RuntimeError("the largest eigenvalue of M^-1 K did not converge")
+    lambda_max = eps.getEigenvalue(0).real
+    for obj in (eps, A, scale, start):
+        obj.destroy()
+    return 2.0 / math.sqrt(lambda_max)
+
+
+def element_time_step(V, material: Material) -> float:
+    """Element-size estimate of the stable step: shortest edge / p-wave speed (s)."""
+    x = V.tabulate_dof_coordinates()
+    nodes = _compat.cell_nodes(V)[: V.mesh.topology.index_map(V.mesh.topology.dim).size_local]
+    pairs = np.array(_EDGES[V.mesh.topology.cell_type.name])
+    lengths = np.linalg.norm(x[nodes[:, pairs[:, 0]]] - x[nodes[:, pairs[:, 1]]], axis=-1)
+    shortest = V.mesh.comm.allreduce(lengths.min(initial=np.inf), op=MPI.MIN)
+    return shortest / material.p_wave_speed

@@ -1,0 +1,87 @@
+"""Bodies from gmsh: the geometry files in ``meshes/`` or a user's .msh/.geo file.
+
+The mesh is generated (or read) on rank 0 and distributed by DOLFINx. Named
+gmsh physical groups travel with it as facet tags so that scenes can refer to
+boundary node sets by name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rwall_fem import _compat
+
+__all__ = ["BodyMesh", "bar_mesh", "boundary_nodes", "read_mesh"]
+
+GEOMETRY_DIR = Path(__file__).resolve().parent.parent / "meshes"
+
+
+@dataclass
+class BodyMesh:
+    """A distributed mesh with its named facet groups (name -> facet tag value)."""
+
+    msh: object
+    facet_tags: object
+    groups: dict[str, int]
+
+    @property
+    def num_cells(self) -> int:
+        """Global number of cells."""
+        imap = self.msh.topology.index_map(self.msh.topology.dim)
+        return imap.size_global
+
+
+def bar_mesh(comm: MPI.Comm, origin, size, element_size: float, cell: str) -> BodyMesh:
+    """Rectangular bar ``meshes/bar.geo`` from ``origin`` (m) spanning ``size`` (m).
+
+    ``cell`` is "hexahedron" or "tetrahedron"; layers are at most ``element_size`` (m) thick.
+    """
+    params = dict(zip(("x0", "y0", "z0"), origin)) | dict(zip(("lx", "ly", "lz"), size))
+    params |= {"h": element_size, "hexahedra": int(cell == "hexahedron")}
+    return read_mesh(comm, GEOMETRY_DIR / "bar.geo", params)
+
+
+def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = None) -> BodyMesh:
+    """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``."""
+    import gmsh
+
+    groups = None
+    if comm.rank == 0:
+        argv = [""]
+        for name, value in (parameters or {}).items():
+            argv += ["-setnumber", name, repr(float(value))]
+        gmsh.initialize(argv)
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(path))
+        if gmsh.model.getDimension() < 3 or not gmsh.model.mesh.getElements(3)[0]:
+            gmsh.model.mesh.generate(3)
+        groups = {
+            gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
+            for dim, tag in gmsh.model.getPhysicalGroups()
+            if dim == 2
+        }
+        if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
+            # DOLFINx reads only cells that belong to a physical group.
+            gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
+    groups = comm.bcast(groups, root=0)
+    try:
+        msh, _, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    return BodyMesh(msh, facet_tags, groups)
+
+
+def boundary_nodes(V) -> np.ndarray:
+    """Local node (block) indices of ``V`` on the exterior boundary of its mesh."""
+    from dolfinx import fem, mesh
+
+    msh = V.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    facets = mesh.exterior_facet_indices(msh.topology)
+    return fem.locate_dofs_topological(V, tdim - 1, facets)

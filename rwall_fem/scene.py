@@ -1,0 +1,319 @@
+"""Scenes: a TOML file read into validated dataclasses.
+
+A scene is checked whole before anything heavy starts. Every problem is a
+:class:`SceneError` whose message is one line naming the file, the key path
+(``wall[0].normal_point``) and what is allowed. Nothing downstream of this
+module reads the raw TOML.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "Initial",
+    "Material",
+    "MeshSpec",
+    "Output",
+    "RunSettings",
+    "Scene",
+    "SceneError",
+    "WallSpec",
+    "apply_override",
+    "load_scene",
+    "parse_scene",
+]
+
+MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
+
+
+class SceneError(ValueError):
+    """A scene that cannot run; the message is one line meant for the user."""
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    end_time: float  # s
+    dt_scale: float = 0.9  # fraction of the stable step 2/omega_max
+    dt: float | None = None  # s, a fixed step; refused above the stable limit
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    shape: str | None  # "bar", or None when ``file`` is given
+    file: Path | None = None
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # m, lowest corner
+    size: tuple[float, float, float] = (0.01, 0.01, 0.1)  # m
+    element_size: float = 2e-3  # m
+    cell: str = "hexahedron"
+
+
+@dataclass(frozen=True)
+class Material:
+    model: str
+    density: float  # kg/m^3
+    young: float  # Pa
+    poisson: float
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lamé parameters (lambda, mu) in Pa."""
+        E, nu = self.young, self.poisson
+        return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+
+    @property
+    def p_wave_speed(self) -> float:
+        """Dilatational wave speed sqrt((lambda + 2 mu)/rho) in m/s."""
+        lmbda, mu = self.lame
+        return math.sqrt((lmbda + 2 * mu) / self.density)
+
+
+@dataclass(frozen=True)
+class Initial:
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # m/s
+
+
+@dataclass(frozen=True)
+class WallSpec:
+    kind: str
+    point: tuple[float, float, float]  # M, m
+    normal_point: tuple[float, float, float]  # M1, m
+    slide: str = "free"
+
+
+@dataclass(frozen=True)
+class Output:
+    directory: Path = Path("results")
+    frames: int = 0  # number of PNG frames over the run; 0: no pictures
+    history_interval: int = 1  # steps between rows of energy.csv and walls.csv
+
+
+@dataclass(frozen=True)
+class Scene:
+    source: str  # file name used in messages
+    run: RunSettings
+    mesh: MeshSpec
+    material: Material
+    initial: Initial
+    walls: tuple[WallSpec, ...] = ()
+    output: Output = field(default_factory=Output)
+
+
+# --- reading -----------------------------------------------------------------
+
+
+def load_scene(path: str | Path, overrides: list[str] = ()) -> Scene:
+    """Read, override (``key.path=value``) and validate the scene file at ``path``."""
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"{path}: scene file not found")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"{path}: not valid TOML: {err}") from None
+    for item in overrides:
+        apply_override(raw, item, str(path))
+    return parse_scene(raw, source=str(path), base=path.parent)
+
+
+def apply_override(raw: dict, item: str, source: str = "--set") -> None:
+    """Apply ``key.path=value`` (``wall[0].slide="tied"``) to the raw scene, in place.
+
+    The value is read as a TOML value; a bare word that is not one is taken as a string.
+    """
+    key, sep, text = item.partition("=")
+    if not sep or not key.strip():
+        raise SceneError(f"{source}: --set {item!r}: expected key.path=value")
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = text.strip()
+    node: Any = raw
+    parts = _split_key(key.strip(), source)
+    for i, part in enumerate(parts[:-1]):
+        nxt = parts[i + 1]
+        if isinstance(part, int):
+            if not isinstance(node, list) or part >= len(node):
+                raise SceneError(f"{source}: --set {key}: index {part} does not exist")
+            node = node[part]
+        else:
+            node = node.setdefault(part, [] if isinstance(nxt, int) else {})
+    last = parts[-1]
+    if isinstance(last, int):
+        if not isinstance(node, list) or last >= len(node):
+            raise SceneError(f"{source}: --set {key}: index {last} does not exist")
+    node[last] = value
+
+
+def _split_key(key: str, source: str) -> list[str | int]:
+    parts: list[str | int] = []
+    for word in key.split("."):
+        name, _, rest = word.partition("[")
+        if name:
+            parts.append(name)
+        while rest:
+            index, _, rest = rest.partition("]")
+            if not index.isdigit():
+                raise SceneError(f"{source}: --set {key}: bad index [{index}]")
+            parts.append(int(index))
+            rest = rest.removeprefix("[")
+    return parts
+
+
+# --- validation ----------------------------------------------------------------
+
+
+class _Table:
+    """Typed access to one TOML table that reports errors with the key path."""
+
+    def __init__(self, raw: Any, path: str, source: str, allowed: tuple[str, ...]):
+        self.path, self.source = path, source
+        if not isinstance(raw, dict):
+            self.fail(path, "must be a table")
+        self.raw = raw
+        for key in raw:
+            if key not in allowed:
+                hint = difflib.get_close_matches(key, allowed, n=1)
+                tip = f" (did you mean '{hint[0]}'?)" if hint else ""
+                self.fail(self.key(key), f"unknown key{tip}; allowed: {', '.join(allowed)}")
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def fail(self, key: str, message: str):
+        raise SceneError(f"{self.source}: {key}: {message}")
+
+    def get(self, name: str, default: Any = ...) -> Any:
+        if name not in self.raw:
+            if default is ...:
+                self.fail(self.key(name), "missing")
+            return default
+        return self.raw[name]
+
+    def number(self, name, default=..., *, low=None, high=None, low_open=True, high_open=False):
+        value = self.get(name, default)
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(self.key(name), f"must be a number, got {value!r}")
+        value = float(value)
+        ok = math.isfinite(value)
+        if low is not None:
+            ok &= value > low if low_open else value >= low
+        if high is not None:
+            ok &= value < high if high_open else value <= high
+        if not ok:
+            lo = "" if low is None else ("(" if low_open else "[") + f"{low:g}"
+            hi = "" if high is None else f"{high:g}" + (")" if high_open else "]")
+            span = f"in {lo or '(-inf'}, {hi or 'inf)'}"
+            self.fail(self.key(name), f"must be a finite number {span}, got {value:g}")
+        return value
+
+    def integer(self, name, default=..., *, low=0):
+        value = self.get(name, default)
+        if isinstance(value, bool) or not isinstance(value, int) or value < low:
+            self.fail(self.key(name), f"must be an integer >= {low}, got {value!r}")
+        return value
+
+    def vector(self, name, default=...) -> tuple[float, float, float]:
+        value = self.get(name, default)
+        if (
+            not isinstance(value, (list, tuple))
+            or len(value) != 3
+            or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in value)
+            or not all(math.isfinite(c) for c in value)
+        ):
+            self.fail(self.key(name), f"must be 3 finite numbers [x, y, z], got {value!r}")
+        return tuple(float(c) for c in value)
+
+    def choice(self, name, choices: tuple[str, ...], default=...) -> str:
+        value = self.get(name, default)
+        if value not in choices:
+            self.fail(self.key(name), f"must be one of {', '.join(map(repr, choices))}, got {value!r}")
+        return value
+
+
+def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> Scene:
+    """Validate the raw TOML mapping ``raw`` into a :class:`Scene`."""
+    top = _Table(raw, "", source, ("run", "mesh", "material", "initial", "wall", "output"))
+
+    t = _Table(top.get("run"), "run", source, ("end_time", "dt_scale", "dt"))
+    run = RunSettings(
+        end_time=t.number("end_time", low=0.0),
+        dt_scale=t.number("dt_scale", 0.9, low=0.0, high=1.0),
+        dt=t.number("dt", None, low=0.0),
+    )
+
+    t = _Table(
+        top.get("mesh"), "mesh", source,
+        ("shape", "file", "origin", "size", "element_size", "cell"),
+    )
+    if "file" in t.raw:
+        if "shape" in t.raw:
+            t.fail("mesh", "give either 'shape' or 'file', not both")
+        file = t.get("file")
+        if not isinstance(file, str):
+            t.fail(t.key("file"), f"must be a path string, got {file!r}")
+        file = (base / file).resolve()
+        if not file.is_file():
+            t.fail(t.key("file"), f"mesh file not found: {file}")
+        if file.suffix not in (".msh", ".geo"):
+            t.fail(t.key("file"), f"must be a gmsh .msh or .geo file, got {file.name}")
+        mesh = MeshSpec(shape=None, file=file)
+    else:
+        mesh = MeshSpec(
+            shape=t.choice("shape", ("bar",)),
+            origin=t.vector("origin", (0.0, 0.0, 0.0)),
+            size=_positive_vector(t, "size"),
+            element_size=t.number("element_size", low=0.0),
+            cell=t.choice("cell", ("hexahedron", "tetrahedron"), "hexahedron"),
+        )
+
+    t = _Table(top.get("material"), "material", source, ("model", "density", "young", "poisson"))
+    material = Material(
+        model=t.choice("model", ("linear_elastic",)),
+        density=t.number("density", low=0.0),
+        young=t.number("young", low=0.0),
+        poisson=t.number("poisson", low=-1.0, high=0.5, high_open=True),
+    )
+
+    t = _Table(top.get("initial", {}), "initial", source, ("velocity",))
+    initial = Initial(velocity=t.vector("velocity", (0.0, 0.0, 0.0)))
+
+    walls_raw = top.get("wall", [])
+    if not isinstance(walls_raw, list):
+        top.fail("wall", "must be an array of tables: write [[wall]]")
+    walls = tuple(_wall(w, f"wall[{i}]", source) for i, w in enumerate(walls_raw))
+
+    t = _Table(top.get("output", {}), "output", source, ("directory", "frames", "history_interval"))
+    directory = t.get("directory", "results")
+    if not isinstance(directory, str):
+        t.fail(t.key("directory"), f"must be a path string, got {directory!r}")
+    output = Output(
+        directory=Path(directory),
+        frames=t.integer("frames", 0),
+        history_interval=t.integer("history_interval", 1, low=1),
+    )
+    return Scene(source, run, mesh, material, initial, walls, output)
+
+
+def _positive_vector(t: _Table, name: str):
+    value = t.vector(name)
+    if min(value) <= 0:
+        t.fail(t.key(name), f"must be 3 positive lengths, got {list(value)}")
+    return value
+
+
+def _wall(raw: Any, path: str, source: str) -> WallSpec:
+    t = _Table(raw, path, source, ("kind", "point", "normal_point", "slide"))
+    kind = t.choice("kind", ("plane",))
+    point, normal_point = t.vector("point"), t.vector("normal_point")
+    if math.dist(point, normal_point) <= 1e-10 * max(1.0, *map(abs, point)):
+        t.fail(t.key("normal_point"), "must differ from 'point' (M1 = M leaves no normal)")
+    slide = t.choice("slide", ("free",), "free")
+    return WallSpec(kind, point, normal_point, slide)
