@@ -1,19 +1,29 @@
-"""rwall_fem: explicit elastodynamics on DOLFINx meshes with Radioss-style rigid walls."""
+"""rwall_fem: explicit elastodynamics on DOLFINx meshes with Radioss-style rigid walls.
 
-from rwall_fem import _compat  # noqa: F401  (orders dolfinx_solver before dolfinx)
-from rwall_fem.model import build_simulation, run_scene
-from rwall_fem.scene import Scene, SceneError, load_scene, parse_scene
-from rwall_fem.walls import PlaneWall, RigidWall
+The public names are imported lazily, so that ``python -m rwall_fem.render``
+(off-screen pictures) runs without DOLFINx in the process: VTK's wheels and
+DOLFINx's C++ libraries must not share a process that renders.
+"""
+
+import importlib
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "PlaneWall",
-    "RigidWall",
-    "Scene",
-    "SceneError",
-    "build_simulation",
-    "load_scene",
-    "parse_scene",
-    "run_scene",
-]
+_API = {
+    "PlaneWall": "rwall_fem.walls",
+    "RigidWall": "rwall_fem.walls",
+    "Scene": "rwall_fem.scene",
+    "SceneError": "rwall_fem.scene",
+    "load_scene": "rwall_fem.scene",
+    "parse_scene": "rwall_fem.scene",
+    "build_simulation": "rwall_fem.model",
+    "run_scene": "rwall_fem.model",
+}
+
+__all__ = sorted(_API)
+
+
+def __getattr__(name: str):
+    if name in _API:
+        return getattr(importlib.import_module(_API[name]), name)
+    raise AttributeError(f"module 'rwall_fem' has no attribute {name!r}")

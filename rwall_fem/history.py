@@ -38,7 +38,8 @@ class History:
         self.max_balance_error = 0.0
         self._last_impulse = np.zeros((len(walls), 3))
         self._last_step = -1
-        self.rows = []  # (t, K, U, W_ext, W_wall, error) as written to energy.csv
+        self.energy_rows = []  # (t, K, U, W_ext, W_wall, error), as in energy.csv
+        self.wall_rows = []  # (t, wall, F_x, F_y, F_z, I_x, I_y, I_z, contacts), as in walls.csv
         self._energy = self._walls = None
         if comm.rank == 0:
             self.directory.mkdir(parents=True, exist_ok=True)
@@ -68,21 +69,32 @@ class History:
         )
         self.max_balance_error = max(self.max_balance_error, abs(error))
         row = (s.t, kinetic, internal, external, wall_work, error)
-        self.rows.append(row)
+        self.energy_rows.append(row)
         interval = (s.step - self._last_step) * s.dt
         self._last_step = s.step
-        if self.comm.rank != 0:
-            return
-        self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
-        self._energy.flush()
+        rows = []
         for i, chunk in enumerate(total[4:].reshape(-1, 4)):
             impulse, contacts = chunk[:3], int(chunk[3])
             force = (impulse - self._last_impulse[i]) / interval
             self._last_impulse[i] = impulse
-            values = ",".join(f"{x:.17g}" for x in (*force, *impulse))
-            self._walls.write(f"{s.t:.17g},{i},{values},{contacts}\n")
-        if self.walls:
+            rows.append((s.t, i, *force, *impulse, contacts))
+        self.wall_rows += rows
+        if self.comm.rank != 0:
+            return
+        self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
+        self._energy.flush()
+        if rows:
+            self._walls.writelines(",".join(f"{x:.17g}" for x in r) + "\n" for r in rows)
             self._walls.flush()
+
+    @property
+    def energy(self) -> np.ndarray:
+        """Energy samples as an array with the columns of ``energy.csv``."""
+        return np.array(self.energy_rows)
+
+    def wall(self, i: int) -> np.ndarray:
+        """Samples of wall ``i`` as an array with the columns of ``walls.csv``."""
+        return np.array([r for r in self.wall_rows if r[1] == i])
 
     def close(self, sim) -> None:
         """Write ``summary.json`` (rank 0) and close the CSV files."""
@@ -100,7 +112,7 @@ class History:
                     "last_contact": _finite_or_none(comm.allreduce(w.last_contact, MPI.MAX)),
                 }
             )
-        t, kinetic, internal, external, wall_work, _ = self.rows[-1]
+        t, kinetic, internal, external, wall_work, _ = self.energy_rows[-1]
         summary = self.info | {
             "ranks": comm.size,
             "steps": sim.num_steps,

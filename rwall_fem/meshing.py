@@ -15,7 +15,7 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 
-__all__ = ["BodyMesh", "bar_mesh", "boundary_nodes", "read_mesh"]
+__all__ = ["BodyMesh", "bar_mesh", "boundary_nodes", "read_mesh", "rotation_to"]
 
 GEOMETRY_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
@@ -35,14 +35,30 @@ class BodyMesh:
         return imap.size_global
 
 
-def bar_mesh(comm: MPI.Comm, origin, size, element_size: float, cell: str) -> BodyMesh:
-    """Rectangular bar ``meshes/bar.geo`` from ``origin`` (m) spanning ``size`` (m).
+def bar_mesh(comm: MPI.Comm, origin, size, element_size: float, cell: str,
+             axis=(0.0, 0.0, 1.0)) -> BodyMesh:
+    """Rectangular bar ``meshes/bar.geo``: the box ``origin`` + [0, size] (m), turned about
+    ``origin`` so that its own z axis points along ``axis``.
 
     ``cell`` is "hexahedron" or "tetrahedron"; layers are at most ``element_size`` (m) thick.
     """
     params = dict(zip(("x0", "y0", "z0"), origin)) | dict(zip(("lx", "ly", "lz"), size))
     params |= {"h": element_size, "hexahedra": int(cell == "hexahedron")}
-    return read_mesh(comm, GEOMETRY_DIR / "bar.geo", params)
+    body = read_mesh(comm, GEOMETRY_DIR / "bar.geo", params)
+    x = body.msh.geometry.x
+    x[:] = (x - origin) @ rotation_to(axis).T + origin
+    return body
+
+
+def rotation_to(axis) -> np.ndarray:
+    """Rotation matrix (3, 3) that turns the z axis onto the direction ``axis``."""
+    b = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    c = b[2]  # cos of the angle between z and b
+    if c < -1 + 1e-12:
+        return np.diag([1.0, -1.0, -1.0])  # half turn about x
+    k = np.array([-b[1], b[0], 0.0])  # z x b, of length sin(angle)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + K + K @ K / (1 + c)
 
 
 def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = None) -> BodyMesh:
@@ -57,7 +73,7 @@ def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = 
         gmsh.initialize(argv)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.open(str(path))
-        if gmsh.model.getDimension() < 3 or not gmsh.model.mesh.getElements(3)[0]:
+        if len(gmsh.model.mesh.getElements(3)[0]) == 0:
             gmsh.model.mesh.generate(3)
         groups = {
             gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag

@@ -38,8 +38,7 @@ def run_scene(scene: Scene | str | Path, out: str | Path | None = None, override
         scene = load_scene(scene, list(overrides))
     sim = build_simulation(scene, comm, out)
     sim.run()
-    history = next(r for r in sim.recorders if isinstance(r, History))
-    return history.summary
+    return sim.history.summary
 
 
 def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
@@ -50,7 +49,7 @@ def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
     if spec.file is not None:
         body = read_mesh(comm, spec.file)
     else:
-        body = bar_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell)
+        body = bar_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell, spec.axis)
     msh = body.msh
     V = _compat.vector_space(msh)
     owned = V.dofmap.index_map.size_local
@@ -95,9 +94,10 @@ def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
         "dt_stable": dt_stable,
         "dt_element_estimate": dt_element,
     }
-    sim.recorders.append(History(directory, scene.output.history_interval, comm, info, walls, state))
+    sim.history = History(directory, scene.output.history_interval, comm, info, walls, state)
+    sim.recorders.append(sim.history)
     if scene.output.frames:
-        from rwall_fem.render import Frames
+        from rwall_fem.frames import Frames
 
         speed = float(np.linalg.norm(scene.initial.velocity))
         sim.recorders.append(Frames(directory, scene.output.frames, sim.num_steps, V, walls, speed))

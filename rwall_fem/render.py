@@ -1,109 +1,77 @@
-"""Off-screen pictures of a run: PNG frames and an animated GIF, drawn on rank 0.
+"""Off-screen pictures of a run: ``python -m rwall_fem.render DIR``.
 
-Each rank sends its cells, points and nodal values to rank 0 (connectivity
-offset by the points already received); rank 0 draws the body on the
-deformed geometry, coloured by the velocity component along the first
-wall's normal, with the walls at their current positions. The camera and the
-colour range are fixed from the first frame so that frames compare.
+Reads the frame data that :class:`rwall_fem.frames.Frames` stored in
+``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
+``DIR/animation.gif``. The body is drawn on its deformed geometry, coloured
+by the velocity component along the first wall's normal, with the walls.
+The camera and the colour range are fixed once for all frames. This module
+must not import DOLFINx (see :mod:`rwall_fem.frames`).
 """
 
 from __future__ import annotations
 
+import json
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
-from dolfinx import fem
 
-from rwall_fem import _compat
+from rwall_fem.walls.shapes import shape_from_parameters
 
-__all__ = ["Frames"]
-
-
-class Frames:
-    """Recorder that renders ``count`` frames evenly over the run into ``directory/frames``."""
-
-    def __init__(self, directory: Path, count: int, num_steps: int, V, walls, speed: float):
-        self.every = max(1, num_steps // max(count - 1, 1))
-        self.directory = Path(directory) / "frames"
-        self.V, self.walls = V, walls
-        self.comm = V.mesh.comm
-        self.direction = walls[0].shape.normals(np.zeros((1, 3))) if walls else None
-        self.clim = (-1.2 * speed or -1.0, 1.2 * speed or 1.0)
-        self._field = fem.Function(V)
-        topology, cell_types, points = _compat.vtk_mesh(V)
-        self._mesh = self._gather((np.asarray(topology), np.asarray(cell_types), points))
-        self._camera = None
-        self.files: list[Path] = []
-
-    def _gather(self, local):
-        pieces = self.comm.gather(local, root=0)
-        if self.comm.rank != 0:
-            return None
-        topologies, types, points, offset = [], [], [], 0
-        for topology, cell_types, x in pieces:
-            # VTK's cell array is [n, i0, .., in-1, n, ...]: shift the indices only.
-            topology = topology.reshape(len(cell_types), -1).copy()
-            topology[:, 1:] += offset
-            topologies.append(topology.ravel())
-            types.append(cell_types)
-            points.append(x)
-            offset += len(x)
-        return np.concatenate(topologies), np.concatenate(types), np.concatenate(points)
-
-    def _nodal(self, values: np.ndarray) -> np.ndarray | None:
-        f = self._field
-        n = values.size
-        f.x.array[:n] = values.ravel()
-        f.x.scatter_forward()
-        gathered = self.comm.gather(f.x.array.reshape(-1, 3).copy(), root=0)
-        return None if gathered is None else np.concatenate(gathered)
-
-    def record(self, sim, s) -> None:
-        u, v = self._nodal(s.u), self._nodal(s.v)
-        if self.comm.rank == 0:
-            self._draw(s.t, u, v)
-
-    def _draw(self, t: float, u: np.ndarray, v: np.ndarray) -> None:
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-        import pyvista
-
-        topology, cell_types, points = self._mesh
-        grid = pyvista.UnstructuredGrid(topology, cell_types, points + u)
-        direction = self.direction if self.direction is not None else np.array([0, 0, 1.0])
-        grid.point_data["velocity along wall normal (m/s)"] = v @ direction
-        plotter = pyvista.Plotter(off_screen=True, window_size=(800, 600))
-        plotter.add_mesh(grid, show_edges=True, clim=self.clim, cmap="coolwarm")
-        size = float(np.ptp(points, axis=0).max())
-        centre = points.mean(axis=0)
-        for wall in self.walls:
-            plotter.add_mesh(_wall_surface(wall.shape, centre, size), color="lightgray", opacity=0.6)
-        plotter.add_text(f"t = {t * 1e6:9.2f} us", font_size=12)
-        if self._camera is None:
-            plotter.camera_position = "iso"
-            plotter.camera.zoom(1.2)
-            self._camera = plotter.camera_position
-        plotter.camera_position = self._camera
-        path = self.directory / f"frame_{len(self.files):04d}.png"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        plotter.screenshot(str(path))
-        plotter.close()
-        self.files.append(path)
-
-    def close(self, sim) -> None:
-        """Assemble the frames into ``animation.gif`` next to the frame folder."""
-        if self.comm.rank != 0 or not self.files:
-            return
-        import imageio.v2 as imageio
-
-        images = [imageio.imread(p) for p in self.files]
-        imageio.mimsave(self.directory.parent / "animation.gif", images, duration=0.1, loop=0)
+__all__ = ["render_frames"]
 
 
-def _wall_surface(shape, centre: np.ndarray, size: float):
-    """A pyvista surface for ``shape``: the plane as a square of side 1.5 x body size."""
+def render_frames(directory: str | Path) -> list[Path]:
+    """Render every stored frame of the run in ``directory``; returns the PNG paths."""
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import imageio.v2 as imageio
     import pyvista
 
+    directory = Path(directory)
+    data = directory / "frames" / "data"
+    mesh = np.load(data / "mesh.npz")
+    points, speed = mesh["points"], float(mesh["speed"])
+    walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
+    direction = walls[0].normals(points[:1]) if walls else np.array([0.0, 0.0, 1.0])
+    label = "velocity along the wall normal (m/s)" if walls else "velocity z (m/s)"
+    clim = (-1.2 * speed, 1.2 * speed) if speed > 0 else (-1.0, 1.0)
+    size = float(np.ptp(points, axis=0).max())
+    centre = points.mean(axis=0)
+    camera, files = None, []
+    for path in sorted(data.glob("frame_*.npz")):
+        frame = np.load(path)
+        grid = pyvista.UnstructuredGrid(mesh["topology"], mesh["cell_types"], points + frame["u"])
+        grid.point_data[label] = frame["v"] @ direction
+        plotter = pyvista.Plotter(off_screen=True, window_size=(800, 600))
+        plotter.add_mesh(grid, show_edges=len(points) < 5000, clim=clim, cmap="coolwarm")
+        for wall in walls:
+            plotter.add_mesh(_wall_surface(pyvista, wall, centre, size), color="lightgray",
+                             opacity=0.6)
+        plotter.add_text(f"t = {float(frame['t']) * 1e6:9.2f} us", font_size=12)
+        if camera is None:
+            plotter.camera_position = "iso"
+            plotter.camera.zoom(1.6)
+            camera = plotter.camera_position
+        plotter.camera_position = camera
+        png = directory / "frames" / path.with_suffix(".png").name
+        plotter.screenshot(str(png))
+        plotter.close()
+        files.append(png)
+    if files:
+        images = [imageio.imread(p) for p in files]
+        imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
+    return files
+
+
+def _wall_surface(pyvista, shape, centre: np.ndarray, size: float):
+    """The plane as a square of side 1.5 x the body size, centred below the body."""
     normal = shape.normals(centre[None, :])
     foot = centre - shape.distance(centre[None, :])[0] * normal
     return pyvista.Plane(center=foot, direction=normal, i_size=1.5 * size, j_size=1.5 * size)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit("usage: python -m rwall_fem.render RESULTS_DIR")
+    render_frames(sys.argv[1])

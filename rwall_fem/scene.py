@@ -48,7 +48,8 @@ class MeshSpec:
     shape: str | None  # "bar", or None when ``file`` is given
     file: Path | None = None
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # m, lowest corner
-    size: tuple[float, float, float] = (0.01, 0.01, 0.1)  # m
+    size: tuple[float, float, float] = (0.01, 0.01, 0.1)  # m, along the bar's own x, y, z
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)  # direction of the bar's own z
     element_size: float = 2e-3  # m
     cell: str = "hexahedron"
 
@@ -251,7 +252,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
 
     t = _Table(
         top.get("mesh"), "mesh", source,
-        ("shape", "file", "origin", "size", "element_size", "cell"),
+        ("shape", "file", "origin", "size", "axis", "element_size", "cell"),
     )
     if "file" in t.raw:
         if "shape" in t.raw:
@@ -270,6 +271,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
             shape=t.choice("shape", ("bar",)),
             origin=t.vector("origin", (0.0, 0.0, 0.0)),
             size=_positive_vector(t, "size"),
+            axis=_direction(t, "axis"),
             element_size=t.number("element_size", low=0.0),
             cell=t.choice("cell", ("hexahedron", "tetrahedron"), "hexahedron"),
         )
@@ -306,6 +308,13 @@ def _positive_vector(t: _Table, name: str):
     value = t.vector(name)
     if min(value) <= 0:
         t.fail(t.key(name), f"must be 3 positive lengths, got {list(value)}")
+    return value
+
+
+def _direction(t: _Table, name: str):
+    value = t.vector(name, (0.0, 0.0, 1.0))
+    if math.hypot(*value) == 0:
+        t.fail(t.key(name), "must be a non-zero direction [x, y, z]")
     return value
 
 

@@ -79,6 +79,7 @@ class Simulation:
     forces: list = field(default_factory=list)
     constraints: list = field(default_factory=list)
     recorders: list = field(default_factory=list)
+    history: object = None  # the History among the recorders
     wall_seconds: float = 0.0
 
     @property

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PlaneWall"]
+__all__ = ["PlaneWall", "shape_from_parameters"]
 
 
 class PlaneWall:
@@ -28,6 +28,10 @@ class PlaneWall:
             raise ValueError("normal_point must differ from point")
         self.normal = normal / length
 
+    def parameters(self) -> dict:
+        """The defining points, as plain lists (for files and for :func:`shape_from_parameters`)."""
+        return {"point": self.point.tolist(), "normal_point": (self.point + self.normal).tolist()}
+
     def distance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Signed distance (m) of the points ``x`` (n, 3) to the plane; negative behind it."""
         return (x - (self.point + offset)) @ self.normal
@@ -35,3 +39,10 @@ class PlaneWall:
     def normals(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Unit normal (3,) toward the allowed side, the same for every point."""
         return self.normal
+
+
+def shape_from_parameters(parameters: dict):
+    """The shape described by ``{"kind": ..., **shape.parameters()}``."""
+    shapes = {"plane": PlaneWall}
+    arguments = dict(parameters)
+    return shapes[arguments.pop("kind")](**arguments)

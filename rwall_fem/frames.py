@@ -1,0 +1,88 @@
+"""Frame data of a run, gathered on rank 0 and rendered by :mod:`rwall_fem.render`.
+
+Each rank sends its cells, points and nodal values to rank 0 (connectivity
+offset by the points already received); rank 0 stores them in
+``frames/data``: ``mesh.npz`` once, then ``frame_NNNN.npz`` per frame.
+Pictures are drawn at the end of the run (or of a stopped run) by a separate
+process, ``python -m rwall_fem.render DIR``, which never loads DOLFINx:
+VTK's wheels crash when they render in a process that holds DOLFINx's C++
+libraries (a libstdc++ ABI clash, seen with vtk 9.7 and DOLFINx 0.5).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from dolfinx import fem
+
+from rwall_fem import _compat
+
+__all__ = ["Frames"]
+
+
+class Frames:
+    """Recorder that stores ``count`` frames evenly over the run in ``directory/frames``."""
+
+    def __init__(self, directory: Path, count: int, num_steps: int, V, walls, speed: float):
+        self.every = max(1, num_steps // max(count - 1, 1))
+        self.directory = Path(directory)
+        self.data = self.directory / "frames" / "data"
+        self.comm = V.mesh.comm
+        self.walls = walls
+        self._field = fem.Function(V)
+        self._count = 0
+        topology, cell_types, points = _compat.vtk_mesh(V)
+        mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
+        if self.comm.rank == 0:
+            self.data.mkdir(parents=True, exist_ok=True)
+            walls_info = [{"kind": w.shape.kind, **w.shape.parameters()} for w in walls]
+            np.savez(
+                self.data / "mesh.npz", topology=mesh[0], cell_types=mesh[1], points=mesh[2],
+                speed=speed, walls=json.dumps(walls_info),
+            )
+
+    def _gather(self, local):
+        pieces = self.comm.gather(local, root=0)
+        if self.comm.rank != 0:
+            return None
+        topologies, types, points, offset = [], [], [], 0
+        for topology, cell_types, x in pieces:
+            # VTK's cell array is [n, i0, .., in-1, n, ...]: shift the indices only.
+            topology = topology.reshape(len(cell_types), -1).copy()
+            topology[:, 1:] += offset
+            topologies.append(topology.ravel())
+            types.append(cell_types)
+            points.append(x)
+            offset += len(x)
+        return np.concatenate(topologies), np.concatenate(types), np.concatenate(points)
+
+    def _nodal(self, values: np.ndarray) -> np.ndarray | None:
+        f = self._field
+        f.x.array[: values.size] = values.ravel()
+        f.x.scatter_forward()
+        gathered = self.comm.gather(f.x.array.reshape(-1, 3).copy(), root=0)
+        return None if gathered is None else np.concatenate(gathered)
+
+    def record(self, sim, s) -> None:
+        u, v = self._nodal(s.u), self._nodal(s.v)
+        if self.comm.rank == 0:
+            np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v)
+        self._count += 1
+
+    def close(self, sim) -> None:
+        """Render the stored frames into PNGs and ``animation.gif`` (rank 0)."""
+        if self.comm.rank != 0 or not self._count:
+            return
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+        env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        result = subprocess.run(
+            [sys.executable, "-m", "rwall_fem.render", str(self.directory)],
+            env=env, capture_output=True, text=True,
+        )
+        if result.returncode != 0:
+            raise RuntimeError(f"rendering the frames failed:\n{result.stderr[-2000:]}")

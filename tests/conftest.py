@@ -1,0 +1,55 @@
+"""Shared helpers: scenes as dictionaries, run in-process on a chosen communicator.
+
+The suite runs serially and under ``mpirun -n 2``; a test that runs a scene
+uses ``MPI.COMM_WORLD`` unless it says otherwise, and every rank asserts.
+"""
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from rwall_fem import build_simulation, parse_scene
+
+STEEL_NU0 = {"model": "linear_elastic", "density": 7850.0, "young": 210.0e9, "poisson": 0.0}
+
+
+def bar_scene(*, elements=40, h=1e-3, axis=(0.0, 0.0, 1.0), cell="hexahedron", speed=10.0,
+              wall=True, end_time=None, gap=0.0):
+    """A nu = 0 steel bar of ``elements`` layers along ``axis`` moving at ``speed`` toward a
+    fixed plane whose normal is ``axis``; the bar's lower face is ``gap`` (m) above the plane."""
+    L = elements * h
+    c = math.sqrt(STEEL_NU0["young"] / STEEL_NU0["density"])
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    origin = list(gap * axis)
+    raw = {
+        "run": {"end_time": end_time or (gap / speed + 3.0 * L / c), "dt_scale": 0.9},
+        "mesh": {"shape": "bar", "origin": origin, "size": [h, h, L], "axis": list(axis),
+                 "element_size": h, "cell": cell},
+        "material": dict(STEEL_NU0),
+        "initial": {"velocity": list(-speed * axis)},
+        "output": {"frames": 0},
+    }
+    if wall:
+        raw["wall"] = [{"kind": "plane", "point": [0.0, 0.0, 0.0], "normal_point": list(axis)}]
+    return raw
+
+
+@pytest.fixture
+def shared_dir(tmp_path_factory):
+    """A directory that every rank of COMM_WORLD sees (rank 0's temporary path)."""
+    path = tmp_path_factory.mktemp("run") if MPI.COMM_WORLD.rank == 0 else None
+    return MPI.COMM_WORLD.bcast(path, root=0)
+
+
+def run(raw, directory, comm=MPI.COMM_WORLD, **overrides):
+    """Run the scene ``raw`` (a dict) into ``directory``; returns the finished Simulation."""
+    raw = copy.deepcopy(raw)
+    for key, value in overrides.items():
+        section, name = key.split("__")
+        raw[section][name] = value
+    sim = build_simulation(parse_scene(raw, source="test"), comm, directory)
+    sim.run()
+    return sim

@@ -1,0 +1,131 @@
+"""The run contract: outputs, the command line, and refusals of bad input."""
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import bar_scene, run
+from mpi4py import MPI
+
+from rwall_fem import SceneError, parse_scene
+
+serial_only = pytest.mark.skipif(
+    MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
+)
+SCENE = """
+[run]
+end_time = 2e-5
+[mesh]
+shape = "bar"
+size = [0.004, 0.004, 0.02]
+element_size = 0.002
+[material]
+model = "linear_elastic"
+density = 7850.0
+young = 210e9
+poisson = 0.3
+[initial]
+velocity = [0.0, 0.0, -5.0]
+[[wall]]
+kind = "plane"
+point = [0.0, 0.0, 0.0]
+normal_point = [0.0, 0.0, 1.0]
+[output]
+frames = 3
+"""
+
+
+def test_outputs_of_a_run(shared_dir):
+    raw = bar_scene(elements=8, h=2e-3, cell="tetrahedron")
+    raw["output"] = {"frames": 3, "history_interval": 5}
+    sim = run(raw, shared_dir)
+    if MPI.COMM_WORLD.rank == 0:
+        out = Path(shared_dir)
+        summary = json.loads((out / "summary.json").read_text())
+        for key in ("dolfinx_version", "ranks", "cells", "nodes", "steps", "dt", "end_time",
+                    "wall_seconds", "effects", "mass", "initial_momentum", "final_momentum"):
+            assert key in summary
+        assert summary["ranks"] == MPI.COMM_WORLD.size
+        assert set(summary["energy"]) == {"initial", "kinetic", "internal", "external_work",
+                                          "wall_work", "max_balance_error"}
+        assert set(summary["walls"][0]) >= {"kind", "impulse", "first_contact", "last_contact"}
+        rows = list(csv.DictReader(open(out / "energy.csv")))
+        assert list(rows[0]) == ["time", "kinetic", "internal", "external_work", "wall_work",
+                                 "balance_error"]
+        # every 5th step and the last one
+        assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
+        walls = list(csv.DictReader(open(out / "walls.csv")))
+        assert list(walls[0]) == ["time", "wall", "force_x", "force_y", "force_z", "impulse_x",
+                                  "impulse_y", "impulse_z", "contacts"]
+        frames = sorted((out / "frames").glob("frame_*.png"))
+        assert len(frames) == 3
+        assert (out / "animation.gif").stat().st_size > 0
+
+
+def test_dt_above_stable_limit_is_refused(shared_dir):
+    raw = bar_scene(elements=4)
+    raw["run"]["dt"] = 1e-6  # h / c = 1.9e-7 s
+    with pytest.raises(SceneError, match=r"run\.dt: 1e-06 s is above the stable limit"):
+        run(raw, shared_dir)
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("run.dt_scale", 1.5, r"run\.dt_scale: must be a finite number in \(0, 1\]"),
+        ("run.end_time", 0.0, r"run\.end_time: must be a finite number in \(0, inf\)"),
+        ("material.poisson", 0.5, r"material\.poisson: .* in \(-1, 0\.5\)"),
+        ("material.densty", 1.0, r"unknown key \(did you mean 'density'\?\)"),
+        ("mesh.cell", "prism", r"mesh\.cell: must be one of 'hexahedron', 'tetrahedron'"),
+        ("mesh.size", [1.0, 0.0, 1.0], r"mesh\.size: must be 3 positive lengths"),
+        ("wall.0.normal_point", [0.0, 0.0, 0.0], r"wall\[0\]\.normal_point: must differ"),
+        ("wall.0.kind", "cone", r"wall\[0\]\.kind: must be one of 'plane'"),
+    ],
+)
+def test_bad_scenes_name_the_key(key, value, message):
+    raw = bar_scene(elements=4)
+    section, *rest = key.split(".")
+    target = raw[section] if len(rest) == 1 else raw[section][int(rest[0])]
+    target[rest[-1]] = value
+    with pytest.raises(SceneError, match=message):
+        parse_scene(raw, source="bad.toml")
+
+
+def _cli(*args, cwd):
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    return subprocess.run([sys.executable, "-m", "rwall_fem", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+@serial_only
+def test_command_line_run_with_override(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    result = _cli("run", "scene.toml", "--out", "out", "--set", "initial.velocity=[0, 0, -2]",
+                  "--set", "output.frames=0", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["initial_momentum"][2] == pytest.approx(-2.0 * summary["mass"])
+    assert "done:" in result.stdout
+
+
+@serial_only
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["run", "missing.toml"], "missing.toml: scene file not found"),
+        (["run", "scene.toml", "--set", "material.young=-1"], "material.young: must be"),
+        (["run", "scene.toml", "--set", "wall[3].slide=free"], "index 3 does not exist"),
+        (["run", "scene.toml", "--set", "run.dt=1e-3"], "run.dt: 0.001 s is above the stable"),
+    ],
+)
+def test_command_line_bad_input_is_one_line(tmp_path, args, message):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    result = _cli(*args, cwd=tmp_path)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], result.stderr
+    assert "Traceback" not in result.stderr
