@@ -29,7 +29,7 @@ class Frames:
     """Recorder that stores ``count`` frames evenly over the run in ``directory/frames``."""
 
     def __init__(self, directory: Path, count: int, num_steps: int, V, walls, speed: float):
-        self.every = max(1, num_steps // max(count - 1, 1))
+        self.steps = {round(k * num_steps / max(count - 1, 1)) for k in range(count)}
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
@@ -67,6 +67,9 @@ class Frames:
         f.x.scatter_forward()
         gathered = self.comm.gather(f.x.array.reshape(-1, 3).copy(), root=0)
         return None if gathered is None else np.concatenate(gathered)
+
+    def due(self, step: int) -> bool:
+        return step in self.steps
 
     def record(self, sim, s) -> None:
         u, v = self._nodal(s.u), self._nodal(s.v)

@@ -28,8 +28,10 @@ __all__ = ["History"]
 class History:
     """Samples energies and wall forces every ``every`` steps and writes the run summary."""
 
-    def __init__(self, directory: Path, every: int, comm: MPI.Comm, info: dict, walls, state):
-        self.every, self.comm, self.info, self.walls = every, comm, info, walls
+    def __init__(self, directory: Path, every: int, num_steps: int, comm: MPI.Comm, info: dict,
+                 walls, state):
+        self.every, self.num_steps = every, num_steps
+        self.comm, self.info, self.walls = comm, info, walls
         self.directory = Path(directory)
         m = state.mass[:, None]
         self.initial_momentum = comm.allreduce(np.sum(m * state.v, axis=0))
@@ -52,6 +54,9 @@ class History:
                     "time,wall,force_x,force_y,force_z,impulse_x,impulse_y,impulse_z,contacts\n"
                 )
                 self._walls.flush()
+
+    def due(self, step: int) -> bool:
+        return step % self.every == 0 or step == self.num_steps
 
     def record(self, sim, s) -> None:
         """Sample step ``s.step``: needs ``v^{n-1/2}`` and ``a^n`` (before the update)."""

@@ -94,7 +94,8 @@ def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
         "dt_stable": dt_stable,
         "dt_element_estimate": dt_element,
     }
-    sim.history = History(directory, scene.output.history_interval, comm, info, walls, state)
+    sim.history = History(directory, scene.output.history_interval, sim.num_steps, comm, info,
+                          walls, state)
     sim.recorders.append(sim.history)
     if scene.output.frames:
         from rwall_fem.frames import Frames

@@ -103,7 +103,7 @@ class Simulation:
             for constraint in self.constraints:
                 constraint.constrain(s)
             for recorder in self.recorders:
-                if step % recorder.every == 0 or step == last:
+                if recorder.due(step):
                     recorder.record(self, s)
             np.multiply(s.a, s.dt, out=scratch)
             s.v += scratch
