@@ -73,7 +73,8 @@ def test_free_flight_conserves_momentum_and_energy(shared_dir):
     assert summary["effects"] == ["linear_elastic"]
     assert summary["walls"] == []
     p0, p1 = np.asarray(summary["initial_momentum"]), np.asarray(summary["final_momentum"])
-    assert np.allclose(p1, p0, rtol=0, atol=1e-13 * np.linalg.norm(p0))
+    # K 1 = 0: a rigid translation has no internal force, up to the round-off of K u.
+    assert np.allclose(p1, p0, rtol=0, atol=1e-11 * np.linalg.norm(p0))
     assert summary["energy"]["max_balance_error"] <= 1e-12
     assert summary["energy"]["kinetic"] == pytest.approx(summary["energy"]["initial"], rel=1e-12)
 
