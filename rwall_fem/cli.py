@@ -22,7 +22,11 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("scene", help="scene file (TOML)")
     run.add_argument("--out", help="results directory (default: the scene's output.directory)")
     run.add_argument(
-        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
         help="override a scene key, value read as TOML (e.g. mesh.element_size=5e-4)",
     )
     run.add_argument("--quiet", action="store_true", help="print only errors")

@@ -42,8 +42,12 @@ class Frames:
             self.data.mkdir(parents=True, exist_ok=True)
             walls_info = [{"kind": w.shape.kind, **w.shape.parameters()} for w in walls]
             np.savez(
-                self.data / "mesh.npz", topology=mesh[0], cell_types=mesh[1], points=mesh[2],
-                speed=speed, walls=json.dumps(walls_info),
+                self.data / "mesh.npz",
+                topology=mesh[0],
+                cell_types=mesh[1],
+                points=mesh[2],
+                speed=speed,
+                walls=json.dumps(walls_info),
             )
 
     def _gather(self, local):
@@ -85,7 +89,9 @@ class Frames:
         env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         result = subprocess.run(
             [sys.executable, "-m", "rwall_fem.render", str(self.directory)],
-            env=env, capture_output=True, text=True,
+            env=env,
+            capture_output=True,
+            text=True,
         )
         if result.returncode != 0:
             raise RuntimeError(f"rendering the frames failed:\n{result.stderr[-2000:]}")

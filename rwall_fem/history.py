@@ -28,8 +28,9 @@ __all__ = ["History"]
 class History:
     """Samples energies and wall forces every ``every`` steps and writes the run summary."""
 
-    def __init__(self, directory: Path, every: int, num_steps: int, comm: MPI.Comm, info: dict,
-                 walls, state):
+    def __init__(
+        self, directory: Path, every: int, num_steps: int, comm: MPI.Comm, info: dict, walls, state
+    ):
         self.every, self.num_steps = every, num_steps
         self.comm, self.info, self.walls = comm, info, walls
         self.directory = Path(directory)

@@ -35,14 +35,16 @@ class BodyMesh:
         return imap.size_global
 
 
-def bar_mesh(comm: MPI.Comm, origin, size, element_size: float, cell: str,
-             axis=(0.0, 0.0, 1.0)) -> BodyMesh:
+def bar_mesh(
+    comm: MPI.Comm, origin, size, element_size: float, cell: str, axis=(0.0, 0.0, 1.0)
+) -> BodyMesh:
     """Rectangular bar ``meshes/bar.geo``: the box ``origin`` + [0, size] (m), turned about
     ``origin`` so that its own z axis points along ``axis``.
 
     ``cell`` is "hexahedron" or "tetrahedron"; layers are at most ``element_size`` (m) thick.
     """
-    params = dict(zip(("x0", "y0", "z0"), origin)) | dict(zip(("lx", "ly", "lz"), size))
+    params = dict(zip(("x0", "y0", "z0"), origin, strict=True))
+    params |= dict(zip(("lx", "ly", "lz"), size, strict=True))
     params |= {"h": element_size, "hexahedra": int(cell == "hexahedron")}
     body = read_mesh(comm, GEOMETRY_DIR / "bar.geo", params)
     x = body.msh.geometry.x

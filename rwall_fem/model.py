@@ -31,8 +31,12 @@ __all__ = ["build_simulation", "run_scene"]
 log = logging.getLogger("rwall_fem")
 
 
-def run_scene(scene: Scene | str | Path, out: str | Path | None = None, overrides=(),
-              comm: MPI.Comm = MPI.COMM_WORLD) -> dict:
+def run_scene(
+    scene: Scene | str | Path,
+    out: str | Path | None = None,
+    overrides=(),
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> dict:
     """Build and run a scene (object or TOML path); returns the summary written to ``out``."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene, list(overrides))
@@ -41,8 +45,9 @@ def run_scene(scene: Scene | str | Path, out: str | Path | None = None, override
     return sim.history.summary
 
 
-def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
-                     out: str | Path | None = None) -> Simulation:
+def build_simulation(
+    scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, out: str | Path | None = None
+) -> Simulation:
     """Mesh the body, assemble mass and stiffness, choose dt and assemble the pipeline."""
     directory = Path(out) if out is not None else scene.output.directory
     spec = scene.mesh
@@ -71,8 +76,12 @@ def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
     log.info(
         "mesh: %d %s cells, %d nodes; stable dt %.4g s (eigenvalue), %.4g s (shortest edge / c_p);"
         " dt = %.4g s",
-        body.num_cells, msh.topology.cell_type.name, V.dofmap.index_map.size_global,
-        dt_stable, dt_element, dt,
+        body.num_cells,
+        msh.topology.cell_type.name,
+        V.dofmap.index_map.size_global,
+        dt_stable,
+        dt_element,
+        dt,
     )
 
     state = State(X=X, mass=mass, dt=dt)
@@ -94,16 +103,21 @@ def build_simulation(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD,
         "dt_stable": dt_stable,
         "dt_element_estimate": dt_element,
     }
-    sim.history = History(directory, scene.output.history_interval, sim.num_steps, comm, info,
-                          walls, state)
+    sim.history = History(
+        directory, scene.output.history_interval, sim.num_steps, comm, info, walls, state
+    )
     sim.recorders.append(sim.history)
     if scene.output.frames:
         from rwall_fem.frames import Frames
 
         speed = float(np.linalg.norm(scene.initial.velocity))
         sim.recorders.append(Frames(directory, scene.output.frames, sim.num_steps, V, walls, speed))
-    log.info("effects: %s; %d steps to t = %.4g s", ", ".join(sim.effects), sim.num_steps,
-             sim.num_steps * dt)
+    log.info(
+        "effects: %s; %d steps to t = %.4g s",
+        ", ".join(sim.effects),
+        sim.num_steps,
+        sim.num_steps * dt,
+    )
     return sim
 
 

@@ -235,7 +235,8 @@ class _Table:
     def choice(self, name, choices: tuple[str, ...], default=...) -> str:
         value = self.get(name, default)
         if value not in choices:
-            self.fail(self.key(name), f"must be one of {', '.join(map(repr, choices))}, got {value!r}")
+            allowed = ", ".join(map(repr, choices))
+            self.fail(self.key(name), f"must be one of {allowed}, got {value!r}")
         return value
 
 
@@ -251,7 +252,9 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
     )
 
     t = _Table(
-        top.get("mesh"), "mesh", source,
+        top.get("mesh"),
+        "mesh",
+        source,
         ("shape", "file", "origin", "size", "axis", "element_size", "cell"),
     )
     if "file" in t.raw:

@@ -16,8 +16,17 @@ from rwall_fem import build_simulation, parse_scene
 STEEL_NU0 = {"model": "linear_elastic", "density": 7850.0, "young": 210.0e9, "poisson": 0.0}
 
 
-def bar_scene(*, elements=40, h=1e-3, axis=(0.0, 0.0, 1.0), cell="hexahedron", speed=10.0,
-              wall=True, end_time=None, gap=0.0):
+def bar_scene(
+    *,
+    elements=40,
+    h=1e-3,
+    axis=(0.0, 0.0, 1.0),
+    cell="hexahedron",
+    speed=10.0,
+    wall=True,
+    end_time=None,
+    gap=0.0,
+):
     """A nu = 0 steel bar of ``elements`` layers along ``axis`` moving at ``speed`` toward a
     fixed plane whose normal is ``axis``; the bar's lower face is ``gap`` (m) above the plane."""
     L = elements * h
@@ -26,8 +35,14 @@ def bar_scene(*, elements=40, h=1e-3, axis=(0.0, 0.0, 1.0), cell="hexahedron", s
     origin = list(gap * axis)
     raw = {
         "run": {"end_time": end_time or (gap / speed + 3.0 * L / c), "dt_scale": 0.9},
-        "mesh": {"shape": "bar", "origin": origin, "size": [h, h, L], "axis": list(axis),
-                 "element_size": h, "cell": cell},
+        "mesh": {
+            "shape": "bar",
+            "origin": origin,
+            "size": [h, h, L],
+            "axis": list(axis),
+            "element_size": h,
+            "cell": cell,
+        },
         "material": dict(STEEL_NU0),
         "initial": {"velocity": list(-speed * axis)},
         "output": {"frames": 0},

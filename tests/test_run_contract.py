@@ -46,21 +46,54 @@ def test_outputs_of_a_run(shared_dir):
     if MPI.COMM_WORLD.rank == 0:
         out = Path(shared_dir)
         summary = json.loads((out / "summary.json").read_text())
-        for key in ("dolfinx_version", "ranks", "cells", "nodes", "steps", "dt", "end_time",
-                    "wall_seconds", "effects", "mass", "initial_momentum", "final_momentum"):
+        for key in (
+            "dolfinx_version",
+            "ranks",
+            "cells",
+            "nodes",
+            "steps",
+            "dt",
+            "end_time",
+            "wall_seconds",
+            "effects",
+            "mass",
+            "initial_momentum",
+            "final_momentum",
+        ):
             assert key in summary
         assert summary["ranks"] == MPI.COMM_WORLD.size
-        assert set(summary["energy"]) == {"initial", "kinetic", "internal", "external_work",
-                                          "wall_work", "max_balance_error"}
+        assert set(summary["energy"]) == {
+            "initial",
+            "kinetic",
+            "internal",
+            "external_work",
+            "wall_work",
+            "max_balance_error",
+        }
         assert set(summary["walls"][0]) >= {"kind", "impulse", "first_contact", "last_contact"}
         rows = list(csv.DictReader(open(out / "energy.csv")))
-        assert list(rows[0]) == ["time", "kinetic", "internal", "external_work", "wall_work",
-                                 "balance_error"]
+        assert list(rows[0]) == [
+            "time",
+            "kinetic",
+            "internal",
+            "external_work",
+            "wall_work",
+            "balance_error",
+        ]
         # every 5th step and the last one
         assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
         walls = list(csv.DictReader(open(out / "walls.csv")))
-        assert list(walls[0]) == ["time", "wall", "force_x", "force_y", "force_z", "impulse_x",
-                                  "impulse_y", "impulse_z", "contacts"]
+        assert list(walls[0]) == [
+            "time",
+            "wall",
+            "force_x",
+            "force_y",
+            "force_z",
+            "impulse_x",
+            "impulse_y",
+            "impulse_z",
+            "contacts",
+        ]
         frames = sorted((out / "frames").glob("frame_*.png"))
         assert len(frames) == 3
         assert (out / "animation.gif").stat().st_size > 0
@@ -97,15 +130,30 @@ def test_bad_scenes_name_the_key(key, value, message):
 
 def _cli(*args, cwd):
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
-    return subprocess.run([sys.executable, "-m", "rwall_fem", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "rwall_fem", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 @serial_only
 def test_command_line_run_with_override(tmp_path):
     (tmp_path / "scene.toml").write_text(SCENE)
-    result = _cli("run", "scene.toml", "--out", "out", "--set", "initial.velocity=[0, 0, -2]",
-                  "--set", "output.frames=0", cwd=tmp_path)
+    result = _cli(
+        "run",
+        "scene.toml",
+        "--out",
+        "out",
+        "--set",
+        "initial.velocity=[0, 0, -2]",
+        "--set",
+        "output.frames=0",
+        cwd=tmp_path,
+    )
     assert result.returncode == 0, result.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["initial_momentum"][2] == pytest.approx(-2.0 * summary["mass"])
