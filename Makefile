@@ -1,0 +1,178 @@
+# rwall_fem: set-up and test driver (Debian 12, run as root or with sudo).
+#
+#   make test                  run the pytest suite on every DOLFINx leg, serially and on NP ranks
+#   make test DOLFINX=0.5      only the Debian leg:  DOLFINx 0.5 (apt) + Open MPI, venv .venv
+#   make test DOLFINX=0.11     only the PyPI leg:    dolfinx-solver-real 0.11 + MPICH, venv .venv-0.11
+#   make venv                  set-up only (honours DOLFINX too)
+#   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
+#   make clean                 remove both venvs, test logs and Python caches (results/ is kept)
+#
+# Set-up is incremental: apt runs only when a package is missing (one dpkg-query otherwise),
+# and pip runs only when a venv is new or pyproject.toml is newer than the venv's stamp.
+# pip keeps its normal cache (~/.cache/pip), so a fresh clone re-uses downloaded wheels.
+#
+# The 0.11 leg needs Python >= 3.12 (pyenv 3.12.x / 3.13.x, or python3.12 / python3.13 on
+# PATH; override with PY011=/path/to/python3.12).  Without one it prints a single
+# "SKIPPED: ..." line and succeeds.
+#
+# Each test run is its own target and make runs with --keep-going, so one `make test` runs
+# every leg and reports every failure, and still exits non-zero if anything failed.
+
+SHELL       := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+MAKEFLAGS   += --keep-going --no-print-directory
+.DELETE_ON_ERROR:
+.NOTPARALLEL:                 # one leg at a time: readable output, and only 2 cores anyway
+
+# ---- knobs ----------------------------------------------------------------------------------
+# Which legs: all | 0.5 | 0.11
+DOLFINX      ?= all
+# MPI ranks for the parallel runs
+NP           ?= 2
+# No -x: under MPI, one rank stopping early would strand the other in a collective.
+PYTEST_ARGS  ?= -q tests
+# Seconds per pytest run, so a deadlocked MPI job cannot hang CI (0 = no limit).
+TEST_TIMEOUT ?= 3600
+# --foreground: Ctrl-C still reaches pytest/mpirun; on time-out mpirun takes its ranks down.
+TIMEOUT       = timeout --foreground $(TEST_TIMEOUT)
+
+# ---- the two legs ---------------------------------------------------------------------------
+# Leg 0.5: Debian's DOLFINx. Always Debian's interpreter: `python3` on PATH may be pyenv's.
+SYS_PYTHON   := /usr/bin/python3
+VENV         := .venv
+LOGS_0.5     := $(VENV)/mpi-logs
+APT_0.5      := python3-dolfinx python3-petsc4py python3-slepc4py python3-mpi4py python3-gmsh \
+                python3-pytest python3-venv openmpi-bin \
+                libegl1 libgl1-mesa-dri libegl-mesa0 libosmesa6
+# Open MPI 4.1 refuses root without --allow-run-as-root, and refuses NP > cores without
+# --oversubscribe.  single_copy_mechanism=none: CMA (process_vm_readv) is blocked in many
+# containers and then large messages fail with "Read -1, expected ..., errno = 1".
+MPIRUN_0.5   := $(TIMEOUT) env OMPI_MCA_btl_vader_single_copy_mechanism=none \
+                mpirun --allow-run-as-root --oversubscribe
+
+# Leg 0.11: the dolfinx-solver-real wheel (bundles PETSc, SLEPc, MPICH); its own mpiexec.
+VENV011      := .venv-0.11
+LOGS_0.11    := $(VENV011)/mpi-logs
+WHEEL_0.11   := dolfinx-solver-real==0.11.* gmsh
+# The wheel is self-contained, but its FFCx JIT needs a C compiler and VTK's off-screen
+# rendering needs EGL/Mesa (all already pulled in by the 0.5 leg's packages).
+APT_0.11     := gcc libc6-dev libegl1 libgl1-mesa-dri libegl-mesa0 libosmesa6
+MPIRUN_0.11  := $(TIMEOUT) env UCX_TLS=self,sm,tcp $(VENV011)/bin/mpiexec
+
+# Environment of the demo and test runs: off-screen pyvista through EGL, headless matplotlib.
+RUN_ENV      := env VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow PYVISTA_OFF_SCREEN=true MPLBACKEND=Agg
+# Tests add: one BLAS/OpenMP thread per rank (NP ranks share the cores), live output.
+TEST_ENV     := $(RUN_ENV) OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONUNBUFFERED=1
+# Under MPI each rank is its own pytest session: skip .pytest_cache (both ranks would write
+# it) and give each rank its own temporary tree (two sessions pruning the shared
+# /tmp/pytest-of-<user> race).  {rank} is filled in by tools/mpi-run-logged.sh.
+MPI_PYTEST    = -m pytest -p no:cacheprovider --basetemp=$(1)/tmp-rank{rank} $(PYTEST_ARGS)
+
+PIP_ENV      := env PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_INPUT=1
+
+# ---- leg selection --------------------------------------------------------------------------
+DOLFINX := $(strip $(DOLFINX))
+ifeq ($(DOLFINX),all)
+  LEGS := 0.5 0.11
+else ifneq ($(filter $(DOLFINX),0.5 0.11),)
+  LEGS := $(DOLFINX)
+else
+  $(error DOLFINX must be all, 0.5 or 0.11 (got '$(DOLFINX)'))
+endif
+
+# The Python >= 3.12 for the 0.11 leg, looked up only when that leg is wanted.
+ifneq ($(filter 0.11,$(LEGS)),)
+  ifeq ($(origin PY011),undefined)
+    PY011 := $(shell bash tools/find-python-0.11.sh)
+  endif
+endif
+
+.PHONY: test venv demo clean apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
+        test-0.5 test-0.5-serial test-0.5-mpi test-0.11 test-0.11-serial test-0.11-mpi
+
+test: $(addprefix test-,$(LEGS))
+venv: $(addprefix venv-,$(LEGS))
+
+# ---- leg 0.5: Debian packages + .venv -------------------------------------------------------
+# Order-only on apt-0.5: the (cheap) dpkg check runs every time but never forces a re-install.
+apt-0.5:
+	@bash tools/ensure-apt-packages.sh $(APT_0.5)
+
+# A venv is (re)made when missing or when its interpreter is gone (dangling bin/python);
+# its fresh pyvenv.cfg then makes the pip stamp out of date.
+ifeq ($(realpath $(VENV)/bin/python),)
+$(VENV)/pyvenv.cfg: FORCE
+endif
+$(VENV)/pyvenv.cfg: | apt-0.5
+	@echo ">>> creating $(VENV) ($(SYS_PYTHON), with system site packages)"
+	rm -rf $(VENV)
+	$(SYS_PYTHON) -m venv --system-site-packages $(VENV)
+
+# numpy is pinned to Debian's: a newer numpy from PyPI breaks Debian's petsc4py (ABI).
+$(VENV)/.installed: pyproject.toml $(VENV)/pyvenv.cfg | apt-0.5
+	@echo ">>> pip install -e '.[test]' into $(VENV)"
+	echo "numpy==$$($(SYS_PYTHON) -c 'import numpy; print(numpy.__version__)')" > $(VENV)/constraints.txt
+	$(PIP_ENV) $(VENV)/bin/pip install -q -c $(VENV)/constraints.txt -e '.[test]'
+	touch $@
+
+venv-0.5: $(VENV)/.installed
+
+test-0.5: test-0.5-serial test-0.5-mpi
+
+test-0.5-serial: venv-0.5
+	@echo "===== DOLFINx 0.5 (Debian): pytest, serial ====="
+	$(TEST_ENV) $(TIMEOUT) $(VENV)/bin/python -m pytest $(PYTEST_ARGS)
+
+test-0.5-mpi: venv-0.5
+	@echo "===== DOLFINx 0.5 (Debian): pytest, $(NP) MPI ranks (rank 0 shown, all in $(LOGS_0.5)) ====="
+	$(TEST_ENV) bash tools/mpi-run-logged.sh $(NP) $(LOGS_0.5) $(MPIRUN_0.5) \
+	    -- $(VENV)/bin/python $(call MPI_PYTEST,$(LOGS_0.5))
+
+# ---- leg 0.11: PyPI wheel + .venv-0.11 ------------------------------------------------------
+ifneq ($(PY011),)
+
+ifeq ($(realpath $(VENV011)/bin/python),)
+$(VENV011)/pyvenv.cfg: FORCE
+endif
+apt-0.11:
+	@bash tools/ensure-apt-packages.sh $(APT_0.11)
+
+$(VENV011)/pyvenv.cfg: | apt-0.11
+	@echo ">>> creating $(VENV011) ($(PY011))"
+	rm -rf $(VENV011)
+	$(PY011) -m venv $(VENV011)
+
+$(VENV011)/.installed: pyproject.toml $(VENV011)/pyvenv.cfg | apt-0.11
+	@echo ">>> pip install $(WHEEL_0.11) -e '.[test]' into $(VENV011)"
+	$(PIP_ENV) $(VENV011)/bin/pip install -q $(WHEEL_0.11) -e '.[test]'
+	touch $@
+
+venv-0.11: $(VENV011)/.installed
+
+test-0.11: test-0.11-serial test-0.11-mpi
+
+test-0.11-serial: venv-0.11
+	@echo "===== DOLFINx 0.11 (PyPI wheel): pytest, serial ====="
+	$(TEST_ENV) $(TIMEOUT) $(VENV011)/bin/python -m pytest $(PYTEST_ARGS)
+
+test-0.11-mpi: venv-0.11
+	@echo "===== DOLFINx 0.11 (PyPI wheel): pytest, $(NP) MPI ranks (rank 0 shown, all in $(LOGS_0.11)) ====="
+	$(TEST_ENV) bash tools/mpi-run-logged.sh $(NP) $(LOGS_0.11) $(MPIRUN_0.11) \
+	    -- $(VENV011)/bin/python $(call MPI_PYTEST,$(LOGS_0.11))
+
+else  # no Python >= 3.12: skip the leg loudly, but do not fail
+
+venv-0.11 test-0.11:
+	@echo "SKIPPED: DOLFINx 0.11 leg (no Python >= 3.12)"
+
+endif
+
+FORCE:
+
+# ---- demo and clean ---------------------------------------------------------------------------
+demo: venv-0.5
+	$(RUN_ENV) $(VENV)/bin/rwall-fem run demos/bar_impact.toml --out results/bar_impact
+
+clean:
+	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info
+	find . -path ./.git -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
