@@ -78,7 +78,8 @@ class Frames:
     def record(self, sim, s) -> None:
         u, v = self._nodal(s.u), self._nodal(s.v)
         if self.comm.rank == 0:
-            np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v)
+            offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
+            np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v, offsets=offsets)
         self._count += 1
 
     def close(self, sim) -> None:

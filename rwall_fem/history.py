@@ -3,12 +3,15 @@
 Energies are booked so that, for central differences, the balance closes
 exactly (see ``../shared/notes/numerics.md``):
 
-- kinetic energy is the shadow value K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2};
+- kinetic energy is the shadow value K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2},
+  walls carried by a main node included;
 - strain energy is U^n = 1/2 u^n . K u^n;
-- the work of every other force g (walls, body forces) is booked at mid-step
-  velocities, 1/2 g^n . (v^{n-1/2} + v^{n+1/2}) dt;
+- the work of every other force g (body forces, walls) is booked at mid-step
+  velocities, 1/2 g^n . (v^{n-1/2} + v^{n+1/2}) dt; the wall work is that of
+  the contact impulses relative to the wall (normal stop and friction), the
+  driving work of prescribed walls counts as external work;
 - the balance error is (K + U - W_ext - W_wall - E0) / E_ref with E0 the
-  initial energy 1/2 sum m v0^2 and E_ref = max(E0, the largest K + U so far).
+  initial energy (kinetic, walls included) and E_ref = max(E0, largest K + U).
 
 Every row is flushed as it is written, so a run that stops leaves complete
 lines up to its last sample. Rank 0 writes; all ranks take part in the sums.
@@ -24,9 +27,23 @@ from mpi4py import MPI
 
 __all__ = ["History"]
 
+WALL_COLUMNS = (
+    ["time", "wall"]
+    + [f"force_{c}" for c in "xyz"]
+    + [f"impulse_{c}" for c in "xyz"]
+    + [f"normal_force_{c}" for c in "xyz"]
+    + [f"tangential_force_{c}" for c in "xyz"]
+    + [f"normal_impulse_{c}" for c in "xyz"]
+    + [f"tangential_impulse_{c}" for c in "xyz"]
+    + ["contacts"]
+    + [f"position_{c}" for c in "xyz"]
+    + [f"velocity_{c}" for c in "xyz"]
+)
+_PER_WALL = 9  # reduced per wall: normal, tangential impulse (3 + 3), contacts, works (2)
+
 
 class History:
-    """Samples energies and wall forces every ``every`` steps and writes the run summary."""
+    """Samples energies and wall forces at the steps it is due and writes the run summary."""
 
     def __init__(
         self, directory: Path, every: int, num_steps: int, comm: MPI.Comm, info: dict, walls, state
@@ -35,14 +52,20 @@ class History:
         self.comm, self.info, self.walls = comm, info, walls
         self.directory = Path(directory)
         m = state.mass[:, None]
-        self.initial_momentum = comm.allreduce(np.sum(m * state.v, axis=0))
-        self.initial_energy = comm.allreduce(0.5 * float(np.sum(m * state.v**2)))
+        moving = [w.motion for w in walls if w.motion.dynamic]
+        self.initial_momentum = comm.allreduce(np.sum(m * state.v, axis=0)) + sum(
+            (mo.mass * mo.velocity for mo in moving), np.zeros(3)
+        )
+        self.initial_energy = comm.allreduce(0.5 * float(np.sum(m * state.v**2))) + sum(
+            0.5 * mo.mass * mo.velocity @ mo.velocity for mo in moving
+        )
         self.reference_energy = self.initial_energy
         self.max_balance_error = 0.0
-        self._last_impulse = np.zeros((len(walls), 3))
+        self.peak_contacts = np.zeros(len(walls), dtype=int)
+        self._last_impulse = np.zeros((len(walls), 6))
         self._last_step = -1
         self.energy_rows = []  # (t, K, U, W_ext, W_wall, error), as in energy.csv
-        self.wall_rows = []  # (t, wall, F_x, F_y, F_z, I_x, I_y, I_z, contacts), as in walls.csv
+        self.wall_rows = []  # rows of walls.csv
         self._energy = self._walls = None
         if comm.rank == 0:
             self.directory.mkdir(parents=True, exist_ok=True)
@@ -51,9 +74,7 @@ class History:
             self._energy.flush()
             if walls:
                 self._walls = open(self.directory / "walls.csv", "w")
-                self._walls.write(
-                    "time,wall,force_x,force_y,force_z,impulse_x,impulse_y,impulse_z,contacts\n"
-                )
+                self._walls.write(",".join(WALL_COLUMNS) + "\n")
                 self._walls.flush()
 
     def due(self, step: int) -> bool:
@@ -63,12 +84,17 @@ class History:
         """Sample step ``s.step``: needs ``v^{n-1/2}`` and ``a^n`` (before the update)."""
         kinetic = 0.5 * float(np.sum(s.mass[:, None] * s.v * (s.v + s.dt * s.a)))
         local = [kinetic, sim.internal.strain_energy(s)]
-        local.append(sum(f.work for f in sim.forces))
-        local.append(sum(w.work for w in self.walls))
+        local.append(sum(f.work(s) for f in sim.forces) + sum(w.driving_work for w in self.walls))
         for w in self.walls:
-            local += [*w.impulse, w.contacts]
+            local += [*w.normal_impulse, *w.tangential_impulse, w.contacts]
+            local += [w.normal_work, w.friction_work]
         total = self.comm.allreduce(np.array(local))
-        kinetic, internal, external, wall_work = total[:4]
+        kinetic, internal, external = total[:3]
+        per_wall = total[3:].reshape(-1, _PER_WALL)
+        wall_work = float(per_wall[:, 7:9].sum())
+        for w in self.walls:
+            if w.motion.dynamic:  # the same on every rank: not part of the sum
+                kinetic += 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity
         self.reference_energy = max(self.reference_energy, kinetic + internal)
         error = (kinetic + internal - external - wall_work - self.initial_energy) / max(
             self.reference_energy, np.finfo(float).tiny
@@ -79,11 +105,16 @@ class History:
         interval = (s.step - self._last_step) * s.dt
         self._last_step = s.step
         rows = []
-        for i, chunk in enumerate(total[4:].reshape(-1, 4)):
-            impulse, contacts = chunk[:3], int(chunk[3])
-            force = (impulse - self._last_impulse[i]) / interval
-            self._last_impulse[i] = impulse
-            rows.append((s.t, i, *force, *impulse, contacts))
+        for i, (w, chunk) in enumerate(zip(self.walls, per_wall, strict=True)):
+            impulses, contacts = chunk[:6], int(chunk[6])
+            self.peak_contacts[i] = max(self.peak_contacts[i], contacts)
+            forces = (impulses - self._last_impulse[i]) / interval
+            self._last_impulse[i] = impulses
+            total_force, total_impulse = forces[:3] + forces[3:], impulses[:3] + impulses[3:]
+            rows.append(
+                (s.t, i, *total_force, *total_impulse, *forces, *impulses, contacts,
+                 *w.position, *w.motion.velocity)
+            )  # fmt: skip
         self.wall_rows += rows
         if self.comm.rank != 0:
             return
@@ -107,17 +138,31 @@ class History:
         s, comm = sim.state, self.comm
         final_momentum = comm.allreduce(np.sum(s.mass[:, None] * s.v, axis=0))
         walls = []
-        for w in self.walls:
-            walls.append(
-                {
-                    "name": w.name,
-                    "kind": w.shape.kind,
-                    "impulse": comm.allreduce(w.impulse).tolist(),
-                    "work": comm.allreduce(w.work),
-                    "first_contact": _finite_or_none(comm.allreduce(w.first_contact, MPI.MIN)),
-                    "last_contact": _finite_or_none(comm.allreduce(w.last_contact, MPI.MAX)),
-                }
-            )
+        for i, w in enumerate(self.walls):
+            entry = {
+                "name": w.name,
+                "kind": w.shape.kind,
+                "slide": w.slide,
+                "secondary_nodes": comm.allreduce(len(w.nodes)),
+                "impulse": comm.allreduce(w.impulse).tolist(),
+                "normal_impulse": comm.allreduce(w.normal_impulse).tolist(),
+                "tangential_impulse": comm.allreduce(w.tangential_impulse).tolist(),
+                "work": comm.allreduce(w.work),
+                "normal_work": comm.allreduce(w.normal_work),
+                "friction_work": comm.allreduce(w.friction_work),
+                "first_contact": _finite_or_none(comm.allreduce(w.first_contact, MPI.MIN)),
+                "last_contact": _finite_or_none(comm.allreduce(w.last_contact, MPI.MAX)),
+                "peak_contacts": int(self.peak_contacts[i]),
+            }
+            if w.motion.dynamic or w.motion.prescribed:
+                entry["motion"] = "main node" if w.motion.dynamic else "prescribed"
+                entry["position"] = w.position.tolist()
+                entry["velocity"] = w.motion.velocity.tolist()
+                entry["driving_work"] = comm.allreduce(w.driving_work)
+            if w.motion.dynamic:
+                entry["mass"] = w.motion.mass
+                final_momentum = final_momentum + w.motion.mass * w.motion.velocity
+            walls.append(entry)
         t, kinetic, internal, external, wall_work, _ = self.energy_rows[-1]
         summary = self.info | {
             "ranks": comm.size,

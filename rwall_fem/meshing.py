@@ -15,7 +15,16 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 
-__all__ = ["BodyMesh", "bar_mesh", "boundary_nodes", "read_mesh", "rotation_to"]
+__all__ = [
+    "BodyMesh",
+    "bar_mesh",
+    "boundary_nodes",
+    "coordinate_noise",
+    "group_nodes",
+    "perturb",
+    "read_mesh",
+    "rotation_to",
+]
 
 GEOMETRY_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
@@ -103,3 +112,37 @@ def boundary_nodes(V) -> np.ndarray:
     msh.topology.create_connectivity(tdim - 1, tdim)
     facets = mesh.exterior_facet_indices(msh.topology)
     return fem.locate_dofs_topological(V, tdim - 1, facets)
+
+
+def group_nodes(V, body: BodyMesh, name: str) -> np.ndarray:
+    """Local node indices of ``V`` on the facets of the named physical group ``name``."""
+    from dolfinx import fem
+
+    fdim = body.msh.topology.dim - 1
+    facets = body.facet_tags.find(body.groups[name])
+    return fem.locate_dofs_topological(V, fdim, facets)
+
+
+def coordinate_noise(ids: np.ndarray, amplitude: float, seed: int) -> np.ndarray:
+    """Deterministic noise in [-amplitude, amplitude]^3 (m) for points with integer ``ids``.
+
+    It depends only on (seed, id), so a node moves the same way on every
+    partitioning: a counter-based hash (splitmix64) of seed, id and component.
+    """
+    ids = np.asarray(ids, dtype=np.uint64)
+    with np.errstate(over="ignore"):
+        salt = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15)
+        keys = (ids[:, None] * np.uint64(3) + np.arange(3, dtype=np.uint64)) ^ salt
+        z = keys + np.uint64(0x9E3779B97F4A7C15)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        z = z ^ (z >> np.uint64(31))
+    unit = (z >> np.uint64(11)).astype(np.float64) / float(1 << 53)  # in [0, 1)
+    return amplitude * (2.0 * unit - 1.0)
+
+
+def perturb(body: BodyMesh, amplitude: float, seed: int) -> None:
+    """Move every node of the mesh by :func:`coordinate_noise` of its input (gmsh) index."""
+    x = body.msh.geometry.x
+    ids = np.asarray(body.msh.geometry.input_global_indices, dtype=np.int64)
+    x += coordinate_noise(ids, amplitude, seed)

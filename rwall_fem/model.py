@@ -14,6 +14,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rwall_fem import _compat
+from rwall_fem.effects import Gravity
 from rwall_fem.history import History
 from rwall_fem.mechanics import (
     critical_time_step,
@@ -21,10 +22,19 @@ from rwall_fem.mechanics import (
     lumped_mass,
     stiffness_matrix,
 )
-from rwall_fem.meshing import bar_mesh, boundary_nodes, read_mesh
-from rwall_fem.scene import Scene, SceneError, load_scene
+from rwall_fem.meshing import (
+    bar_mesh,
+    boundary_nodes,
+    coordinate_noise,
+    group_nodes,
+    perturb,
+    read_mesh,
+)
+from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import LinearElasticForce, Simulation, State
-from rwall_fem.walls import PlaneWall, RigidWall
+from rwall_fem.walls import RigidWall
+from rwall_fem.walls.motion import MainNodeMotion, PrescribedMotion
+from rwall_fem.walls.shapes import SHAPES
 
 __all__ = ["build_simulation", "run_scene"]
 
@@ -55,6 +65,8 @@ def build_simulation(
         body = read_mesh(comm, spec.file)
     else:
         body = bar_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell, spec.axis)
+    if spec.noise is not None:
+        perturb(body, *spec.noise)
     msh = body.msh
     V = _compat.vector_space(msh)
     owned = V.dofmap.index_map.size_local
@@ -86,11 +98,13 @@ def build_simulation(
 
     state = State(X=X, mass=mass, dt=dt)
     state.v[:] = scene.initial.velocity
-    walls = _walls(scene, V, owned)
+    forces = [] if scene.gravity is None else [Gravity(scene.gravity, state)]
+    walls = [_wall(scene, i, V, body, state, comm) for i in range(len(scene.walls))]
     sim = Simulation(
         state=state,
         end_time=scene.run.end_time,
         internal=LinearElasticForce(K, state),
+        forces=forces,
         constraints=walls,
     )
     info = {
@@ -121,15 +135,80 @@ def build_simulation(
     return sim
 
 
-def _walls(scene: Scene, V, owned: int) -> list[RigidWall]:
-    if not scene.walls:
-        return []
-    nodes = boundary_nodes(V)
-    nodes = nodes[nodes < owned]
-    return [
-        RigidWall(PlaneWall(w.point, w.normal_point), nodes, f"wall[{i}]")
-        for i, w in enumerate(scene.walls)
-    ]
+def _wall(scene: Scene, i: int, V, body, state: State, comm: MPI.Comm) -> RigidWall:
+    """Wall ``i`` of the scene with its shape, motion, tangential law and secondary nodes."""
+    spec: WallSpec = scene.walls[i]
+    where = f"{scene.source}: wall[{i}]"
+    point = np.asarray(spec.point)
+    noise = scene.mesh.noise
+    if spec.motion is not None and noise is not None:
+        # The main node is a node of the model: noise moves it too (spec 6.5), with an
+        # id no mesh node has. The wall's orientation follows where it is defined from M.
+        point = point + coordinate_noise([2**62 + i], *noise)[0]
+    arguments = {key: getattr(spec, key) for key in SHAPE_KEYS[spec.kind]}
+    try:
+        shape = SHAPES[spec.kind](point, **arguments)
+    except ValueError as err:
+        raise SceneError(f"{where}: {err} (after coordinate noise)") from None
+
+    motion = None
+    if spec.motion is not None:
+        if spec.motion.prescribed:
+            motion = PrescribedMotion(spec.motion.velocity)
+        else:
+            motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity)
+
+    alpha = 1.0
+    if spec.friction_filter is not None:
+        how, value = spec.friction_filter
+        alpha = {"coefficient": value, "steps": 2 * np.pi / max(value, 1e-300)}.get(
+            how, 2 * np.pi * value * state.dt
+        )
+        if not 0.0 < alpha <= 1.0:
+            raise SceneError(
+                f"{where}.friction_filter.{how}: gives alpha = {alpha:.4g} with dt = "
+                f"{state.dt:.4g} s; alpha must be in (0, 1]"
+            )
+    nodes = _secondary_nodes(spec, where, shape, V, body, state)
+    return RigidWall(
+        shape,
+        nodes,
+        f"wall[{i}]",
+        slide=spec.slide,
+        friction=spec.friction,
+        filter_alpha=alpha,
+        motion=motion,
+        comm=comm,
+    )
+
+
+def _secondary_nodes(spec: WallSpec, where: str, shape, V, body, state: State) -> np.ndarray:
+    """Owned secondary nodes (spec section 5): boundary nodes by default; or nodes with
+    0 <= d <= search_distance at the start, plus named sets; minus excluded sets."""
+    owned = len(state.X)
+    sec = spec.secondary
+    for key, names in (("add", sec.add), ("exclude", sec.exclude)):
+        for name in names:
+            if name not in body.groups:
+                known = ", ".join(sorted(body.groups)) or "none"
+                raise SceneError(
+                    f"{where}.secondary.{key}: unknown node set {name!r}; the mesh has: {known}"
+                )
+    selected = np.zeros(owned, dtype=bool)
+    if sec.search_distance is None and not sec.add:
+        selected[_owned(boundary_nodes(V), owned)] = True
+    if sec.search_distance is not None:
+        d = shape.distance(state.X)
+        selected |= (d >= 0.0) & (d <= sec.search_distance)
+    for name in sec.add:
+        selected[_owned(group_nodes(V, body, name), owned)] = True
+    for name in sec.exclude:
+        selected[_owned(group_nodes(V, body, name), owned)] = False
+    return np.flatnonzero(selected)
+
+
+def _owned(nodes: np.ndarray, owned: int) -> np.ndarray:
+    return nodes[nodes < owned]
 
 
 def _round_down(dt: float, digits: int = 4) -> float:

@@ -65,11 +65,27 @@ def render_frames(directory: str | Path) -> list[Path]:
     return files
 
 
-def _wall_surface(pyvista, shape, centre: np.ndarray, size: float):
-    """The plane as a square of side 1.5 x the body size, centred below the body."""
-    normal = shape.normals(centre[None, :])
-    foot = centre - shape.distance(centre[None, :])[0] * normal
-    return pyvista.Plane(center=foot, direction=normal, i_size=1.5 * size, j_size=1.5 * size)
+def _wall_surface(pyvista, shape, offset: np.ndarray, centre: np.ndarray, size: float):
+    """A pyvista surface for ``shape`` translated by ``offset`` (m): an infinite plane as a
+    square of side 1.5 x the body size below the body, a cylinder 1.5 x the body size long."""
+    point = shape.point + offset
+    if shape.kind == "plane":
+        foot = centre - shape.distance(centre[None, :], offset)[0] * shape.normal
+        return pyvista.Plane(
+            center=foot, direction=shape.normal, i_size=1.5 * size, j_size=1.5 * size
+        )
+    if shape.kind == "parallelogram":
+        corners = point + np.array(
+            [0 * shape.sides[0], shape.sides[0], shape.sides[0] + shape.sides[1], shape.sides[1]]
+        )
+        return pyvista.PolyData(corners, faces=[4, 0, 1, 2, 3])
+    if shape.kind == "cylinder":
+        foot = point + ((centre - point) @ shape.axis) * shape.axis
+        length = max(1.5 * size, 2.5 * shape.radius)
+        return pyvista.Cylinder(
+            center=foot, direction=shape.axis, radius=shape.radius, height=length, resolution=96
+        )
+    return pyvista.Sphere(radius=shape.radius, center=point, theta_resolution=64, phi_resolution=64)
 
 
 if __name__ == "__main__":

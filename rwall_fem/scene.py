@@ -9,6 +9,7 @@ module reads the raw TOML.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -52,6 +53,7 @@ class MeshSpec:
     axis: tuple[float, float, float] = (0.0, 0.0, 1.0)  # direction of the bar's own z
     element_size: float = 2e-3  # m
     cell: str = "hexahedron"
+    noise: tuple[float, int] | None = None  # (amplitude in m, seed) on initial coordinates
 
 
 @dataclass(frozen=True)
@@ -80,11 +82,40 @@ class Initial:
 
 
 @dataclass(frozen=True)
+class Secondary:
+    """Which nodes a wall acts on; the default is every boundary node of the body."""
+
+    search_distance: float | None = None  # m: nodes with 0 <= d <= this at the start
+    add: tuple[str, ...] = ()  # named node sets (gmsh physical groups) to include
+    exclude: tuple[str, ...] = ()  # named node sets to leave out; exclusion wins
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A main node of ``mass`` starting at ``velocity``, or a prescribed ``velocity`` history."""
+
+    mass: float | None  # kg; None for a prescribed motion
+    velocity: tuple  # m/s: [vx, vy, vz], or rows (t, vx, vy, vz) for a prescribed history
+
+    @property
+    def prescribed(self) -> bool:
+        return self.mass is None
+
+
+@dataclass(frozen=True)
 class WallSpec:
-    kind: str
-    point: tuple[float, float, float]  # M, m
-    normal_point: tuple[float, float, float]  # M1, m
-    slide: str = "free"
+    kind: str  # "plane", "cylinder", "sphere", "parallelogram"
+    point: tuple[float, float, float]  # M (m): on the plane, the axis, the centre, a corner
+    normal_point: tuple[float, float, float] | None = None  # plane: M1, normal M1 - M
+    axis_point: tuple[float, float, float] | None = None  # cylinder: M1, axis M1 - M
+    diameter: float | None = None  # cylinder, sphere (m)
+    corner1: tuple[float, float, float] | None = None  # parallelogram: M1, side L1 = M1 - M
+    corner2: tuple[float, float, float] | None = None  # parallelogram: M2, side L2 = M2 - M
+    slide: str = "free"  # "free", "tied" or "friction"
+    friction: float = 0.0  # Coulomb coefficient mu
+    friction_filter: tuple[str, float] | None = None  # ("coefficient"|"steps"|"frequency", x)
+    secondary: Secondary = field(default_factory=Secondary)
+    motion: Motion | None = None  # None: a fixed wall
 
 
 @dataclass(frozen=True)
@@ -103,6 +134,7 @@ class Scene:
     initial: Initial
     walls: tuple[WallSpec, ...] = ()
     output: Output = field(default_factory=Output)
+    gravity: tuple[float, float, float] | None = None  # m/s^2
 
 
 # --- reading -----------------------------------------------------------------
@@ -242,7 +274,9 @@ class _Table:
 
 def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> Scene:
     """Validate the raw TOML mapping ``raw`` into a :class:`Scene`."""
-    top = _Table(raw, "", source, ("run", "mesh", "material", "initial", "wall", "output"))
+    top = _Table(
+        raw, "", source, ("run", "mesh", "material", "initial", "gravity", "wall", "output")
+    )
 
     t = _Table(top.get("run"), "run", source, ("end_time", "dt_scale", "dt"))
     run = RunSettings(
@@ -255,7 +289,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         top.get("mesh"),
         "mesh",
         source,
-        ("shape", "file", "origin", "size", "axis", "element_size", "cell"),
+        ("shape", "file", "origin", "size", "axis", "element_size", "cell", "noise"),
     )
     if "file" in t.raw:
         if "shape" in t.raw:
@@ -268,7 +302,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
             t.fail(t.key("file"), f"mesh file not found: {file}")
         if file.suffix not in (".msh", ".geo"):
             t.fail(t.key("file"), f"must be a gmsh .msh or .geo file, got {file.name}")
-        mesh = MeshSpec(shape=None, file=file)
+        mesh = MeshSpec(shape=None, file=file, noise=_noise(t))
     else:
         mesh = MeshSpec(
             shape=t.choice("shape", ("bar",)),
@@ -277,6 +311,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
             axis=_direction(t, "axis"),
             element_size=t.number("element_size", low=0.0),
             cell=t.choice("cell", ("hexahedron", "tetrahedron"), "hexahedron"),
+            noise=_noise(t),
         )
 
     t = _Table(top.get("material"), "material", source, ("model", "density", "young", "poisson"))
@@ -289,6 +324,12 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
 
     t = _Table(top.get("initial", {}), "initial", source, ("velocity",))
     initial = Initial(velocity=t.vector("velocity", (0.0, 0.0, 0.0)))
+
+    gravity = None
+    if "gravity" in top.raw:
+        gravity = _Table(top.get("gravity"), "gravity", source, ("acceleration",)).vector(
+            "acceleration"
+        )
 
     walls_raw = top.get("wall", [])
     if not isinstance(walls_raw, list):
@@ -304,7 +345,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         frames=t.integer("frames", 0),
         history_interval=t.integer("history_interval", 1, low=1),
     )
-    return Scene(source, run, mesh, material, initial, walls, output)
+    return Scene(source, run, mesh, material, initial, walls, output, gravity)
 
 
 def _positive_vector(t: _Table, name: str):
@@ -321,11 +362,149 @@ def _direction(t: _Table, name: str):
     return value
 
 
+def _noise(t: _Table):
+    if "noise" not in t.raw:
+        return None
+    n = _Table(t.get("noise"), t.key("noise"), t.source, ("amplitude", "seed"))
+    return n.number("amplitude", low=0.0), n.integer("seed", 0)
+
+
+_SLIDES = {
+    "free": "free",
+    "tied": "tied",
+    "friction": "friction",
+    0: "free",
+    1: "tied",
+    2: "friction",
+}
+# The keys that define each wall shape besides ``point`` (M).
+SHAPE_KEYS = {
+    "plane": ("normal_point",),
+    "cylinder": ("axis_point", "diameter"),
+    "sphere": ("diameter",),
+    "parallelogram": ("corner1", "corner2"),
+}
+_COMMON_KEYS = ("kind", "point", "slide", "friction", "friction_filter", "secondary", "motion")
+
+
 def _wall(raw: Any, path: str, source: str) -> WallSpec:
-    t = _Table(raw, path, source, ("kind", "point", "normal_point", "slide"))
-    kind = t.choice("kind", ("plane",))
-    point, normal_point = t.vector("point"), t.vector("normal_point")
-    if math.dist(point, normal_point) <= 1e-10 * max(1.0, *map(abs, point)):
-        t.fail(t.key("normal_point"), "must differ from 'point' (M1 = M leaves no normal)")
-    slide = t.choice("slide", ("free",), "free")
-    return WallSpec(kind, point, normal_point, slide)
+    kinds = tuple(SHAPE_KEYS)
+    kind = raw.get("kind") if isinstance(raw, dict) else None
+    shape_keys = SHAPE_KEYS.get(kind, ())
+    t = _Table(raw, path, source, _COMMON_KEYS + (shape_keys or sum(SHAPE_KEYS.values(), ())))
+    t.choice("kind", kinds)
+    for other, keys in SHAPE_KEYS.items():
+        for key in set(keys) - set(shape_keys):
+            if key in t.raw:
+                t.fail(t.key(key), f"is not a key of a {kind} wall (it belongs to a {other})")
+    point = t.vector("point")
+    values: dict[str, Any] = {}
+    for key in shape_keys:
+        values[key] = t.number(key, low=0.0) if key == "diameter" else t.vector(key)
+
+    def distinct(key):
+        scale = max(math.hypot(*point), math.hypot(*values[key]))
+        if math.dist(point, values[key]) <= 1e-10 * scale:
+            t.fail(t.key(key), f"must differ from 'point' ({key} = point leaves no direction)")
+
+    if kind == "plane":
+        distinct("normal_point")
+    elif kind == "cylinder":
+        distinct("axis_point")
+    elif kind == "parallelogram":
+        distinct("corner1")
+        distinct("corner2")
+        l1 = [a - b for a, b in zip(values["corner1"], point, strict=True)]
+        l2 = [a - b for a, b in zip(values["corner2"], point, strict=True)]
+        cross = math.hypot(
+            l1[1] * l2[2] - l1[2] * l2[1],
+            l1[2] * l2[0] - l1[0] * l2[2],
+            l1[0] * l2[1] - l1[1] * l2[0],
+        )
+        if cross <= 1e-10 * math.hypot(*l1) * math.hypot(*l2):
+            t.fail(t.key("corner2"), "sides corner1 - point and corner2 - point are parallel")
+
+    slide_raw = t.get("slide", "free")
+    if isinstance(slide_raw, bool) or slide_raw not in _SLIDES:
+        t.fail(
+            t.key("slide"), f"must be 'free', 'tied', 'friction' (or 0, 1, 2), got {slide_raw!r}"
+        )
+    slide = _SLIDES[slide_raw]
+    friction = 0.0
+    if slide == "friction":
+        friction = t.number("friction", low=0.0, low_open=False)
+    elif "friction" in t.raw:
+        t.fail(t.key("friction"), f"needs slide = 'friction' (slide is '{slide}')")
+    friction_filter = None
+    if "friction_filter" in t.raw:
+        if slide != "friction":
+            t.fail(t.key("friction_filter"), f"needs slide = 'friction' (slide is '{slide}')")
+        f = _Table(
+            t.get("friction_filter"),
+            t.key("friction_filter"),
+            source,
+            ("coefficient", "steps", "frequency"),
+        )
+        if len(f.raw) != 1:
+            f.fail(f.path, "give exactly one of coefficient, steps, frequency")
+        (how,) = f.raw
+        if how == "coefficient":
+            friction_filter = (how, f.number(how, low=0.0, high=1.0))
+        elif how == "steps":
+            friction_filter = (how, f.number(how, low=2 * math.pi, low_open=False))
+        else:
+            friction_filter = (how, f.number(how, low=0.0))
+
+    sec = _Table(
+        t.get("secondary", {}), t.key("secondary"), source, ("search_distance", "add", "exclude")
+    )
+    secondary = Secondary(
+        search_distance=sec.number("search_distance", None, low=0.0, low_open=False),
+        add=_names(sec, "add"),
+        exclude=_names(sec, "exclude"),
+    )
+
+    motion = None
+    if "motion" in t.raw:
+        mo = _Table(t.get("motion"), t.key("motion"), source, ("mass", "velocity"))
+        mass = mo.number("mass", None, low=0.0)
+        velocity = mo.get("velocity")
+        if isinstance(velocity, list) and velocity and isinstance(velocity[0], list):
+            if mass is not None:
+                mo.fail(mo.key("mass"), "a velocity table prescribes the motion: drop 'mass'")
+            velocity = _velocity_table(mo)
+        else:
+            velocity = mo.vector("velocity")
+        motion = Motion(mass, velocity)
+    return WallSpec(
+        kind,
+        point,
+        **values,
+        slide=slide,
+        friction=friction,
+        friction_filter=friction_filter,
+        secondary=secondary,
+        motion=motion,
+    )
+
+
+def _names(t: _Table, name: str) -> tuple[str, ...]:
+    value = t.get(name, [])
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        t.fail(t.key(name), f"must be a list of node-set names, got {value!r}")
+    return tuple(value)
+
+
+def _velocity_table(t: _Table) -> tuple:
+    rows = t.get("velocity")
+    ok = all(
+        isinstance(r, list)
+        and len(r) == 4
+        and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in r
+        )
+        for r in rows
+    )
+    if not ok or any(b[0] <= a[0] for a, b in itertools.pairwise(rows)):
+        t.fail(t.key("velocity"), "a table must be rows [t, vx, vy, vz] with increasing t")
+    return tuple(tuple(float(x) for x in r) for r in rows)

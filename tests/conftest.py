@@ -12,6 +12,9 @@ import pytest
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
+from rwall_fem.history import WALL_COLUMNS
+
+COLUMN = {name: i for i, name in enumerate(WALL_COLUMNS)}  # columns of walls.csv
 
 STEEL_NU0 = {"model": "linear_elastic", "density": 7850.0, "young": 210.0e9, "poisson": 0.0}
 

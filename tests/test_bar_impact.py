@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import STEEL_NU0, bar_scene, run
+from conftest import COLUMN, STEEL_NU0, bar_scene, run
 
 N, H, V0 = 40, 1e-3, 10.0
 C = math.sqrt(STEEL_NU0["young"] / STEEL_NU0["density"])
@@ -22,17 +22,17 @@ MASS = STEEL_NU0["density"] * A * L
 SKEWED = (1.0, -2.0, 2.0)
 
 
-def contact_figures(sim):
+def contact_figures(sim, wall=0):
     """Contact start, duration (s), total impulse (N s) and mid-contact mean force (N)."""
-    walls = sim.history.wall(0)
-    t, contacts = walls[:, 0], walls[:, 8]
-    normal = sim.constraints[0].shape.normal
+    walls = sim.history.wall(wall)
+    t, contacts = walls[:, COLUMN["time"]], walls[:, COLUMN["contacts"]]
+    normal = sim.constraints[wall].shape.normal
     in_contact = np.flatnonzero(contacts > 0)
     start, end = t[in_contact[0]], t[in_contact[-1]] + sim.state.dt
     duration = end - start
-    force = walls[:, 2:5] @ normal
+    force = walls[:, COLUMN["force_x"] : COLUMN["force_z"] + 1] @ normal
     middle = (t >= start + 0.25 * duration) & (t <= start + 0.75 * duration)
-    impulse = walls[-1, 5:8] @ normal
+    impulse = walls[-1, COLUMN["impulse_x"] : COLUMN["impulse_z"] + 1] @ normal
     return start, duration, impulse, force[middle].mean()
 
 

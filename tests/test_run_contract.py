@@ -12,6 +12,7 @@ from conftest import bar_scene, run
 from mpi4py import MPI
 
 from rwall_fem import SceneError, parse_scene
+from rwall_fem.history import WALL_COLUMNS
 
 serial_only = pytest.mark.skipif(
     MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
@@ -83,17 +84,10 @@ def test_outputs_of_a_run(shared_dir):
         # every 5th step and the last one
         assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
         walls = list(csv.DictReader(open(out / "walls.csv")))
-        assert list(walls[0]) == [
-            "time",
-            "wall",
-            "force_x",
-            "force_y",
-            "force_z",
-            "impulse_x",
-            "impulse_y",
-            "impulse_z",
-            "contacts",
-        ]
+        columns = ["time", "wall", *(f"{q}_{c}" for q in ("force", "impulse") for c in "xyz")]
+        assert list(walls[0])[:8] == columns
+        assert list(walls[0]) == WALL_COLUMNS
+        assert {"contacts", "normal_force_x", "tangential_impulse_z", "velocity_z"} <= set(walls[0])
         frames = sorted((out / "frames").glob("frame_*.png"))
         assert len(frames) == 3
         assert (out / "animation.gif").stat().st_size > 0
@@ -116,7 +110,7 @@ def test_dt_above_stable_limit_is_refused(shared_dir):
         ("mesh.cell", "prism", r"mesh\.cell: must be one of 'hexahedron', 'tetrahedron'"),
         ("mesh.size", [1.0, 0.0, 1.0], r"mesh\.size: must be 3 positive lengths"),
         ("wall.0.normal_point", [0.0, 0.0, 0.0], r"wall\[0\]\.normal_point: must differ"),
-        ("wall.0.kind", "cone", r"wall\[0\]\.kind: must be one of 'plane'"),
+        ("wall.0.kind", "cone", r"wall\[0\]\.kind: must be one of 'plane', 'cylinder'"),
     ],
 )
 def test_bad_scenes_name_the_key(key, value, message):

@@ -1,10 +1,21 @@
 """Rigid walls with the semantics of the Radioss ``/RWALL`` option.
 
-``shapes`` holds the geometry (signed distance and outward normal of each
-shape); ``constraint`` holds the kinematic condition shared by all shapes.
+``shapes``: geometry (signed distance and normal of each shape); ``motion``:
+fixed, main-node and prescribed walls; ``constraint``: the kinematic
+condition shared by all shapes (normal stop, tied, Coulomb friction).
 """
 
 from rwall_fem.walls.constraint import RigidWall
-from rwall_fem.walls.shapes import PlaneWall
+from rwall_fem.walls.motion import FixedMotion, MainNodeMotion, PrescribedMotion
+from rwall_fem.walls.shapes import CylinderWall, ParallelogramWall, PlaneWall, SphereWall
 
-__all__ = ["PlaneWall", "RigidWall"]
+__all__ = [
+    "CylinderWall",
+    "FixedMotion",
+    "MainNodeMotion",
+    "ParallelogramWall",
+    "PlaneWall",
+    "PrescribedMotion",
+    "RigidWall",
+    "SphereWall",
+]

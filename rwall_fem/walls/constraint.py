@@ -1,66 +1,207 @@
-"""The kinematic rigid-wall condition (spec section 4), shared by all shapes.
+"""The kinematic rigid-wall condition (spec sections 2-4), shared by all shapes.
 
-After the acceleration solve, each secondary node's velocity is predicted,
-``v* = v^{n-1/2} + dt a^n``, and its position, ``x* = x^n + dt v*``. A node
-whose predicted position is on the forbidden side (and, on planes, whose
-relative normal velocity points into the wall) is in contact: the wall
-applies the impulse that removes its relative normal velocity. The impulse
-is added to ``a^n`` as ``I / (m dt)``, which gives exactly the velocity
-``v^{n+1/2}`` of editing both ``v^{n-1/2}`` and ``a^n``. The node stops where
-it is, up to one step of travel short of the surface: no projection.
+After the acceleration solve, each secondary node's velocity and position are
+predicted, ``v* = v^{n-1/2} + dt a^n`` and ``x* = x^n + dt v*``, and so is the
+wall's position. A node whose predicted position is on the forbidden side is
+in contact (on a parallelogram only inside it, and only if it is not more than
+two steps of travel behind it). The wall then applies to the node the impulse
+``I`` that
+
+- removes its normal velocity relative to the wall (a node slightly behind a
+  parallelogram gets the velocity that brings it back onto it in one step);
+- leaves its tangential velocity free (``slide="free"``), removes it
+  (``"tied"``), or removes it up to the Coulomb limit ``mu |I_N|``
+  (``"friction"``), optionally filtered: ``I_T = alpha I_T + (1 - alpha) I_T_prev``.
+
+``I`` is added to ``a^n`` as ``I / (m dt)``, which gives the same ``v^{n+1/2}``
+as editing both ``v^{n-1/2}`` and ``a^n``. A node stops where it is, at most
+one step of travel short of the surface; it is never projected. A node
+already behind the surface stays there unless one step takes it out (6.3).
+
+A wall carried by a main node (``MainNodeMotion``) receives minus the sum of
+the impulses, so momentum is conserved to round-off. The coupling is done in
+the same step: the wall's velocity over the step solves
+``(M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i)`` (P_i = n_i n_i^T, or
+the identity for tied nodes; b_i the target normal velocity), i.e. the wall
+moves with the mass of the nodes it treats, the spec's one-step mass coupling
+without a lag. Tied and sticking nodes then follow the wall exactly.
+
+Energy: the work of the contact impulses is booked at mid-step velocities
+relative to the wall, 1/2 I . (w^{n-1/2} + w^{n+1/2}) with w = v - V, split into
+normal and tangential (friction) parts; it is the energy the wall dissipates.
+A prescribed wall also does driving work 1/2 I . (V^{n-1/2} + V^{n+1/2}), booked
+as external work.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
+
+from rwall_fem.walls.motion import FixedMotion
 
 __all__ = ["RigidWall"]
 
+SLIDES = ("free", "tied", "friction")
+
 
 class RigidWall:
-    """A fixed rigid wall acting on the owned secondary nodes ``nodes`` of a body.
+    """A rigid wall acting on the owned secondary ``nodes`` (local node indices) of a body.
 
-    Attributes accumulated on this rank (reduce over ranks to report them):
-    ``impulse`` (N s), the push of the structure on the wall; ``work`` (J), the
-    work of the wall on the structure booked at mid-step velocities; and the
-    contact counters.
+    Accumulated on this rank (reduce over ranks to report): ``normal_impulse``
+    and ``tangential_impulse`` (N s, the push of the structure on the wall),
+    ``normal_work`` and ``friction_work`` (J, work of the wall on the structure
+    relative to the wall), ``driving_work`` (J, prescribed walls), contact counts.
     """
 
-    def __init__(self, shape, nodes: np.ndarray, name: str):
-        self.shape = shape
-        self.name = name
+    def __init__(
+        self,
+        shape,
+        nodes: np.ndarray,
+        name: str,
+        *,
+        slide: str = "free",
+        friction: float = 0.0,
+        filter_alpha: float = 1.0,
+        motion=None,
+        comm: MPI.Comm = MPI.COMM_WORLD,
+    ):
+        if slide not in SLIDES:
+            raise ValueError(f"slide must be one of {SLIDES}")
+        self.shape, self.name, self.slide = shape, name, slide
+        self.friction, self.filter_alpha = float(friction), float(filter_alpha)
+        self.motion = motion if motion is not None else FixedMotion()
+        self.comm = comm
         self.nodes = np.asarray(nodes, dtype=np.int64)
-        self.impulse = np.zeros(3)
-        self.work = 0.0
+        self.finite = shape.kind == "parallelogram"
+        self.normal_impulse = np.zeros(3)
+        self.tangential_impulse = np.zeros(3)
+        self.normal_work = self.friction_work = self.driving_work = 0.0
         self.contacts = 0  # nodes treated in the latest step
         self.first_contact = np.inf  # s
         self.last_contact = -np.inf  # s
-        self._pending_work = 0.0  # 1/2 I^n . v^{n+1/2}, booked at the next step
+        self._pending = np.zeros(3)  # (normal, friction, driving) halves for the next step
+        filtered = slide == "friction" and self.filter_alpha < 1.0
+        self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
+
+    @property
+    def work(self) -> float:
+        """Work (J) of the contact impulses relative to the wall: the energy it dissipated."""
+        return self.normal_work + self.friction_work
+
+    @property
+    def impulse(self) -> np.ndarray:
+        """Total push (N s) of this rank's nodes on the wall."""
+        return self.normal_impulse + self.tangential_impulse
+
+    @property
+    def position(self) -> np.ndarray:
+        """Current position (m) of the wall's defining point M (the main node)."""
+        return self.shape.point + self.motion.offset
 
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
-        dt, idx = state.dt, self.nodes
+        dt, idx, motion, shape = state.dt, self.nodes, self.motion, self.shape
+        wall_velocity = motion.predict(state.t, dt)
+        offset = motion.offset
         v_old = state.v[idx]
         v_pred = v_old + dt * state.a[idx]
-        x_pred = state.X[idx] + state.u[idx] + dt * v_pred
-        d = self.shape.distance(x_pred)
-        n = self.shape.normals(x_pred)
-        vn = v_pred @ n if n.ndim == 1 else np.einsum("ij,ij->i", v_pred, n)
-        hit = d < 0.0
-        if not self.shape.radial:
-            hit &= vn < 0.0
-        self.work += self._pending_work
-        self._pending_work = 0.0
-        self.contacts = int(np.count_nonzero(hit))
-        if not self.contacts:
+        x_now = state.X[idx] + state.u[idx]
+        x_pred = x_now + dt * v_pred
+        hit = shape.distance(x_pred, offset + dt * wall_velocity) < 0.0
+        if self.finite:
+            hit &= shape.inside_patch(x_pred, offset + dt * wall_velocity)
+        h = np.flatnonzero(hit)
+        target = np.zeros(len(h))  # normal velocity relative to the wall after the step
+        if self.finite and len(h):
+            d_now = shape.distance(x_now[h], offset)
+            speed = np.linalg.norm(v_pred[h] - wall_velocity, axis=1)
+            near = d_now >= -2.0 * dt * speed  # deeper nodes pass behind the wall
+            h, d_now = h[near], d_now[near]
+            target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
+
+        self.normal_work += self._pending[0]
+        self.friction_work += self._pending[1]
+        self.driving_work += self._pending[2]
+        self._pending[:] = 0.0
+        self.contacts = len(h)
+        kept = None
+        if self._previous_tangential is not None:
+            kept = self._previous_tangential[h]
+            self._previous_tangential[:] = 0.0
+        if not len(h) and not motion.dynamic:
+            motion.advance(wall_velocity, dt)
             return
-        nh = n if n.ndim == 1 else n[hit]
-        dv = -vn[hit, None] * nh
-        m = state.mass[idx[hit], None]
-        state.a[idx[hit]] += dv / dt
-        impulse = m * dv
-        self.impulse -= impulse.sum(axis=0)
-        self.work += 0.5 * np.sum(impulse * v_old[hit])
-        self._pending_work = 0.5 * np.sum(impulse * (v_pred[hit] + dv))
-        self.first_contact = min(self.first_contact, state.t)
-        self.last_contact = state.t
+
+        n = np.broadcast_to(shape.normals(x_now[h], offset), (len(h), 3))
+        m = state.mass[idx[h]][:, None]
+        vs = v_pred[h]
+        tied = np.full(len(h), self.slide == "tied")
+        if motion.dynamic:
+            predicted = wall_velocity
+            wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, tied)
+        normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
+        if motion.dynamic and self.slide == "friction":
+            # Second pass: sticking nodes move with the wall, slipping ones push it.
+            extra = np.where(slip[:, None], tangential, 0.0)
+            wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, ~slip, extra)
+            normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
+        if self._previous_tangential is not None:
+            self._previous_tangential[h] = tangential
+        impulse = normal + tangential
+        state.a[idx[h]] += impulse / (m * dt)
+
+        final = wall_velocity
+        if motion.dynamic:
+            # The main node takes exactly what the nodes received (momentum to round-off).
+            final = predicted - self.comm.allreduce(impulse.sum(axis=0)) / motion.mass
+        before = motion.velocity
+        motion.advance(final, dt)
+        w_old = v_old[h] - before
+        w_new = vs + impulse / m - final
+        self.normal_work += 0.5 * np.sum(normal * w_old)
+        self.friction_work += 0.5 * np.sum(tangential * w_old)
+        self._pending[0] = 0.5 * np.sum(normal * w_new)
+        self._pending[1] = 0.5 * np.sum(tangential * w_new)
+        if motion.prescribed:
+            self.driving_work += 0.5 * impulse.sum(axis=0) @ before
+            self._pending[2] = 0.5 * impulse.sum(axis=0) @ final
+        self.normal_impulse -= normal.sum(axis=0)
+        self.tangential_impulse -= tangential.sum(axis=0)
+        if len(h):
+            self.first_contact = min(self.first_contact, state.t)
+            self.last_contact = state.t
+
+    def _coupled_velocity(self, predicted, m, n, vs, target, tied, extra=None) -> np.ndarray:
+        """Velocity (m/s) of a main-node wall over the step when it moves with the mass of
+        the nodes it treats: normal motion shared by all, tangential by the ``tied`` ones;
+        ``extra`` impulses (N s) are given to the nodes on top."""
+        P = np.where(tied[:, None, None], np.eye(3), np.einsum("ij,ik->ijk", n, n))
+        matrix = np.einsum("i,ijk->jk", m[:, 0], P)
+        rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
+        if extra is not None:
+            rhs -= extra.sum(axis=0)
+        total = self.comm.allreduce(np.concatenate([matrix.ravel(), rhs]))
+        mass = self.motion.mass
+        return np.linalg.solve(
+            mass * np.eye(3) + total[:9].reshape(3, 3), mass * predicted + total[9:]
+        )
+
+    def _impulses(self, m, n, w, target, kept):
+        """Normal and tangential impulses (N s) for predicted relative velocities ``w``
+        (n, 3), and which nodes slip."""
+        wn = np.einsum("ij,ij->i", w, n)
+        normal = m * (target - wn)[:, None] * n
+        stick = -m * (w - wn[:, None] * n)
+        slip = np.zeros(len(w), dtype=bool)
+        if self.slide == "free":
+            return normal, np.zeros_like(stick), slip
+        if self.slide == "tied":
+            return normal, stick, slip
+        if kept is not None:
+            stick = self.filter_alpha * stick + (1.0 - self.filter_alpha) * kept
+        limit = self.friction * np.linalg.norm(normal, axis=1)
+        size = np.linalg.norm(stick, axis=1)
+        slip = size > limit
+        stick[slip] *= (limit[slip] / size[slip])[:, None]
+        return normal, stick, slip

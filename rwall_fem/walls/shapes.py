@@ -1,14 +1,32 @@
-"""Wall shapes: signed distance to the surface and the normal pointing to the allowed side.
+"""Wall shapes: signed distance to the surface and the normal toward the allowed side.
 
-A shape answers for many nodes at once: ``x`` has shape (n, 3) in metres.
-``offset`` (m) is the wall's translation from its initial position (moving walls).
+A shape answers for many nodes at once: ``x`` has shape (n, 3) in metres and
+``offset`` (3,) is the wall's translation from its initial position (moving
+walls translate, never rotate). Distances are in metres, negative on the
+forbidden side.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PlaneWall", "shape_from_parameters"]
+__all__ = [
+    "CylinderWall",
+    "ParallelogramWall",
+    "PlaneWall",
+    "SphereWall",
+    "shape_from_parameters",
+]
+
+_TINY = 1e-300
+
+
+def _unit(vector, what: str) -> np.ndarray:
+    vector = np.asarray(vector, dtype=float)
+    length = np.linalg.norm(vector)
+    if not np.isfinite(length) or length == 0:
+        raise ValueError(f"{what} has no direction")
+    return vector / length
 
 
 class PlaneWall:
@@ -18,31 +36,139 @@ class PlaneWall:
     """
 
     kind = "plane"
-    radial = False  # the normal does not depend on the node position
+    radial = False  # one normal for every node
 
     def __init__(self, point, normal_point):
         self.point = np.asarray(point, dtype=float)
-        normal = np.asarray(normal_point, dtype=float) - self.point
-        length = np.linalg.norm(normal)
-        if not length > 0:
-            raise ValueError("normal_point must differ from point")
-        self.normal = normal / length
+        self.normal = _unit(
+            np.asarray(normal_point, dtype=float) - self.point, "normal_point - point"
+        )
 
     def parameters(self) -> dict:
-        """The defining points, as plain lists (for files and for :func:`shape_from_parameters`)."""
+        """The defining points as lists (for files and :func:`shape_from_parameters`)."""
         return {"point": self.point.tolist(), "normal_point": (self.point + self.normal).tolist()}
 
     def distance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
-        """Signed distance (m) of the points ``x`` (n, 3) to the plane; negative behind it."""
+        """Signed distance (m) of the points ``x`` (n, 3) to the plane."""
         return (x - (self.point + offset)) @ self.normal
 
     def normals(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Unit normal (3,) toward the allowed side, the same for every point."""
         return self.normal
 
+    def inside_patch(self, x: np.ndarray, offset=0.0):
+        """Every point of an infinite plane can touch it."""
+        return True
+
+
+class ParallelogramWall(PlaneWall):
+    """Finite plane: the parallelogram M + a L1 + b L2, 0 <= a, b <= 1, L1 = M1 - M, L2 = M2 - M.
+
+    n = unit(L1 x L2); the allowed side is d >= 0. Only points whose projection
+    falls inside the parallelogram can touch it.
+    """
+
+    kind = "parallelogram"
+
+    def __init__(self, point, corner1, corner2):
+        self.point = np.asarray(point, dtype=float)
+        self.sides = np.array([corner1, corner2], dtype=float) - self.point  # L1, L2
+        self.normal = _unit(np.cross(*self.sides), "(M1 - M) x (M2 - M)")
+        # (a, b) = inverse Gram matrix @ (L1 . r, L2 . r) for r in the plane.
+        self._dual = np.linalg.solve(self.sides @ self.sides.T, self.sides)
+
+    def parameters(self) -> dict:
+        return {
+            "point": self.point.tolist(),
+            "corner1": (self.point + self.sides[0]).tolist(),
+            "corner2": (self.point + self.sides[1]).tolist(),
+        }
+
+    def inside_patch(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        """Whether the projections of ``x`` on the plane fall inside the parallelogram."""
+        ab = (x - (self.point + offset)) @ self._dual.T
+        return np.all((ab >= 0.0) & (ab <= 1.0), axis=1)
+
+
+class _RoundWall:
+    """Shared by the cylinder and the sphere: distance and normal from a radial vector."""
+
+    radial = True  # the normal follows the node (taken at its current position)
+
+    def distance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        return np.linalg.norm(self._radial(x, offset), axis=1) - self.radius
+
+    def normals(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        """Unit radial normals (n, 3); a point on the axis or at the centre gets ``fallback``."""
+        r = self._radial(x, offset)
+        length = np.linalg.norm(r, axis=1, keepdims=True)
+        degenerate = length[:, 0] <= 1e-12 * self.radius
+        n = r / np.maximum(length, _TINY)
+        n[degenerate] = self.fallback
+        return n
+
+    def inside_patch(self, x: np.ndarray, offset=0.0):
+        return True
+
+
+class CylinderWall(_RoundWall):
+    """Infinite cylinder of ``diameter`` (m) about the axis through ``point`` and ``axis_point``.
+
+    Contact from outside only (radial distance >= D/2), no end caps.
+    """
+
+    kind = "cylinder"
+
+    def __init__(self, point, axis_point, diameter: float):
+        self.point = np.asarray(point, dtype=float)
+        self.axis = _unit(np.asarray(axis_point, dtype=float) - self.point, "axis_point - point")
+        if not diameter > 0:
+            raise ValueError("diameter must be > 0")
+        self.radius = 0.5 * float(diameter)
+        # Any unit vector normal to the axis, for nodes exactly on it.
+        helper = np.eye(3)[np.argmin(np.abs(self.axis))]
+        self.fallback = _unit(np.cross(self.axis, helper), "fallback")
+
+    def parameters(self) -> dict:
+        return {
+            "point": self.point.tolist(),
+            "axis_point": (self.point + self.axis).tolist(),
+            "diameter": 2 * self.radius,
+        }
+
+    def _radial(self, x, offset):
+        r = x - (self.point + offset)
+        return r - np.outer(r @ self.axis, self.axis)
+
+
+class SphereWall(_RoundWall):
+    """Sphere of ``diameter`` (m) centred at ``point``; the allowed side is outside."""
+
+    kind = "sphere"
+    fallback = np.array([0.0, 0.0, 1.0])
+
+    def __init__(self, point, diameter: float):
+        self.point = np.asarray(point, dtype=float)
+        if not diameter > 0:
+            raise ValueError("diameter must be > 0")
+        self.radius = 0.5 * float(diameter)
+
+    def parameters(self) -> dict:
+        return {"point": self.point.tolist(), "diameter": 2 * self.radius}
+
+    def _radial(self, x, offset):
+        return x - (self.point + offset)
+
+
+SHAPES = {
+    "plane": PlaneWall,
+    "parallelogram": ParallelogramWall,
+    "cylinder": CylinderWall,
+    "sphere": SphereWall,
+}
+
 
 def shape_from_parameters(parameters: dict):
     """The shape described by ``{"kind": ..., **shape.parameters()}``."""
-    shapes = {"plane": PlaneWall}
     arguments = dict(parameters)
-    return shapes[arguments.pop("kind")](**arguments)
+    return SHAPES[arguments.pop("kind")](**arguments)

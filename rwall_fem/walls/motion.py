@@ -1,0 +1,83 @@
+"""How a wall moves: fixed, carried by a main node of given mass, or prescribed.
+
+A moving wall translates and never rotates (spec section 2): its state is the
+translation ``offset`` (m) of its defining points at time t_n and its velocity
+(m/s) over the current step. Every rank holds the same wall state: whatever
+changes it (the contact impulse) is summed over ranks first.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["FixedMotion", "MainNodeMotion", "PrescribedMotion"]
+
+
+class FixedMotion:
+    """A wall that never moves: a pure kinematic condition."""
+
+    dynamic = False
+    prescribed = False
+    mass = np.inf
+
+    def __init__(self):
+        self.offset = np.zeros(3)
+        self.velocity = np.zeros(3)  # V^{n+1/2}
+        self.previous_velocity = np.zeros(3)  # V^{n-1/2}
+
+    def predict(self, t: float, dt: float) -> np.ndarray:
+        """Wall velocity (m/s) over [t, t + dt] before this step's contact impulse."""
+        return self.velocity
+
+    def advance(self, velocity: np.ndarray, dt: float) -> None:
+        """Take ``velocity`` (m/s) as V^{n+1/2} and move by ``dt`` (s)."""
+
+
+class MainNodeMotion(FixedMotion):
+    """A wall carried by a main node of ``mass`` (kg) starting at ``velocity`` (m/s).
+
+    Contact impulses act on the main node by momentum conservation.
+    """
+
+    dynamic = True
+
+    def __init__(self, mass: float, velocity):
+        super().__init__()
+        self.mass = float(mass)
+        self.velocity = np.asarray(velocity, dtype=float).copy()
+        self.previous_velocity = self.velocity.copy()
+
+    def advance(self, velocity: np.ndarray, dt: float) -> None:
+        self.previous_velocity = self.velocity
+        self.velocity = np.asarray(velocity, dtype=float)
+        self.offset = self.offset + dt * self.velocity
+
+
+class PrescribedMotion(FixedMotion):
+    """A wall that follows a velocity history, whatever hits it.
+
+    ``table`` is a constant velocity [vx, vy, vz] (m/s) or rows [t, vx, vy, vz]
+    (s, m/s) interpolated linearly and held constant outside the table.
+    """
+
+    prescribed = True
+
+    def __init__(self, table):
+        table = np.atleast_2d(np.asarray(table, dtype=float))
+        if table.shape[1] == 3:
+            table = np.hstack([[[0.0]], table])
+        self.times, self.values = table[:, 0], table[:, 1:]
+        super().__init__()
+        self.velocity = self._at(0.0)
+        self.previous_velocity = self.velocity.copy()
+
+    def _at(self, t: float) -> np.ndarray:
+        return np.array([np.interp(t, self.times, column) for column in self.values.T])
+
+    def predict(self, t: float, dt: float) -> np.ndarray:
+        return self._at(t + 0.5 * dt)
+
+    def advance(self, velocity: np.ndarray, dt: float) -> None:
+        self.previous_velocity = self.velocity
+        self.velocity = np.asarray(velocity, dtype=float)
+        self.offset = self.offset + dt * self.velocity
