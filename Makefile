@@ -6,10 +6,19 @@
 #   make venv                  set-up only (honours DOLFINX too)
 #   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
 #   make clean                 remove both venvs, test logs and Python caches (results/ is kept)
+#   make clean-wheels          remove the wheelhouses (see below; the next set-up refills them)
 #
 # Set-up is incremental: apt runs only when a package is missing (one dpkg-query otherwise),
 # and pip runs only when a venv is new or pyproject.toml is newer than the venv's stamp.
-# pip keeps its normal cache (~/.cache/pip), so a fresh clone re-uses downloaded wheels.
+#
+# Wheel cache: pip's own HTTP cache (~/.cache/pip) does not fill on this network (the proxy
+# sends no caching headers), so each leg keeps a wheelhouse outside the clone, by default
+# ~/.cache/rwall_fem/wheels/<leg>/py<X.Y> (or under $XDG_CACHE_HOME; knob WHEELHOUSE, empty
+# = none).  tools/pip-install-cached.sh installs with `pip install --no-index --find-links`
+# from it, so a fresh clone (CI) downloads nothing once it is filled; only when that fails
+# (first run, a new dependency in pyproject.toml) does it fetch the missing wheels from the
+# index into the wheelhouse, prune the ones no longer used, and install from it.
+# `make clean-wheels` empties it.
 #
 # The 0.11 leg needs Python >= 3.12 (pyenv 3.12.x / 3.13.x, or python3.12 / python3.13 on
 # PATH; override with PY011=/path/to/python3.12).  Without one it prints a single
@@ -69,6 +78,10 @@ TEST_ENV     := $(RUN_ENV) OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONUNBUFF
 MPI_PYTEST    = -m pytest -p no:cacheprovider --basetemp=$(1)/tmp-rank{rank} $(PYTEST_ARGS)
 
 PIP_ENV      := env PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_INPUT=1
+# Persistent wheel cache, one wheelhouse per leg (and Python version): see the header.
+WHEELHOUSE   ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/rwall_fem/wheels
+# $(call PIP_INSTALL,LEG,VENV) PIP-INSTALL-ARGS...: pip install into VENV via LEG's wheelhouse.
+PIP_INSTALL   = $(PIP_ENV) bash tools/pip-install-cached.sh '$(if $(WHEELHOUSE),$(WHEELHOUSE)/$(1))' $(2)/bin/python
 
 # ---- leg selection --------------------------------------------------------------------------
 DOLFINX := $(strip $(DOLFINX))
@@ -87,7 +100,7 @@ ifneq ($(filter 0.11,$(LEGS)),)
   endif
 endif
 
-.PHONY: test venv demo clean apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
+.PHONY: test venv demo clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
         test-0.5 test-0.5-serial test-0.5-mpi test-0.11 test-0.11-serial test-0.11-mpi
 
 test: $(addprefix test-,$(LEGS))
@@ -112,7 +125,7 @@ $(VENV)/pyvenv.cfg: | apt-0.5
 $(VENV)/.installed: pyproject.toml $(VENV)/pyvenv.cfg | apt-0.5
 	@echo ">>> pip install -e '.[test]' into $(VENV)"
 	echo "numpy==$$($(SYS_PYTHON) -c 'import numpy; print(numpy.__version__)')" > $(VENV)/constraints.txt
-	$(PIP_ENV) $(VENV)/bin/pip install -q -c $(VENV)/constraints.txt -e '.[test]'
+	$(call PIP_INSTALL,0.5,$(VENV)) -c $(VENV)/constraints.txt -e '.[test]'
 	touch $@
 
 venv-0.5: $(VENV)/.installed
@@ -144,7 +157,7 @@ $(VENV011)/pyvenv.cfg: | apt-0.11
 
 $(VENV011)/.installed: pyproject.toml $(VENV011)/pyvenv.cfg | apt-0.11
 	@echo ">>> pip install $(WHEEL_0.11) -e '.[test]' into $(VENV011)"
-	$(PIP_ENV) $(VENV011)/bin/pip install -q $(WHEEL_0.11) -e '.[test]'
+	$(call PIP_INSTALL,0.11,$(VENV011)) $(WHEEL_0.11) -e '.[test]'
 	touch $@
 
 venv-0.11: $(VENV011)/.installed
@@ -176,3 +189,7 @@ demo: venv-0.5
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info
 	find . -path ./.git -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
+
+# The wheelhouses live outside the clone and are shared by all clones: not part of `clean`.
+clean-wheels:
+	rm -rf '$(WHEELHOUSE)'

@@ -11,7 +11,8 @@ exactly (see ``../shared/notes/numerics.md``):
   the contact impulses relative to the wall (normal stop and friction), the
   driving work of prescribed walls counts as external work;
 - the balance error is (K + U - W_ext - W_wall - E0) / E_ref with E0 the
-  initial energy (kinetic, walls included) and E_ref = max(E0, largest K + U).
+  initial energy (kinetic, walls included) and E_ref the largest of E0, K + U,
+  |W_ext| and |W_wall| so far (a body dropped from rest starts with E0 = 0).
 
 Every row is flushed as it is written, so a run that stops leaves complete
 lines up to its last sample. Rank 0 writes; all ranks take part in the sums.
@@ -95,7 +96,9 @@ class History:
         for w in self.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic += 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity
-        self.reference_energy = max(self.reference_energy, kinetic + internal)
+        self.reference_energy = max(
+            self.reference_energy, kinetic + internal, abs(external), abs(wall_work)
+        )
         error = (kinetic + internal - external - wall_work - self.initial_energy) / max(
             self.reference_energy, np.finfo(float).tiny
         )

@@ -77,7 +77,8 @@ class RigidWall:
         self.normal_impulse = np.zeros(3)
         self.tangential_impulse = np.zeros(3)
         self.normal_work = self.friction_work = self.driving_work = 0.0
-        self.contacts = 0  # nodes treated in the latest step
+        self.contacts = 0  # number of nodes treated in the latest step
+        self.touching = self.nodes[:0]  # those nodes (local indices)
         self.first_contact = np.inf  # s
         self.last_contact = -np.inf  # s
         self._pending = np.zeros(3)  # (normal, friction, driving) halves for the next step
@@ -125,6 +126,7 @@ class RigidWall:
         self.driving_work += self._pending[2]
         self._pending[:] = 0.0
         self.contacts = len(h)
+        self.touching = idx[h]  # nodes treated in the latest step
         kept = None
         if self._previous_tangential is not None:
             kept = self._previous_tangential[h]
