@@ -198,8 +198,14 @@ def _secondary_nodes(spec: WallSpec, where: str, shape, V, body, state: State) -
     if sec.search_distance is None and not sec.add:
         selected[_owned(boundary_nodes(V), owned)] = True
     if sec.search_distance is not None:
+        # The mesher leaves round-off (1e-19 m seen) on nodes placed at d = 0: distances
+        # within 1e-10 of the body size count as zero, as the spec does for degeneracy.
+        comm = V.mesh.comm
+        low, high = np.empty(3), np.empty(3)
+        comm.Allreduce(state.X.min(axis=0, initial=np.inf), low, op=MPI.MIN)
+        comm.Allreduce(state.X.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
         d = shape.distance(state.X)
-        selected |= (d >= 0.0) & (d <= sec.search_distance)
+        selected |= (d >= -1e-10 * np.linalg.norm(high - low)) & (d <= sec.search_distance)
     for name in sec.add:
         selected[_owned(group_nodes(V, body, name), owned)] = True
     for name in sec.exclude:

@@ -45,10 +45,9 @@ def render_frames(directory: str | Path) -> list[Path]:
         grid.point_data[label] = frame["v"] @ direction
         plotter = pyvista.Plotter(off_screen=True, window_size=(800, 600))
         plotter.add_mesh(grid, show_edges=len(points) < 5000, clim=clim, cmap="coolwarm")
-        for wall in walls:
-            plotter.add_mesh(
-                _wall_surface(pyvista, wall, centre, size), color="lightgray", opacity=0.6
-            )
+        for wall, offset in zip(walls, frame["offsets"], strict=True):
+            surface = _wall_surface(pyvista, wall, offset, centre, size)
+            plotter.add_mesh(surface, color="lightgray", opacity=0.6)
         plotter.add_text(f"t = {float(frame['t']) * 1e6:9.2f} us", font_size=12)
         if camera is None:
             plotter.camera_position = "iso"

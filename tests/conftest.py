@@ -101,7 +101,9 @@ class Probe:
             w.shape.distance(s.X[w.nodes] + s.u[w.nodes], w.motion.offset).min(initial=np.inf)
             for w in self.walls
         ]
-        self.distances.append(self.comm.allreduce(np.array(nearest), op=MPI.MIN))
+        nearest_everywhere = np.empty(len(nearest))
+        self.comm.Allreduce(np.array(nearest, dtype=float), nearest_everywhere, op=MPI.MIN)
+        self.distances.append(nearest_everywhere)
 
     def close(self, sim):
         self.t, self.x, self.v = map(np.array, (self.t, self.x, self.v))
@@ -119,14 +121,28 @@ def run_probed(raw, directory, comm=MPI.COMM_WORLD):
 SOFT = {"model": "linear_elastic", "density": 1000.0, "young": 1.0e6, "poisson": 0.3}
 
 
-def block_scene(*, size=0.01, h=0.005, origin=(0.0, 0.0, 0.0), end_time=0.2, gravity=None,
-                wall=None, velocity=(0.0, 0.0, 0.0), cell="hexahedron"):
+def block_scene(
+    *,
+    size=0.01,
+    h=0.005,
+    origin=(0.0, 0.0, 0.0),
+    end_time=0.2,
+    gravity=None,
+    wall=None,
+    velocity=(0.0, 0.0, 0.0),
+    cell="hexahedron",
+):
     """A soft cube (c_p about 37 m/s, so dt is about 1e-4 s) with its lowest corner at
     ``origin``, on the walls ``wall`` (a list of wall tables)."""
     raw = {
         "run": {"end_time": end_time},
-        "mesh": {"shape": "bar", "origin": list(origin), "size": [size] * 3,
-                 "element_size": h, "cell": cell},
+        "mesh": {
+            "shape": "bar",
+            "origin": list(origin),
+            "size": [size] * 3,
+            "element_size": h,
+            "cell": cell,
+        },
         "material": dict(SOFT),
         "initial": {"velocity": list(velocity)},
         "wall": wall or [],
