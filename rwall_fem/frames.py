@@ -28,12 +28,21 @@ __all__ = ["Frames"]
 class Frames:
     """Recorder that stores ``count`` frames evenly over the run in ``directory/frames``."""
 
-    def __init__(self, directory: Path, count: int, num_steps: int, V, walls, speed: float):
+    def __init__(
+        self,
+        directory: Path,
+        count: int,
+        num_steps: int,
+        V,
+        walls,
+        speed: float,
+        color: str = "normal_velocity",
+    ):
         self.steps = {round(k * num_steps / max(count - 1, 1)) for k in range(count)}
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
-        self.walls = walls
+        self.walls, self.color = walls, color
         self._field = fem.Function(V)
         self._count = 0
         topology, cell_types, points = _compat.vtk_mesh(V)
@@ -89,7 +98,7 @@ class Frames:
         env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
         env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         result = subprocess.run(
-            [sys.executable, "-m", "rwall_fem.render", str(self.directory)],
+            [sys.executable, "-m", "rwall_fem.render", str(self.directory), self.color],
             env=env,
             capture_output=True,
             text=True,

@@ -125,7 +125,10 @@ def build_simulation(
         from rwall_fem.frames import Frames
 
         speed = float(np.linalg.norm(scene.initial.velocity))
-        sim.recorders.append(Frames(directory, scene.output.frames, sim.num_steps, V, walls, speed))
+        frames = Frames(
+            directory, scene.output.frames, sim.num_steps, V, walls, speed, scene.output.color
+        )
+        sim.recorders.append(frames)
     log.info(
         "effects: %s; %d steps to t = %.4g s",
         ", ".join(sim.effects),

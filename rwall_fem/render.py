@@ -22,8 +22,15 @@ from rwall_fem.walls.shapes import shape_from_parameters
 __all__ = ["render_frames"]
 
 
-def render_frames(directory: str | Path) -> list[Path]:
-    """Render every stored frame of the run in ``directory``; returns the PNG paths."""
+COLOURS = ("normal_velocity", "speed", "displacement")
+
+
+def render_frames(directory: str | Path, colour: str = "normal_velocity") -> list[Path]:
+    """Render every stored frame of the run in ``directory``; returns the PNG paths.
+
+    ``colour``: "normal_velocity" (along the first wall's normal, m/s), "speed" (m/s) or
+    "displacement" (magnitude, m).
+    """
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import imageio.v2 as imageio
     import pyvista
@@ -33,25 +40,37 @@ def render_frames(directory: str | Path) -> list[Path]:
     mesh = np.load(data / "mesh.npz")
     points, speed = mesh["points"], float(mesh["speed"])
     walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
-    direction = walls[0].normals(points[:1]) if walls else np.array([0.0, 0.0, 1.0])
-    label = "velocity along the wall normal (m/s)" if walls else "velocity z (m/s)"
-    clim = (-1.2 * speed, 1.2 * speed) if speed > 0 else (-1.0, 1.0)
-    size = float(np.ptp(points, axis=0).max())
-    centre = points.mean(axis=0)
+    frames = [dict(np.load(path)) for path in sorted(data.glob("frame_*.npz"))]
+    values = [_colour(colour, f, walls, points) for f in frames]
+    label = _colour_label(colour, walls)
+    top = max(float(np.abs(v).max(initial=0.0)) for v in values) or 1.0
+    clim = (
+        (-1.2 * max(speed, top), 1.2 * max(speed, top))
+        if colour == "normal_velocity"
+        else (0.0, top)
+    )
+    # One box for the whole run: it fixes the camera and the size of the walls drawn.
+    moved = np.concatenate([points + f["u"] for f in frames])
+    low, high = moved.min(axis=0), moved.max(axis=0)
+    centre, size = 0.5 * (low + high), float((high - low).max())
+    end = float(frames[-1]["t"]) if frames else 0.0
+    unit, scale = ("us", 1e6) if end < 1e-3 else ("ms", 1e3) if end < 1.0 else ("s", 1.0)
     camera, files = None, []
-    for path in sorted(data.glob("frame_*.npz")):
-        frame = np.load(path)
+    for path, frame, value in zip(sorted(data.glob("frame_*.npz")), frames, values, strict=True):
         grid = pyvista.UnstructuredGrid(mesh["topology"], mesh["cell_types"], points + frame["u"])
-        grid.point_data[label] = frame["v"] @ direction
+        grid.point_data[label] = value
         plotter = pyvista.Plotter(off_screen=True, window_size=(800, 600))
-        plotter.add_mesh(grid, show_edges=len(points) < 5000, clim=clim, cmap="coolwarm")
+        plotter.add_mesh(
+            grid, show_edges=len(points) < 1000, edge_color="dimgray", clim=clim, cmap="coolwarm"
+        )
         for wall, offset in zip(walls, frame["offsets"], strict=True):
             surface = _wall_surface(pyvista, wall, offset, centre, size)
             plotter.add_mesh(surface, color="lightgray", opacity=0.6)
-        plotter.add_text(f"t = {float(frame['t']) * 1e6:9.2f} us", font_size=12)
+        plotter.add_text(f"t = {float(frame['t']) * scale:9.3f} {unit}", font_size=12)
         if camera is None:
             plotter.camera_position = "iso"
-            plotter.camera.zoom(1.6)
+            margin = 0.15 * size
+            plotter.reset_camera(bounds=np.ravel([low - margin, high + margin], order="F"))
             camera = plotter.camera_position
         plotter.camera_position = camera
         png = directory / "frames" / path.with_suffix(".png").name
@@ -64,9 +83,23 @@ def render_frames(directory: str | Path) -> list[Path]:
     return files
 
 
+def _colour_label(colour: str, walls) -> str:
+    if colour == "normal_velocity":
+        return "velocity along the wall normal (m/s)" if walls else "velocity z (m/s)"
+    return {"speed": "speed (m/s)", "displacement": "displacement (m)"}[colour]
+
+
+def _colour(colour: str, frame: dict, walls, points: np.ndarray) -> np.ndarray:
+    if colour == "normal_velocity":
+        normal = walls[0].normals(points[:1]) if walls else np.array([0.0, 0.0, 1.0])
+        return frame["v"] @ np.broadcast_to(normal, (1, 3))[0]
+    field = frame["v"] if colour == "speed" else frame["u"]
+    return np.linalg.norm(field, axis=1)
+
+
 def _wall_surface(pyvista, shape, offset: np.ndarray, centre: np.ndarray, size: float):
     """A pyvista surface for ``shape`` translated by ``offset`` (m): an infinite plane as a
-    square of side 1.5 x the body size below the body, a cylinder 1.5 x the body size long."""
+    square of side 1.5 ``size`` under ``centre``, a cylinder 1.5 ``size`` long."""
     point = shape.point + offset
     if shape.kind == "plane":
         foot = centre - shape.distance(centre[None, :], offset)[0] * shape.normal
@@ -88,6 +121,6 @@ def _wall_surface(pyvista, shape, offset: np.ndarray, centre: np.ndarray, size: 
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit("usage: python -m rwall_fem.render RESULTS_DIR")
-    render_frames(sys.argv[1])
+    if len(sys.argv) not in (2, 3) or sys.argv[2:] and sys.argv[2] not in COLOURS:
+        sys.exit(f"usage: python -m rwall_fem.render RESULTS_DIR [{'|'.join(COLOURS)}]")
+    render_frames(*sys.argv[1:])

@@ -123,6 +123,7 @@ class Output:
     directory: Path = Path("results")
     frames: int = 0  # number of PNG frames over the run; 0: no pictures
     history_interval: int = 1  # steps between rows of energy.csv and walls.csv
+    color: str = "normal_velocity"  # frames coloured by: "normal_velocity", "speed", "displacement"
 
 
 @dataclass(frozen=True)
@@ -211,7 +212,12 @@ class _Table:
         self.raw = raw
         for key in raw:
             if key not in allowed:
-                hint = difflib.get_close_matches(key, allowed, n=1)
+                hint = (
+                    difflib.get_close_matches(key, allowed, n=1)
+                    or [name for name in allowed if name.startswith(key) or key.startswith(name)][
+                        :1
+                    ]
+                )
                 tip = f" (did you mean '{hint[0]}'?)" if hint else ""
                 self.fail(self.key(key), f"unknown key{tip}; allowed: {', '.join(allowed)}")
 
@@ -336,7 +342,12 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         top.fail("wall", "must be an array of tables: write [[wall]]")
     walls = tuple(_wall(w, f"wall[{i}]", source) for i, w in enumerate(walls_raw))
 
-    t = _Table(top.get("output", {}), "output", source, ("directory", "frames", "history_interval"))
+    t = _Table(
+        top.get("output", {}),
+        "output",
+        source,
+        ("directory", "frames", "history_interval", "color"),
+    )
     directory = t.get("directory", "results")
     if not isinstance(directory, str):
         t.fail(t.key("directory"), f"must be a path string, got {directory!r}")
@@ -344,6 +355,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         directory=Path(directory),
         frames=t.integer("frames", 0),
         history_interval=t.integer("history_interval", 1, low=1),
+        color=t.choice("color", ("normal_velocity", "speed", "displacement"), "normal_velocity"),
     )
     return Scene(source, run, mesh, material, initial, walls, output, gravity)
 
@@ -391,12 +403,12 @@ def _wall(raw: Any, path: str, source: str) -> WallSpec:
     kinds = tuple(SHAPE_KEYS)
     kind = raw.get("kind") if isinstance(raw, dict) else None
     shape_keys = SHAPE_KEYS.get(kind, ())
-    t = _Table(raw, path, source, _COMMON_KEYS + (shape_keys or sum(SHAPE_KEYS.values(), ())))
+    t = _Table(raw, path, source, _COMMON_KEYS + sum(SHAPE_KEYS.values(), ()))
     t.choice("kind", kinds)
-    for other, keys in SHAPE_KEYS.items():
-        for key in set(keys) - set(shape_keys):
-            if key in t.raw:
-                t.fail(t.key(key), f"is not a key of a {kind} wall (it belongs to a {other})")
+    for key in sorted(set(sum(SHAPE_KEYS.values(), ())) - set(shape_keys)):
+        if key in t.raw:
+            owners = " or ".join(k for k, keys in SHAPE_KEYS.items() if key in keys)
+            t.fail(t.key(key), f"is not a key of a {kind} wall (it belongs to a {owners} wall)")
     point = t.vector("point")
     values: dict[str, Any] = {}
     for key in shape_keys:

@@ -111,15 +111,83 @@ def test_dt_above_stable_limit_is_refused(shared_dir):
         ("mesh.size", [1.0, 0.0, 1.0], r"mesh\.size: must be 3 positive lengths"),
         ("wall.0.normal_point", [0.0, 0.0, 0.0], r"wall\[0\]\.normal_point: must differ"),
         ("wall.0.kind", "cone", r"wall\[0\]\.kind: must be one of 'plane', 'cylinder'"),
+        ("wall.0.slide", "sticky", r"wall\[0\]\.slide: must be 'free', 'tied', 'friction'"),
+        ("wall.0.friction", 0.3, r"wall\[0\]\.friction: needs slide = 'friction'"),
+        ("wall.0.diameter", 1.0, r"wall\[0\]\.diameter: is not a key of a plane wall"),
+        ("wall.0.point", [0.0, float("nan"), 0.0], r"wall\[0\]\.point: must be 3 finite"),
+        ("wall.0.motion", {"mass": -1.0, "velocity": [0, 0, 1]}, r"motion\.mass: must be"),
+        ("wall.0.motion", {"velocity": [[0, 0, 0, 1], [0, 1, 0, 0]]}, r"increasing t"),
+        ("wall.0.secondary", {"search": 1.0}, r"did you mean 'search_distance'"),
+        ("mesh.noise", {"amplitude": -1e-6}, r"mesh\.noise\.amplitude: must be a finite"),
+        ("gravity", [0, 0, -9.81], r"gravity: must be a table"),
     ],
 )
 def test_bad_scenes_name_the_key(key, value, message):
     raw = bar_scene(elements=4)
     section, *rest = key.split(".")
-    target = raw[section] if len(rest) == 1 else raw[section][int(rest[0])]
-    target[rest[-1]] = value
+    target = raw if not rest else raw[section] if len(rest) == 1 else raw[section][int(rest[0])]
+    target[rest[-1] if rest else section] = value
     with pytest.raises(SceneError, match=message):
         parse_scene(raw, source="bad.toml")
+
+
+@pytest.mark.parametrize(
+    "wall, message",
+    [
+        (
+            {"kind": "cylinder", "point": [0, 0, 0], "axis_point": [0, 0, 1], "diameter": 0.0},
+            r"wall\[0\]\.diameter: must be a finite number in \(0, inf\)",
+        ),
+        (
+            {"kind": "cylinder", "point": [1, 1, 1], "axis_point": [1, 1, 1], "diameter": 1.0},
+            r"wall\[0\]\.axis_point: must differ from 'point'",
+        ),
+        ({"kind": "sphere", "point": [0, 0, 0]}, r"wall\[0\]\.diameter: missing"),
+        (
+            {
+                "kind": "parallelogram",
+                "point": [0, 0, 0],
+                "corner1": [1, 0, 0],
+                "corner2": [3, 0, 0],
+            },
+            r"wall\[0\]\.corner2: sides .* are parallel",
+        ),
+        (
+            {
+                "kind": "plane",
+                "point": [0, 0, 0],
+                "normal_point": [0, 0, 1],
+                "slide": "friction",
+                "friction": 0.2,
+                "friction_filter": {"steps": 3},
+            },
+            r"friction_filter\.steps: .*\[6\.28",
+        ),
+        (
+            {
+                "kind": "plane",
+                "point": [0, 0, 0],
+                "normal_point": [0, 0, 1],
+                "slide": "friction",
+                "friction": 0.2,
+                "friction_filter": {"steps": 10, "coefficient": 0.5},
+            },
+            r"give exactly one of coefficient, steps, frequency",
+        ),
+    ],
+)
+def test_bad_walls_name_the_field(wall, message):
+    raw = bar_scene(elements=4)
+    raw["wall"] = [wall]
+    with pytest.raises(SceneError, match=message):
+        parse_scene(raw, source="bad.toml")
+
+
+def test_friction_filter_frequency_above_one_step_is_refused(shared_dir):
+    raw = bar_scene(elements=4)
+    raw["wall"][0] |= {"slide": "friction", "friction": 0.2, "friction_filter": {"frequency": 1e9}}
+    with pytest.raises(SceneError, match=r"friction_filter\.frequency: gives alpha = .* must be"):
+        run(raw, shared_dir)
 
 
 def _cli(*args, cwd):

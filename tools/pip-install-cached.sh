@@ -27,6 +27,11 @@
 #
 # An empty WHEELHOUSE means: no wheelhouse, plain `pip install ARGS`.  Concurrent runs on
 # the same wheelhouse are serialised (flock on WHEELHOUSE/py<X.Y>.lock).
+#
+# pip byte-compiles what it installs one file at a time, which for VTK, matplotlib, ... takes
+# as long as the unpacking; so pip runs with --no-compile and `compileall -j 0` then compiles
+# the venv's site-packages on every core.  (Skipping compilation altogether would make every
+# later import slower, and forever where PYTHONDONTWRITEBYTECODE is set.)
 set -euo pipefail
 
 if [[ $# -lt 2 ]]; then
@@ -36,8 +41,18 @@ fi
 wh=$1 py=$2; shift 2
 pip=("$py" -m pip)
 
+# Byte-compile the venv's own site-packages (not the system's) in parallel.  Like pip, ignore
+# files that do not compile (templates, Python-2 leftovers in some packages).
+compile_venv() {
+    local site
+    site=$("$py" -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
+    "$py" -W ignore -m compileall -q -j 0 "$site" >/dev/null 2>&1 || true
+}
+
 if [[ -z $wh ]]; then
-    exec "${pip[@]}" install -q "$@"
+    "${pip[@]}" install -q --no-compile "$@"
+    compile_venv
+    exit 0
 fi
 
 here=$(dirname "$(readlink -f "${BASH_SOURCE[0]}")")
@@ -52,13 +67,14 @@ trap 'rm -rf "$tmp"' EXIT
 
 # ---- 1. offline, from the wheelhouse alone ----
 install_offline() {
-    "${pip[@]}" install -q --no-index --find-links "$wh" "$@" 2>"$tmp/offline.err"
+    "${pip[@]}" install -q --no-compile --no-index --find-links "$wh" "$@" 2>"$tmp/offline.err"
 }
 if install_offline "$@"; then
+    compile_venv
     echo "    (installed from the wheelhouse $wh; nothing downloaded)"
     exit 0
 fi
-why=$(grep -m 1 '^ERROR' "$tmp/offline.err" || tail -n 1 "$tmp/offline.err" || true)
+why=$(grep -E '^\s*ERROR:' "$tmp/offline.err" | tail -n 1 | sed -E 's/^\s*ERROR: //' || true)
 echo ">>> wheelhouse $wh cannot satisfy the requirements${why:+ ($why)}: refreshing it from the index"
 
 # ---- 2. refresh the wheelhouse, prune it, and install offline again ----
@@ -96,6 +112,7 @@ for f in wh.iterdir():
 EOF
 }
 if refresh "$@" && install_offline "$@"; then
+    compile_venv
     echo "    (wheelhouse $wh refreshed: $(du -sh "$wh" | cut -f1); installed from it)"
     exit 0
 fi
@@ -103,4 +120,5 @@ fi
 
 # ---- 3. last resort ----
 echo ">>> WARNING: could not install from the wheelhouse $wh; plain pip install from the index"
-"${pip[@]}" install -q "$@"
+"${pip[@]}" install -q --no-compile "$@"
+compile_venv
