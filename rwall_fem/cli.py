@@ -1,6 +1,7 @@
 """Command line: ``rwall-fem run SCENE [--out DIR] [--set key=value ...]``.
 
-Exit codes: 0 done, 2 bad input (one line on stderr, no traceback).
+Exit codes: 0 done, 2 bad input (one line on stderr, no traceback), 3 run stopped by a
+guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept).
 """
 
 from __future__ import annotations
@@ -50,6 +51,10 @@ def main(argv: list[str] | None = None) -> int:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
+    if summary["status"] != "done":
+        if comm.rank == 0:
+            print(f"rwall-fem: stopped: {summary['reason']}", file=sys.stderr)
+        return 3
     if comm.rank == 0 and not args.quiet:
         e = summary["energy"]
         print(

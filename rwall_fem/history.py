@@ -16,6 +16,12 @@ exactly (see ``../shared/notes/numerics.md``):
 
 Every row is flushed as it is written, so a run that stops leaves complete
 lines up to its last sample. Rank 0 writes; all ranks take part in the sums.
+
+The guards act at every sample, on the summed values, so every rank takes the
+same decision at the same step: non-finite energies (a NaN or Inf in a nodal
+array), a balance error above ``max_energy_error``, a step below ``min_dt``,
+or a SIGTERM received by any rank stop the run (:class:`RunStopped`) with one
+message naming the step, the time, the quantity and the worst node.
 """
 
 from __future__ import annotations
@@ -25,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
+
+from rwall_fem.solver import RunStopped
 
 __all__ = ["History"]
 
@@ -47,9 +55,22 @@ class History:
     """Samples energies and wall forces at the steps it is due and writes the run summary."""
 
     def __init__(
-        self, directory: Path, every: int, num_steps: int, comm: MPI.Comm, info: dict, walls, state
+        self,
+        directory: Path,
+        every: int,
+        num_steps: int,
+        comm: MPI.Comm,
+        info: dict,
+        walls,
+        state,
+        *,
+        node_ids: np.ndarray,
+        max_energy_error: float = 0.05,
+        min_dt: float = 0.0,
     ):
         self.every, self.num_steps = every, num_steps
+        self.node_ids = node_ids  # global index of each owned node, for messages
+        self.max_energy_error, self.min_dt = max_energy_error, min_dt
         self.comm, self.info, self.walls = comm, info, walls
         self.directory = Path(directory)
         m = state.mass[:, None]
@@ -86,12 +107,13 @@ class History:
         kinetic = 0.5 * float(np.sum(s.mass[:, None] * s.v * (s.v + s.dt * s.a)))
         local = [kinetic, sim.internal.strain_energy(s)]
         local.append(sum(f.work(s) for f in sim.forces) + sum(w.driving_work for w in self.walls))
+        local.append(float(sim.terminate_requested))
         for w in self.walls:
             local += [*w.normal_impulse, *w.tangential_impulse, w.contacts]
             local += [w.normal_work, w.friction_work]
         total = self.comm.allreduce(np.array(local))
-        kinetic, internal, external = total[:3]
-        per_wall = total[3:].reshape(-1, _PER_WALL)
+        kinetic, internal, external, terminate = total[:4]
+        per_wall = total[4:].reshape(-1, _PER_WALL)
         wall_work = float(per_wall[:, 7:9].sum())
         for w in self.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
@@ -119,13 +141,42 @@ class History:
                  *w.position, *w.motion.velocity)
             )  # fmt: skip
         self.wall_rows += rows
-        if self.comm.rank != 0:
-            return
-        self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
-        self._energy.flush()
-        if rows:
-            self._walls.writelines(",".join(f"{x:.17g}" for x in r) + "\n" for r in rows)
-            self._walls.flush()
+        if self.comm.rank == 0:
+            self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
+            self._energy.flush()
+            if rows:
+                self._walls.writelines(",".join(f"{x:.17g}" for x in r) + "\n" for r in rows)
+                self._walls.flush()
+        self._guard(s, error, terminate, np.isfinite(total).all())
+
+    def _guard(self, s, error: float, terminate: float, finite: bool) -> None:
+        """Stop the run (on every rank alike) when a guard trips at this sample."""
+        where = f"step {s.step}, t = {s.t:.6g} s"
+        if not finite:
+            bad = ~(np.isfinite(s.u).all(axis=1) & np.isfinite(s.v).all(axis=1))
+            node = self._worst(bad.astype(float), s)
+            raise RunStopped(f"{where}: NaN or Inf in the nodal state; first bad node {node}")
+        if abs(error) > self.max_energy_error:
+            node = self._worst(np.linalg.norm(s.v, axis=1), s, "|v| = {:.4g} m/s")
+            raise RunStopped(
+                f"{where}: energy balance error {error:.3g} exceeds run.max_energy_error = "
+                f"{self.max_energy_error:g}; fastest node {node}"
+            )
+        if s.dt < self.min_dt:
+            raise RunStopped(
+                f"{where}: time step {s.dt:.4g} s is below run.min_dt = {self.min_dt:g} s"
+            )
+        if terminate:
+            raise RunStopped(f"{where}: terminated by SIGTERM")
+
+    def _worst(self, score: np.ndarray, s, detail: str = "") -> str:
+        """'<global id> at (x, y, z) m' of the node with the largest ``score`` on any rank."""
+        score = np.where(np.isnan(score), np.inf, score)
+        i = int(np.argmax(score)) if len(score) else -1
+        mine = (score[i], self.node_ids[i], *(s.X[i] + s.u[i])) if i >= 0 else (-np.inf,)
+        best = max(self.comm.allgather(mine), key=lambda c: c[0])
+        text = f"{best[1]} at ({best[2]:.6g}, {best[3]:.6g}, {best[4]:.6g}) m"
+        return f"{text}, {detail.format(best[0])}" if detail else text
 
     @property
     def energy(self) -> np.ndarray:
@@ -168,6 +219,8 @@ class History:
             walls.append(entry)
         t, kinetic, internal, external, wall_work, _ = self.energy_rows[-1]
         summary = self.info | {
+            "status": "done" if sim.status == "done" else "stopped",
+            "reason": sim.status.removeprefix("stopped: ") if sim.status != "done" else None,
             "ranks": comm.size,
             "steps": sim.num_steps,
             "dt": s.dt,

@@ -118,7 +118,16 @@ def build_simulation(
         "dt_element_estimate": dt_element,
     }
     sim.history = History(
-        directory, scene.output.history_interval, sim.num_steps, comm, info, walls, state
+        directory,
+        scene.output.history_interval,
+        sim.num_steps,
+        comm,
+        info,
+        walls,
+        state,
+        node_ids=V.dofmap.index_map.local_to_global(np.arange(owned, dtype=np.int32)),
+        max_energy_error=scene.run.max_energy_error,
+        min_dt=scene.run.min_dt,
     )
     sim.recorders.append(sim.history)
     if scene.output.frames:

@@ -42,6 +42,8 @@ class RunSettings:
     end_time: float  # s
     dt_scale: float = 0.9  # fraction of the stable step 2/omega_max
     dt: float | None = None  # s, a fixed step; refused above the stable limit
+    max_energy_error: float = 0.05  # the run stops when |energy balance error| exceeds this
+    min_dt: float = 0.0  # s: the run stops when the step falls below this
 
 
 @dataclass(frozen=True)
@@ -284,11 +286,18 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         raw, "", source, ("run", "mesh", "material", "initial", "gravity", "wall", "output")
     )
 
-    t = _Table(top.get("run"), "run", source, ("end_time", "dt_scale", "dt"))
+    t = _Table(
+        top.get("run"),
+        "run",
+        source,
+        ("end_time", "dt_scale", "dt", "max_energy_error", "min_dt"),
+    )
     run = RunSettings(
         end_time=t.number("end_time", low=0.0),
         dt_scale=t.number("dt_scale", 0.9, low=0.0, high=1.0),
         dt=t.number("dt", None, low=0.0),
+        max_energy_error=t.number("max_energy_error", 0.05, low=0.0),
+        min_dt=t.number("min_dt", 0.0, low=0.0, low_open=False),
     )
 
     t = _Table(

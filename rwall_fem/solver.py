@@ -14,13 +14,19 @@ Only the effects a scene asks for are in the lists, so nothing else runs.
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 from petsc4py import PETSc
 
-__all__ = ["LinearElasticForce", "Simulation", "State"]
+__all__ = ["LinearElasticForce", "RunStopped", "Simulation", "State"]
+
+
+class RunStopped(Exception):
+    """A guard stopped the run; the message names the step, time, quantity and worst node."""
 
 
 @dataclass
@@ -81,6 +87,8 @@ class Simulation:
     recorders: list = field(default_factory=list)
     history: object = None  # the History among the recorders
     wall_seconds: float = 0.0
+    status: str = "not run"  # "done", or "stopped: <reason>"
+    terminate_requested: bool = False  # set by SIGTERM; acted on at the next history sample
 
     @property
     def num_steps(self) -> int:
@@ -91,24 +99,50 @@ class Simulation:
         """Names of the effects in the step pipeline, in the order they act."""
         return [e.name for e in [self.internal, *self.forces, *self.constraints]]
 
-    def run(self) -> None:
-        """Advance from t = 0 to ``end_time`` (s), then close the recorders."""
+    def run(self) -> str:
+        """Advance from t = 0 to ``end_time`` (s), then close the recorders.
+
+        Returns ``self.status``: "done", or "stopped: ..." when a guard (see
+        :class:`~rwall_fem.history.History`) or SIGTERM stopped the run. Either way
+        every recorder is closed, so the outputs up to the last sample stay valid.
+        """
         s, forces, last = self.state, [self.internal, *self.forces], self.num_steps
         scratch = np.empty_like(s.u)
         started = time.perf_counter()
-        for step in range(last + 1):
-            s.step, s.t = step, step * s.dt
-            for effect in forces:
-                effect.accelerate(s)
-            for constraint in self.constraints:
-                constraint.constrain(s)
+        previous = _on_sigterm(self)
+        try:
+            for step in range(last + 1):
+                s.step, s.t = step, step * s.dt
+                for effect in forces:
+                    effect.accelerate(s)
+                for constraint in self.constraints:
+                    constraint.constrain(s)
+                for recorder in self.recorders:
+                    if recorder.due(step):
+                        recorder.record(self, s)
+                np.multiply(s.a, s.dt, out=scratch)
+                s.v += scratch
+                np.multiply(s.v, s.dt, out=scratch)
+                s.u += scratch
+            self.status = "done"
+        except RunStopped as stop:
+            self.status = f"stopped: {stop}"
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+            self.wall_seconds = time.perf_counter() - started
             for recorder in self.recorders:
-                if recorder.due(step):
-                    recorder.record(self, s)
-            np.multiply(s.a, s.dt, out=scratch)
-            s.v += scratch
-            np.multiply(s.v, s.dt, out=scratch)
-            s.u += scratch
-        self.wall_seconds = time.perf_counter() - started
-        for recorder in self.recorders:
-            recorder.close(self)
+                recorder.close(self)
+        return self.status
+
+
+def _on_sigterm(sim: Simulation):
+    """Make SIGTERM a request to stop cleanly; returns the previous handler (None if the
+    handler cannot be set, outside the main thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def request(signum, frame):
+        sim.terminate_requested = True
+
+    return signal.signal(signal.SIGTERM, request)

@@ -1,0 +1,49 @@
+"""Only the effects a scene calls for are in the step: the rest never runs."""
+
+import pytest
+from conftest import bar_scene, block_scene, run
+
+import rwall_fem.effects
+import rwall_fem.frames
+import rwall_fem.walls.constraint
+import rwall_fem.walls.motion
+
+
+def forbidden(name):
+    def call(*args, **kwargs):
+        raise AssertionError(f"{name} ran although the scene did not ask for it")
+
+    return call
+
+
+@pytest.fixture
+def nothing_optional(monkeypatch):
+    """Make every optional effect fail loudly if it runs."""
+    for owner, name in [
+        (rwall_fem.effects.Gravity, "accelerate"),
+        (rwall_fem.frames.Frames, "record"),
+        (rwall_fem.walls.motion.MainNodeMotion, "advance"),
+        (rwall_fem.walls.motion.PrescribedMotion, "predict"),
+        (rwall_fem.walls.constraint.RigidWall, "_coupled_velocity"),
+    ]:
+        monkeypatch.setattr(owner, name, forbidden(f"{owner.__name__}.{name}"))
+
+
+def test_plain_impact_runs_only_elasticity_and_its_wall(nothing_optional, shared_dir):
+    sim = run(bar_scene(elements=10), shared_dir)
+    assert sim.effects == ["linear_elastic", "wall[0]"]
+    assert sim.forces == [] and sim.recorders == [sim.history]
+    wall = sim.constraints[0]
+    # Free sliding on a fixed wall: no tangential impulse was ever computed or booked.
+    assert wall.slide == "free" and not wall.tangential_impulse.any()
+    assert wall.friction_work == 0.0 and wall._previous_tangential is None
+
+
+def test_free_flight_runs_only_elasticity(nothing_optional, shared_dir):
+    sim = run(bar_scene(elements=10, wall=False), shared_dir)
+    assert sim.effects == ["linear_elastic"] and sim.constraints == []
+
+
+def test_gravity_is_an_effect_when_asked(shared_dir):
+    sim = run(block_scene(gravity=[0.0, 0.0, -9.81], end_time=1e-3), shared_dir)
+    assert sim.effects == ["linear_elastic", "gravity"]

@@ -1,0 +1,127 @@
+"""Run guards and what a stopped run leaves behind (Radioss /STOP, LS-DYNA ENDENG)."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import bar_scene, run
+from mpi4py import MPI
+
+from rwall_fem import build_simulation, parse_scene
+from rwall_fem.history import WALL_COLUMNS
+
+serial_only = pytest.mark.skipif(
+    MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
+)
+
+
+def complete_rows(path: Path, columns: int) -> list[list[float]]:
+    """Every line of a CSV file, each checked to be complete and numeric."""
+    rows = list(csv.reader(open(path)))
+    assert all(len(r) == columns for r in rows)
+    return [[float(x) for x in r] for r in rows[1:]]
+
+
+def test_nan_in_the_state_stops_the_run_and_names_the_node(shared_dir):
+    sim = build_simulation(
+        parse_scene(bar_scene(elements=10), source="test"), MPI.COMM_WORLD, shared_dir
+    )
+    if MPI.COMM_WORLD.rank == 0:
+        sim.state.v[0, 2] = np.nan  # what an instability leaves behind
+    status = sim.run()
+    assert status.startswith("stopped: step 0, t = 0 s: NaN or Inf in the nodal state")
+    assert "first bad node" in status and " m" in status
+    if MPI.COMM_WORLD.rank == 0:
+        summary = json.loads((Path(shared_dir) / "summary.json").read_text())
+        assert summary["status"] == "stopped" and "NaN" in summary["reason"]
+        complete_rows(Path(shared_dir) / "energy.csv", 6)
+
+
+def test_energy_error_guard(shared_dir):
+    raw = bar_scene(elements=10)
+    raw["run"]["max_energy_error"] = 1e-300  # any round-off trips it
+    sim = run(raw, shared_dir)
+    assert "energy balance error" in sim.status and "exceeds run.max_energy_error" in sim.status
+    assert "fastest node" in sim.status and "|v| = " in sim.status
+    assert sim.history.summary["status"] == "stopped"
+    assert len(sim.history.energy_rows) < sim.num_steps + 1
+
+
+def test_min_dt_guard(shared_dir):
+    raw = bar_scene(elements=10)
+    raw["run"]["min_dt"] = 1.0
+    sim = run(raw, shared_dir)
+    assert sim.status.startswith("stopped: step 0, t = 0 s: time step")
+    assert "below run.min_dt = 1 s" in sim.status
+
+
+LONG = """
+[run]
+end_time = 1.0
+[mesh]
+shape = "bar"
+size = [0.004, 0.004, 0.04]
+element_size = 0.002
+[material]
+model = "linear_elastic"
+density = 7850.0
+young = 210e9
+poisson = 0.3
+[initial]
+velocity = [0.0, 0.0, -5.0]
+[[wall]]
+kind = "plane"
+point = [0.0, 0.0, 0.0]
+normal_point = [0.0, 0.0, 1.0]
+"""
+
+
+def _start_long_run(tmp_path):
+    (tmp_path / "scene.toml").write_text(LONG)
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    process = subprocess.Popen(
+        [sys.executable, "-m", "rwall_fem", "run", "scene.toml", "--out", "out", "--quiet"],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    energy = tmp_path / "out" / "energy.csv"
+    deadline = time.monotonic() + 120
+    while not (energy.exists() and energy.stat().st_size > 20000):
+        assert process.poll() is None and time.monotonic() < deadline
+        time.sleep(0.2)
+    return process
+
+
+@serial_only
+def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
+    process = _start_long_run(tmp_path)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 3
+    assert stderr.strip().startswith("rwall-fem: stopped: step ")
+    assert "terminated by SIGTERM" in stderr and len(stderr.strip().splitlines()) == 1
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "stopped" and "SIGTERM" in summary["reason"]
+    rows = complete_rows(tmp_path / "out" / "energy.csv", 6)
+    assert summary["energy"]["kinetic"] == rows[-1][1]
+    complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
+
+
+@serial_only
+def test_sigkill_leaves_complete_csv_lines(tmp_path):
+    process = _start_long_run(tmp_path)
+    process.kill()
+    process.communicate(timeout=60)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", 6)
+    assert len(rows) > 100
+    assert not (tmp_path / "out" / "summary.json").exists()
