@@ -60,10 +60,10 @@ def test_corner_impact(shared_dir):
 
 
 def test_slightly_penetrated_nodes_are_pushed_back_in_one_step(shared_dir):
-    depth = 2e-5  # less than two steps of travel at 0.5 m/s (dt is about 1e-4 s)
+    depth = 2e-5  # less than two steps of normal travel at 0.5 m/s (dt is about 1e-4 s)
     patch = PATCH | {"secondary": {"add": ["bottom"]}}
     scene = block_scene(
-        origin=(0.02, -0.005, -depth), velocity=(0.5, 0.0, 0.0), wall=[patch], end_time=0.002
+        origin=(0.02, -0.005, -depth), velocity=(0.5, 0.0, -0.5), wall=[patch], end_time=0.002
     )
     sim, probe = run_probed(scene, shared_dir)
     assert probe.distances[0, 0] == pytest.approx(-depth)

@@ -4,7 +4,7 @@ After the acceleration solve, each secondary node's velocity and position are
 predicted, ``v* = v^{n-1/2} + dt a^n`` and ``x* = x^n + dt v*``, and so is the
 wall's position. A node whose predicted position is on the forbidden side is
 in contact (on a parallelogram only inside it, and only if it is not more than
-two steps of travel behind it). The wall then applies to the node the impulse
+two steps of normal travel, 2 dt |(v* - V) . n|, behind it). The wall then applies to the node the impulse
 ``I`` that
 
 - removes its normal velocity relative to the wall (a node slightly behind a
@@ -116,8 +116,8 @@ class RigidWall:
         target = np.zeros(len(h))  # normal velocity relative to the wall after the step
         if self.finite and len(h):
             d_now = shape.distance(x_now[h], offset)
-            speed = np.linalg.norm(v_pred[h] - wall_velocity, axis=1)
-            near = d_now >= -2.0 * dt * speed  # deeper nodes pass behind the wall
+            normal_speed = np.abs((v_pred[h] - wall_velocity) @ shape.normal)
+            near = d_now >= -2.0 * dt * normal_speed  # deeper nodes pass behind the wall
             h, d_now = h[near], d_now[near]
             target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
 
