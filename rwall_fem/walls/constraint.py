@@ -4,8 +4,8 @@ After the acceleration solve, each secondary node's velocity and position are
 predicted, ``v* = v^{n-1/2} + dt a^n`` and ``x* = x^n + dt v*``, and so is the
 wall's position. A node whose predicted position is on the forbidden side is
 in contact (on a parallelogram only inside it, and only if it is not more than
-two steps of normal travel, 2 dt |(v* - V) . n|, behind it). The wall then applies to the node the impulse
-``I`` that
+two steps of normal travel, 2 dt |(v* - V) . n|, behind it). The wall then
+applies to the node the impulse ``I`` that
 
 - removes its normal velocity relative to the wall (a node slightly behind a
   parallelogram gets the velocity that brings it back onto it in one step);

@@ -59,7 +59,8 @@ def check_stable(sim, probe, *, balance=1e-10, inside=1e-12, dissipative=True):
     print(  # the figures quoted in the README: run with -s to see them
         f"[hard] {name}: steps {sim.num_steps}, balance error "
         f"{summary['energy']['max_balance_error']:.1e}, deepest node {probe.distances.min():.1e} m,"
-        f" wall work / E0 {sum(w['work'] for w in summary['walls']) / max(summary['energy']['initial'], 1e-300):.2e},"
+        f" wall work {sum(w['work'] for w in summary['walls']):.2e} J"
+        f" (E0 {summary['energy']['initial']:.2e} J),"
         f" {summary['wall_seconds']:.2f} s"
     )
     if dissipative:  # fixed or main-node walls only take energy out
