@@ -53,7 +53,8 @@ def test_corner_impact(shared_dir):
     summary = sim.history.summary
     change = np.subtract(summary["final_momentum"], summary["initial_momentum"])
     impulse = np.asarray(summary["walls"][0]["impulse"])
-    assert np.allclose(change, -impulse, rtol=0, atol=1e-12 * np.abs(impulse).max())
+    # Exact but for the round-off of sum(K u) (1e-12 relative seen with DOLFINx 0.11).
+    assert np.allclose(change, -impulse, rtol=0, atol=1e-11 * np.abs(impulse).max())
     assert impulse[2] < 0 and summary["walls"][0]["peak_contacts"] <= 4  # 2 x 2 nodes inside
     assert summary["energy"]["max_balance_error"] < 1e-10
     assert np.all(np.isfinite(probe.v))
