@@ -5,6 +5,8 @@
 #   make test DOLFINX=0.11     only the PyPI leg:    dolfinx-solver-real 0.11 + MPICH, venv .venv-0.11
 #   make venv                  set-up only (honours DOLFINX too)
 #   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
+#   make study / make bench    accuracy vs wall time (results/study, copied to docs/); throughput
+#                              benchmark (bench/results.md); both on the Debian leg, long runs
 #   make clean                 remove both venvs, test logs and Python caches (results/ is kept)
 #   make clean-wheels          remove the wheelhouses (see below; the next set-up refills them)
 #
@@ -100,7 +102,7 @@ ifneq ($(filter 0.11,$(LEGS)),)
   endif
 endif
 
-.PHONY: test venv demo clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
+.PHONY: test venv demo study bench clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
         test-0.5 test-0.5-serial test-0.5-mpi test-0.11 test-0.11-serial test-0.11-mpi
 
 test: $(addprefix test-,$(LEGS))
@@ -185,6 +187,18 @@ FORCE:
 # ---- demo and clean ---------------------------------------------------------------------------
 demo: venv-0.5
 	$(RUN_ENV) $(VENV)/bin/rwall-fem run demos/bar_impact.toml --out results/bar_impact
+
+# The full study takes 10-20 minutes; its table and plots are copied into docs/ for the README.
+study: venv-0.5
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/rwall-fem study --out results/study
+	mkdir -p docs
+	cp results/study/study.md docs/study.md
+	cp results/study/study_*.png docs/
+
+# Throughput, memory bandwidth floor, Python share, start-up, 2-rank efficiency (~10 minutes).
+bench: venv-0.5
+	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
+	    $(VENV)/bin/python bench/bench.py --out bench/results.md
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info

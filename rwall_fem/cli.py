@@ -1,4 +1,5 @@
-"""Command line: ``rwall-fem run SCENE [--out DIR] [--set key=value ...]``.
+"""Command line: ``rwall-fem run SCENE [--out DIR] [--set key=value ...]``, and
+``rwall-fem study [--quick] [--out DIR]`` (what accuracy costs in time, :mod:`rwall_fem.study`).
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback), 3 run stopped by a
 guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept).
@@ -31,7 +32,15 @@ def main(argv: list[str] | None = None) -> int:
         help="override a scene key, value read as TOML (e.g. mesh.element_size=5e-4)",
     )
     run.add_argument("--quiet", action="store_true", help="print only errors")
+    study = commands.add_parser("study", help="accuracy against wall time, on exact references")
+    study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
+    study.add_argument("--out", default="results/study", help="results directory")
     args = parser.parse_args(argv)
+    if args.command == "study":
+        from rwall_fem.study import run_study
+
+        run_study(args.out, quick=args.quick)
+        return 0
 
     from mpi4py import MPI
 
