@@ -10,6 +10,7 @@ wheel requires.
 from __future__ import annotations
 
 import importlib.util
+import inspect
 
 if importlib.util.find_spec("dolfinx_solver") is not None:
     import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
@@ -22,6 +23,7 @@ from dolfinx import fem, plot
 __all__ = [
     "DOLFINX_VERSION",
     "cell_nodes",
+    "create_vector",
     "model_to_mesh",
     "vector_space",
     "vtk_mesh",
@@ -64,3 +66,9 @@ def model_to_mesh(model, comm, rank: int, gdim: int = 3):
     from dolfinx.io import gmshio
 
     return gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+
+
+def create_vector(V, form):
+    """A ghosted PETSc vector for assembling the linear ``form`` whose test space is ``V``."""
+    first = next(iter(inspect.signature(fem.petsc.create_vector).parameters))
+    return fem.petsc.create_vector(V if first == "V" else form)

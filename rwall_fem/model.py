@@ -72,7 +72,7 @@ def build_simulation(
     owned = V.dofmap.index_map.size_local
     X = V.tabulate_dof_coordinates()[:owned].copy()
     mass = lumped_mass(V, scene.material.density)
-    K = stiffness_matrix(V, scene.material)
+    K = stiffness_matrix(V, scene.material)  # small strain: also the tangent at u = 0
 
     dt_stable = critical_time_step(K, mass, X)
     dt_element = element_time_step(V, scene.material)
@@ -100,10 +100,19 @@ def build_simulation(
     state.v[:] = scene.initial.velocity
     forces = [] if scene.gravity is None else [Gravity(scene.gravity, state)]
     walls = [_wall(scene, i, V, body, state, comm) for i in range(len(scene.walls))]
+    monitors = []
+    if scene.material.model == "linear_elastic":
+        internal = LinearElasticForce(K, state)
+    else:
+        from rwall_fem.hyperelasticity import HyperelasticForce, StableStepMonitor
+
+        K.destroy()  # only the initial stable step needed it
+        internal = HyperelasticForce(V, scene.material, state)
+        monitors.append(StableStepMonitor(internal, state, dt_stable))
     sim = Simulation(
         state=state,
         end_time=scene.run.end_time,
-        internal=LinearElasticForce(K, state),
+        internal=internal,
         forces=forces,
         constraints=walls,
     )
@@ -129,7 +138,7 @@ def build_simulation(
         max_energy_error=scene.run.max_energy_error,
         min_dt=scene.run.min_dt,
     )
-    sim.recorders.append(sim.history)
+    sim.recorders += [sim.history, *monitors]
     if scene.output.frames:
         from rwall_fem.frames import Frames
 

@@ -31,6 +31,8 @@ __all__ = [
 ]
 
 MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
+# Small strain (constant stiffness), and the large-deformation (hyperelastic) models.
+MATERIAL_MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
 
 
 class SceneError(ValueError):
@@ -331,7 +333,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
 
     t = _Table(top.get("material"), "material", source, ("model", "density", "young", "poisson"))
     material = Material(
-        model=t.choice("model", ("linear_elastic",)),
+        model=t.choice("model", MATERIAL_MODELS),
         density=t.number("density", low=0.0),
         young=t.number("young", low=0.0),
         poisson=t.number("poisson", low=-1.0, high=0.5, high_open=True),

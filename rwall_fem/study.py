@@ -394,8 +394,9 @@ def summarise(rows, cases, target: float = 0.01) -> str:
                 best = (name, one[0], one[1])
         if best is not None:
             lines.append("")
+            where = case.name.replace("_", " ")
             lines.append(
-                f"In one line: {100 * target:g} % {label} error on the {case.name.replace('_', ' ')}"
+                f"In one line: {100 * target:g} % {label} error on the {where}"
                 f" costs {best[2]:,.0f} cells and {best[1]:.3g} s with the cheapest technology "
                 f"({best[0]})."
             )

@@ -1,0 +1,137 @@
+"""Large deformation (total Lagrangian): hyperelastic internal forces as an effect.
+
+Selected by ``material.model = "saint_venant_kirchhoff"`` or ``"neo_hookean"``
+(compressible). The internal force is the residual of the first Piola-Kirchhoff
+stress, f = int P(F) : grad(w) dX with F = I + grad(u), assembled every step
+from a form compiled once; the strain energy is int psi(F) dX. At u = 0 both
+models have the small-strain stiffness, so the initial stable step is that of
+the linear model; :meth:`HyperelasticForce.stable_step` re-estimates it in
+the current configuration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from rwall_fem import _compat
+from rwall_fem.scene import Material
+from rwall_fem.solver import RunStopped
+
+__all__ = ["HyperelasticForce", "StableStepMonitor", "strain_energy_density"]
+
+QUADRATURE_DEGREE = 2  # exact for the linearised P1 / Q1 stiffness
+
+
+def strain_energy_density(F, material: Material):
+    """psi(F) in J/m^3 for the material's hyperelastic model."""
+    lmbda, mu = material.lame
+    d = F.ufl_shape[0]
+    if material.model == "saint_venant_kirchhoff":
+        E = 0.5 * (F.T * F - ufl.Identity(d))
+        return 0.5 * lmbda * ufl.tr(E) ** 2 + mu * ufl.inner(E, E)
+    if material.model == "neo_hookean":
+        J = ufl.det(F)
+        return 0.5 * mu * (ufl.tr(F.T * F) - d) - mu * ufl.ln(J) + 0.5 * lmbda * ufl.ln(J) ** 2
+    raise ValueError(f"no hyperelastic model {material.model!r}")
+
+
+class HyperelasticForce:
+    """Internal force of a hyperelastic body; *sets* ``state.a`` like the linear force."""
+
+    def __init__(self, V, material: Material, state):
+        self.name = material.model
+        self.V = V
+        self.u = fem.Function(V)
+        gdim = V.mesh.geometry.dim
+        F = ufl.variable(ufl.Identity(gdim) + ufl.grad(self.u))
+        psi = strain_energy_density(F, material)
+        P = ufl.diff(psi, F)
+        w = ufl.TestFunction(V)
+        # One quadrature rule for both forms: the discrete force is then exactly the
+        # gradient of the discrete strain energy, which the energy balance relies on.
+        dx = ufl.dx(metadata={"quadrature_degree": QUADRATURE_DEGREE})
+        self._force = fem.form(ufl.inner(P, ufl.grad(w)) * dx)
+        self._energy = fem.form(psi * dx)
+        self._vector = _compat.create_vector(V, self._force)
+        self._owned = state.u.size
+        self.assemblies = 0  # force assemblies so far (a cost counter)
+
+    def forces(self, u: np.ndarray) -> np.ndarray:
+        """Internal forces (N) on the owned nodes for the displacement ``u`` (n, 3), a view."""
+        self.u.x.array[: self._owned] = u.ravel()
+        self.u.x.scatter_forward()
+        b = self._vector
+        with b.localForm() as local:
+            local.set(0.0)
+        fem.petsc.assemble_vector(b, self._force)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.assemblies += 1
+        return b.array.reshape(-1, 3)
+
+    def accelerate(self, state) -> None:
+        np.multiply(self.forces(state.u), state.inv_mass, out=state.a)
+        np.negative(state.a, out=state.a)
+
+    def strain_energy(self, state) -> float:
+        """Strain energy (J) of this rank's cells at the displacement of the latest step."""
+        return fem.assemble_scalar(self._energy)
+
+    def largest_eigenvalue(self, state, iterations: int) -> float:
+        """Rayleigh quotient (1/s^2) of a power iteration on M^-1/2 K_t M^-1/2, the tangent
+        stiffness K_t applied by finite differences of the internal forces; warm-started
+        from the previous call's vector."""
+        comm = self.V.mesh.comm
+        scale = np.sqrt(state.inv_mass)
+        base = self.forces(state.u).copy()
+        x = getattr(self, "_mode", None)
+        if x is None:  # a start that depends only on coordinates: the same on any partition
+            x = np.sin(state.X @ np.array([12.9898, 78.233, 37.719]) * 1e3)[:, None] * [1, -1, 1]
+            x = x / np.sqrt(comm.allreduce(float(np.sum(x * x))))
+        size = comm.allreduce(float(np.ptp(state.X, axis=0).max(initial=0.0)), op=MPI.MAX)
+        rayleigh = 0.0
+        for _ in range(iterations):
+            dx = scale * x
+            # Perturb by 1e-7 of the body size: linear enough, far above round-off.
+            largest = comm.allreduce(float(np.abs(dx).max(initial=0.0)), op=MPI.MAX)
+            reach = 1e-7 * size / largest
+            y = (self.forces(state.u + reach * dx) - base) / reach * scale
+            rayleigh = comm.allreduce(float(np.sum(x * y)))
+            x = y / np.sqrt(comm.allreduce(float(np.sum(y * y))))
+        self._mode = x
+        self.forces(state.u)  # leave the Function at the current displacement
+        return rayleigh
+
+
+class StableStepMonitor:
+    """Re-estimates the stable step of a hyperelastic body every ``every`` steps and stops
+    the run (never silently) when the step in use exceeds it.
+
+    The estimate scales the exact initial limit ``dt_stable`` (s) by the change of the
+    tangent's largest eigenvalue, tracked by a warm-started power iteration (the same
+    iteration at t = 0 and later, so its bias cancels in the ratio).
+    """
+
+    def __init__(self, force: HyperelasticForce, state, dt_stable: float, every: int = 100):
+        self.force, self.every, self.dt_stable = force, every, dt_stable
+        self.reference = force.largest_eigenvalue(state, iterations=40)
+        self.estimates = []  # (t, estimated stable step)
+
+    def due(self, step: int) -> bool:
+        return step % self.every == 0
+
+    def record(self, sim, s) -> None:
+        ratio = self.force.largest_eigenvalue(s, iterations=8) / self.reference
+        estimate = self.dt_stable / np.sqrt(max(ratio, 1e-300))
+        self.estimates.append((s.t, estimate))
+        if s.dt > estimate:
+            raise RunStopped(
+                f"step {s.step}, t = {s.t:.6g} s: the deformation lowered the stable step to "
+                f"about {estimate:.4g} s, below dt = {s.dt:.4g} s; lower run.dt_scale"
+            )
+
+    def close(self, sim) -> None:
+        pass
