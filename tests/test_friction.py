@@ -114,3 +114,16 @@ def test_tied_face_follows_a_main_node_wall(shared_dir):
     gained = w.motion.mass * (w.motion.velocity - velocity)
     assert np.allclose(gained, pushed, rtol=0, atol=1e-13 * np.abs(pushed).max())
     assert summary["energy"]["max_balance_error"] < 1e-10
+
+
+def test_sticking_nodes_follow_a_main_node_wall(shared_dir):
+    """mu = 1 and a block moving with its wall: every node in contact sticks and has
+    exactly the wall's velocity, although the wall itself is pushed by the block."""
+    velocity = [0.4, -0.3, 0.0]
+    wall = floor(slide="friction", friction=1.0, motion={"mass": 1e-2, "velocity": velocity})
+    scene = block_scene(gravity=[0, 0, -G], wall=wall, end_time=0.05, velocity=velocity)
+    sim, probe = run_probed(scene, shared_dir)
+    s, w = sim.state, sim.constraints[0]
+    assert w.comm.allreduce(len(w.touching)) > 0
+    assert np.allclose(s.v[w.touching], w.motion.velocity, rtol=0, atol=1e-12)
+    assert sim.history.summary["walls"][0]["friction_work"] == pytest.approx(0.0, abs=1e-15)
