@@ -47,17 +47,8 @@ class Frames:
         self._count = 0
         topology, cell_types, points = _compat.vtk_mesh(V)
         mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
-        if self.comm.rank == 0:
-            self.data.mkdir(parents=True, exist_ok=True)
-            walls_info = [{"kind": w.shape.kind, **w.shape.parameters()} for w in walls]
-            np.savez(
-                self.data / "mesh.npz",
-                topology=mesh[0],
-                cell_types=mesh[1],
-                points=mesh[2],
-                speed=speed,
-                walls=json.dumps(walls_info),
-            )
+        self._mesh = mesh
+        self._speed = speed
 
     def _gather(self, local):
         pieces = self.comm.gather(local, root=0)
@@ -84,9 +75,26 @@ class Frames:
     def due(self, step: int) -> bool:
         return step in self.steps
 
+    def _save_mesh(self) -> None:
+        self.data.mkdir(parents=True, exist_ok=True)
+        for stale in [*self.data.glob("frame_*.npz"), *self.data.parent.glob("frame_*.png")]:
+            stale.unlink()  # a previous run into the same directory
+        walls_info = [{"kind": w.shape.kind, **w.shape.parameters()} for w in self.walls]
+        topology, cell_types, points = self._mesh
+        np.savez(
+            self.data / "mesh.npz",
+            topology=topology,
+            cell_types=cell_types,
+            points=points,
+            speed=self._speed,
+            walls=json.dumps(walls_info),
+        )
+
     def record(self, sim, s) -> None:
         u, v = self._nodal(s.u), self._nodal(s.v)
         if self.comm.rank == 0:
+            if not self._count:
+                self._save_mesh()
             offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
             np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v, offsets=offsets)
         self._count += 1

@@ -89,15 +89,15 @@ class History:
         self.energy_rows = []  # (t, K, U, W_ext, W_wall, error), as in energy.csv
         self.wall_rows = []  # rows of walls.csv
         self._energy = self._walls = None
-        if comm.rank == 0:
-            self.directory.mkdir(parents=True, exist_ok=True)
-            self._energy = open(self.directory / "energy.csv", "w")
-            self._energy.write("time,kinetic,internal,external_work,wall_work,balance_error\n")
-            self._energy.flush()
-            if walls:
-                self._walls = open(self.directory / "walls.csv", "w")
-                self._walls.write(",".join(WALL_COLUMNS) + "\n")
-                self._walls.flush()
+
+    def _open(self) -> None:
+        """Create the directory and the CSV files (rank 0) when the run starts writing."""
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self._energy = open(self.directory / "energy.csv", "w")
+        self._energy.write("time,kinetic,internal,external_work,wall_work,balance_error\n")
+        if self.walls:
+            self._walls = open(self.directory / "walls.csv", "w")
+            self._walls.write(",".join(WALL_COLUMNS) + "\n")
 
     def due(self, step: int) -> bool:
         return step % self.every == 0 or step == self.num_steps
@@ -142,6 +142,8 @@ class History:
             )  # fmt: skip
         self.wall_rows += rows
         if self.comm.rank == 0:
+            if self._energy is None:
+                self._open()
             self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
             self._energy.flush()
             if rows:
@@ -241,6 +243,8 @@ class History:
         }
         self.summary = summary
         if comm.rank == 0:
+            if self._energy is None:
+                self._open()
             (self.directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
             self._energy.close()
             if self._walls:

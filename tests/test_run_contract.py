@@ -239,3 +239,27 @@ def test_command_line_bad_input_is_one_line(tmp_path, args, message):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], result.stderr
     assert "Traceback" not in result.stderr
+
+
+@serial_only
+def test_check_prints_what_would_run_and_writes_nothing(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    result = _cli("check", "scene.toml", "--set", "mesh.cell='tetrahedron'", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "is valid" in result.stdout and "tetrahedron cells" in result.stdout
+    assert "effects: linear_elastic, wall[0]" in result.stdout
+    assert "estimated wall time" in result.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]
+
+
+@serial_only
+def test_render_draws_a_results_folder_again(tmp_path):
+    (tmp_path / "scene.toml").write_text(SCENE)
+    assert _cli("run", "scene.toml", "--out", "out", "--quiet", cwd=tmp_path).returncode == 0
+    for png in (tmp_path / "out" / "frames").glob("*.png"):
+        png.unlink()
+    result = _cli("render", "out", "--color", "displacement", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert len(list((tmp_path / "out" / "frames").glob("frame_*.png"))) == 3
+    missing = _cli("render", "nowhere", cwd=tmp_path)
+    assert missing.returncode == 2 and "no frame data" in missing.stderr
