@@ -67,7 +67,9 @@ class History:
         node_ids: np.ndarray,
         max_energy_error: float = 0.05,
         min_dt: float = 0.0,
+        plot: bool = False,
     ):
+        self.plot = plot  # draw histories.png at the end
         self.every, self.num_steps = every, num_steps
         self.node_ids = node_ids  # global index of each owned node, for messages
         self.max_energy_error, self.min_dt = max_energy_error, min_dt
@@ -249,6 +251,10 @@ class History:
             self._energy.close()
             if self._walls:
                 self._walls.close()
+            if self.plot:
+                from rwall_fem.plots import plot_histories
+
+                plot_histories(self.directory)
 
 
 def _finite_or_none(x: float):

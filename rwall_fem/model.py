@@ -137,6 +137,7 @@ def build_simulation(
         node_ids=V.dofmap.index_map.local_to_global(np.arange(owned, dtype=np.int32)),
         max_energy_error=scene.run.max_energy_error,
         min_dt=scene.run.min_dt,
+        plot=scene.output.plot,
     )
     sim.recorders += [sim.history, *monitors]
     if scene.output.frames:

@@ -128,6 +128,7 @@ class Output:
     frames: int = 0  # number of PNG frames over the run; 0: no pictures
     history_interval: int = 1  # steps between rows of energy.csv and walls.csv
     color: str = "normal_velocity"  # frames coloured by: "normal_velocity", "speed", "displacement"
+    plot: bool = True  # histories.png: energies and wall forces over time
 
 
 @dataclass(frozen=True)
@@ -357,7 +358,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         top.get("output", {}),
         "output",
         source,
-        ("directory", "frames", "history_interval", "color"),
+        ("directory", "frames", "history_interval", "color", "plot"),
     )
     directory = t.get("directory", "results")
     if not isinstance(directory, str):
@@ -367,6 +368,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         frames=t.integer("frames", 0),
         history_interval=t.integer("history_interval", 1, low=1),
         color=t.choice("color", ("normal_velocity", "speed", "displacement"), "normal_velocity"),
+        plot=t.choice("plot", (True, False), True),
     )
     return Scene(source, run, mesh, material, initial, walls, output, gravity)
 

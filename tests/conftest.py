@@ -48,7 +48,7 @@ def bar_scene(
         },
         "material": dict(STEEL_NU0),
         "initial": {"velocity": list(-speed * axis)},
-        "output": {"frames": 0},
+        "output": {"frames": 0, "plot": False},
     }
     if wall:
         raw["wall"] = [{"kind": "plane", "point": [0.0, 0.0, 0.0], "normal_point": list(axis)}]
@@ -163,6 +163,7 @@ def block_scene(
         "material": dict(SOFT),
         "initial": {"velocity": list(velocity)},
         "wall": wall or [],
+        "output": {"plot": False},
     }
     if gravity is not None:
         raw["gravity"] = {"acceleration": list(gravity)}

@@ -91,6 +91,7 @@ def test_outputs_of_a_run(shared_dir):
         frames = sorted((out / "frames").glob("frame_*.png"))
         assert len(frames) == 3
         assert (out / "animation.gif").stat().st_size > 0
+        assert (out / "histories.png").stat().st_size > 0
 
 
 def test_dt_above_stable_limit_is_refused(shared_dir):
