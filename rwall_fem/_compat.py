@@ -24,6 +24,8 @@ __all__ = [
     "DOLFINX_VERSION",
     "cell_nodes",
     "create_vector",
+    "expression",
+    "scalar_space",
     "model_to_mesh",
     "vector_space",
     "vtk_mesh",
@@ -72,3 +74,16 @@ def create_vector(V, form):
     """A ghosted PETSc vector for assembling the linear ``form`` whose test space is ``V``."""
     first = next(iter(inspect.signature(fem.petsc.create_vector).parameters))
     return fem.petsc.create_vector(V if first == "V" else form)
+
+
+def scalar_space(msh, family: str = "DG", degree: int = 0) -> fem.FunctionSpace:
+    """Scalar space, e.g. piecewise constants for cell data."""
+    if _MODERN:
+        return fem.functionspace(msh, (family, degree))
+    return fem.FunctionSpace(msh, (family, degree))
+
+
+def expression(expr, V) -> fem.Expression:
+    """``expr`` compiled for interpolation into ``V``."""
+    points = V.element.interpolation_points
+    return fem.Expression(expr, points() if callable(points) else points)

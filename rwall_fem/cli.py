@@ -62,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
 
     comm = MPI.COMM_WORLD
     quiet = getattr(args, "quiet", False)
+    logging.getLogger().setLevel(logging.WARNING)  # the form compiler logs at INFO
     log = logging.getLogger("rwall_fem")
     handler = logging.StreamHandler(sys.stdout)
     handler.setFormatter(logging.Formatter("rwall-fem: %(message)s"))

@@ -140,6 +140,12 @@ def build_simulation(
         plot=scene.output.plot,
     )
     sim.recorders += [sim.history, *monitors]
+    if scene.output.fields:
+        from rwall_fem.fields import Fields
+
+        sim.recorders.append(
+            Fields(directory, scene.output.fields, sim.num_steps, V, scene.material)
+        )
     if scene.output.frames:
         from rwall_fem.frames import Frames
 

@@ -126,6 +126,7 @@ class WallSpec:
 class Output:
     directory: Path = Path("results")
     frames: int = 0  # number of PNG frames over the run; 0: no pictures
+    fields: int = 0  # snapshots of displacement, velocity, von Mises in fields.xdmf; 0: none
     history_interval: int = 1  # steps between rows of energy.csv and walls.csv
     color: str = "normal_velocity"  # frames coloured by: "normal_velocity", "speed", "displacement"
     plot: bool = True  # histories.png: energies and wall forces over time
@@ -358,7 +359,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         top.get("output", {}),
         "output",
         source,
-        ("directory", "frames", "history_interval", "color", "plot"),
+        ("directory", "frames", "fields", "history_interval", "color", "plot"),
     )
     directory = t.get("directory", "results")
     if not isinstance(directory, str):
@@ -366,6 +367,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
     output = Output(
         directory=Path(directory),
         frames=t.integer("frames", 0),
+        fields=t.integer("fields", 0),
         history_interval=t.integer("history_interval", 1, low=1),
         color=t.choice("color", ("normal_velocity", "speed", "displacement"), "normal_velocity"),
         plot=t.choice("plot", (True, False), True),

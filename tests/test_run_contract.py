@@ -42,7 +42,7 @@ frames = 3
 
 def test_outputs_of_a_run(shared_dir):
     raw = bar_scene(elements=8, h=2e-3, cell="tetrahedron")
-    raw["output"] = {"frames": 3, "history_interval": 5}
+    raw["output"] = {"frames": 3, "fields": 2, "history_interval": 5}
     sim = run(raw, shared_dir)
     if MPI.COMM_WORLD.rank == 0:
         out = Path(shared_dir)
@@ -92,6 +92,9 @@ def test_outputs_of_a_run(shared_dir):
         assert len(frames) == 3
         assert (out / "animation.gif").stat().st_size > 0
         assert (out / "histories.png").stat().st_size > 0
+        xdmf = (out / "fields.xdmf").read_text()
+        for name in ("displacement", "velocity", "von_mises_stress"):
+            assert xdmf.count(f'Name="{name}"') == 2  # two snapshots of each field
 
 
 def test_dt_above_stable_limit_is_refused(shared_dir):
