@@ -10,6 +10,7 @@ import importlib
 __version__ = "0.1.0"
 
 _API = {
+    "BodyMesh": "rwall_fem.meshing",
     "PlaneWall": "rwall_fem.walls",
     "RigidWall": "rwall_fem.walls",
     "Scene": "rwall_fem.scene",

@@ -7,7 +7,7 @@ boundary node sets by name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -34,8 +34,8 @@ class BodyMesh:
     """A distributed mesh with its named facet groups (name -> facet tag value)."""
 
     msh: object
-    facet_tags: object
-    groups: dict[str, int]
+    facet_tags: object = None
+    groups: dict[str, int] = field(default_factory=dict)
 
     @property
     def num_cells(self) -> int:

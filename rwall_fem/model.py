@@ -23,6 +23,7 @@ from rwall_fem.mechanics import (
     stiffness_matrix,
 )
 from rwall_fem.meshing import (
+    BodyMesh,
     bar_mesh,
     boundary_nodes,
     coordinate_noise,
@@ -56,16 +57,29 @@ def run_scene(
 
 
 def build_simulation(
-    scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, out: str | Path | None = None
+    scene: Scene,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    out: str | Path | None = None,
+    *,
+    body: BodyMesh | None = None,
 ) -> Simulation:
-    """Mesh the body, assemble mass and stiffness, choose dt and assemble the pipeline."""
+    """Mesh the body, assemble mass and stiffness, choose dt and assemble the pipeline.
+
+    ``body`` is a mesh of your own (``BodyMesh(msh, facet_tags, groups)``, any
+    distributed DOLFINx mesh of tetrahedra or hexahedra); it replaces the
+    scene's ``[mesh]`` and sets the communicator.
+    """
     directory = Path(out) if out is not None else scene.output.directory
     spec = scene.mesh
-    if spec.file is not None:
+    if body is not None:
+        comm = body.msh.comm
+    elif spec is None:
+        raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
+    elif spec.file is not None:
         body = read_mesh(comm, spec.file)
     else:
         body = bar_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell, spec.axis)
-    if spec.noise is not None:
+    if spec is not None and spec.noise is not None:
         perturb(body, *spec.noise)
     msh = body.msh
     V = _compat.vector_space(msh)
@@ -168,7 +182,7 @@ def _wall(scene: Scene, i: int, V, body, state: State, comm: MPI.Comm) -> RigidW
     spec: WallSpec = scene.walls[i]
     where = f"{scene.source}: wall[{i}]"
     point = np.asarray(spec.point)
-    noise = scene.mesh.noise
+    noise = scene.mesh.noise if scene.mesh is not None else None
     if spec.motion is not None and noise is not None:
         # The main node is a node of the model: noise moves it too (spec 6.5), with an
         # id no mesh node has. The wall's orientation follows where it is defined from M.

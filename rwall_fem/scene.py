@@ -136,7 +136,7 @@ class Output:
 class Scene:
     source: str  # file name used in messages
     run: RunSettings
-    mesh: MeshSpec
+    mesh: MeshSpec | None  # None: the body is given to build_simulation
     material: Material
     initial: Initial
     walls: tuple[WallSpec, ...] = ()
@@ -305,12 +305,14 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
     )
 
     t = _Table(
-        top.get("mesh"),
+        top.get("mesh", {}),
         "mesh",
         source,
         ("shape", "file", "origin", "size", "axis", "element_size", "cell", "noise"),
     )
-    if "file" in t.raw:
+    if not t.raw:
+        mesh = None  # a mesh of one's own, given to build_simulation
+    elif "file" in t.raw:
         if "shape" in t.raw:
             t.fail("mesh", "give either 'shape' or 'file', not both")
         file = t.get("file")

@@ -1,0 +1,43 @@
+"""Every demo runs, at a coarse resolution, with a closed energy balance and its pictures."""
+
+import json
+import runpy
+from pathlib import Path
+
+import pytest
+from mpi4py import MPI
+
+from rwall_fem import build_simulation, load_scene
+
+DEMOS = Path(__file__).resolve().parent.parent / "demos"
+COARSE = {  # scene -> overrides that keep it to a few seconds
+    "bar_impact": ["mesh.element_size=0.005", "run.end_time=3e-5"],
+    "moving_wall_crush": ["mesh.element_size=0.005", "run.end_time=1e-4"],
+    "friction_slide": ["mesh.element_size=0.01", "run.end_time=0.1"],
+}
+
+
+def test_every_scene_has_a_coarse_setting():
+    assert sorted(p.stem for p in DEMOS.glob("*.toml")) == sorted(COARSE)
+
+
+@pytest.mark.parametrize("name", sorted(COARSE))
+def test_demo_scene(name, shared_dir):
+    scene = load_scene(DEMOS / f"{name}.toml", [*COARSE[name], "output.frames=2"])
+    sim = build_simulation(scene, MPI.COMM_WORLD, shared_dir)
+    assert sim.run() == "done"
+    assert sim.history.summary["energy"]["max_balance_error"] < 1e-8
+    if MPI.COMM_WORLD.rank == 0:
+        out = Path(shared_dir)
+        assert len(list((out / "frames").glob("frame_*.png"))) == 2
+        assert (out / "animation.gif").is_file() and (out / "histories.png").is_file()
+
+
+def test_python_demo(shared_dir, monkeypatch):
+    monkeypatch.chdir(shared_dir)
+    runpy.run_path(str(DEMOS / "demo_bar_impact.py"), run_name="__main__")
+    if MPI.COMM_WORLD.rank == 0:
+        out = Path(shared_dir) / "results" / "demo_bar_impact"
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["energy"]["max_balance_error"] < 1e-10
+        assert len(list((out / "frames").glob("frame_*.png"))) == 12
