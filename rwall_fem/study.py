@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -387,7 +388,7 @@ def summarise(rows, cases, target: float = 0.01) -> str:
                 f"{one[0]:.3g} s ({one[2]})"
             )
             if half is not None:
-                text += f"; halving it costs {half[0] / one[0]:.3g}x the time"
+                text += f"; halving it costs {half[0] / one[0]:.3g}x the time ({half[2]})"
             text += f" (error ~ time^{slope:.2f} over the runs)."
             lines.append(text)
             if best is None or one[0] < best[1]:
@@ -475,7 +476,7 @@ def plot(rows, case: Case, path: Path) -> None:
     plt.close(fig)
 
 
-def write_outputs(rows, cases, out: Path, seconds: float) -> None:
+def write_outputs(rows, cases, out: Path, seconds: float, load=None) -> None:
     """study.csv, study.md (summary + tables), summary.md, study_<case>.png (rank 0 only)."""
     out.mkdir(parents=True, exist_ok=True)
     columns = list(dict.fromkeys(k for r in rows for k in r))
@@ -485,7 +486,11 @@ def write_outputs(rows, cases, out: Path, seconds: float) -> None:
         writer.writerows(rows)
     summary = summarise(rows, cases)
     (out / "summary.md").write_text(summary)
-    parts = [summary, f"The whole study took {seconds:.0f} s (set-up included).", ""]
+    took = f"The whole study took {seconds:.0f} s (set-up included) on {os.cpu_count()} cores"
+    if load is not None:
+        # Timings are only as good as the machine was quiet: say how busy it was.
+        took += f"; 1-minute load average {load[0]:.2f} before, {load[1]:.2f} after"
+    parts = [summary, took + ".", ""]
     for case in cases:
         plot(rows, case, out / f"study_{case.name}.png")
         parts += [
@@ -515,6 +520,7 @@ def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
     cases = [CASES[name] for name in (cases or CASES)]
     repeat_below, max_repeats = (0.3, 2) if quick else (1.0, 3)
     started = time.perf_counter()
+    load = [os.getloadavg()[0]]
     rows = []
     for case in cases:
         for cell in CELLS:
@@ -536,7 +542,8 @@ def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
                             flush=True,
                         )
     seconds = comm.allreduce(time.perf_counter() - started, op=MPI.MAX)
+    load.append(os.getloadavg()[0])
     if comm.rank == 0:
-        write_outputs(rows, cases, out, seconds)
+        write_outputs(rows, cases, out, seconds, load)
     comm.Barrier()
     return rows
