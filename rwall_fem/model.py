@@ -82,10 +82,18 @@ def build_simulation(
     if spec is not None and spec.noise is not None:
         perturb(body, *spec.noise)
     msh = body.msh
+    cell = msh.topology.cell_type.name
+    if cell not in ("tetrahedron", "hexahedron"):
+        raise SceneError(
+            f"{scene.source}: mesh: {cell} cells; allowed: tetrahedra or hexahedra (a volume)"
+        )
     V = _compat.vector_space(msh)
     owned = V.dofmap.index_map.size_local
     X = V.tabulate_dof_coordinates()[:owned].copy()
-    mass = lumped_mass(V, scene.material.density)
+    try:
+        mass = lumped_mass(V, scene.material.density)
+    except ValueError as err:
+        raise SceneError(f"{scene.source}: mesh: {err}") from None
     K = stiffness_matrix(V, scene.material)  # small strain: also the tangent at u = 0
 
     dt_stable = critical_time_step(K, mass, X)

@@ -267,3 +267,25 @@ def test_render_draws_a_results_folder_again(tmp_path):
     assert len(list((tmp_path / "out" / "frames").glob("frame_*.png"))) == 3
     missing = _cli("render", "nowhere", cwd=tmp_path)
     assert missing.returncode == 2 and "no frame data" in missing.stderr
+
+
+@serial_only
+def test_a_surface_mesh_is_refused(tmp_path):
+    import gmsh
+
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.occ.addRectangle(0, 0, 0, 0.01, 0.01)
+    gmsh.model.occ.synchronize()
+    gmsh.model.addPhysicalGroup(2, [1])
+    gmsh.model.mesh.generate(2)
+    gmsh.write(str(tmp_path / "square.msh"))
+    gmsh.finalize()
+    scene = SCENE.replace(
+        '[mesh]\nshape = "bar"\nsize = [0.004, 0.004, 0.02]\nelement_size = 0.002',
+        '[mesh]\nfile = "square.msh"',
+    )
+    (tmp_path / "scene.toml").write_text(scene)
+    result = _cli("run", "scene.toml", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "mesh: triangle cells; allowed: tetrahedra or hexahedra" in result.stderr
