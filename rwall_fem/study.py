@@ -95,7 +95,11 @@ def _bar(h, cell, material, end_time, dt_scale, c_p):
             "cell": cell,
         },
         "material": dict(material),
-        "output": {"frames": 0, "history_interval": _history_interval(end_time, h, dt_scale, c_p)},
+        "output": {
+            "frames": 0,
+            "plot": False,  # no histories.png per run: the study draws its own plots
+            "history_interval": _history_interval(end_time, h, dt_scale, c_p),
+        },
     }
 
 
@@ -192,6 +196,7 @@ def friction_scene(h: float, cell: str, dt_scale: float) -> dict:
         ],
         "output": {
             "frames": 0,
+            "plot": False,
             "history_interval": _history_interval(BELT_END, h, dt_scale, _soft_c_p()),
         },
     }
