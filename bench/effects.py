@@ -1,0 +1,80 @@
+"""Per-step cost with and without each effect: `python bench/effects.py` -> bench/effects.md.
+
+One scene (a soft block of 4,096 hexahedra resting on a plane), run with one effect
+switched on at a time; the figure is the median over 3 runs of the time loop's wall
+time per step (start-up excluded). What a scene does not ask for is not in its
+pipeline, so the base line is what every scene pays.
+"""
+
+import copy
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+from mpi4py import MPI
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from rwall_fem import build_simulation, parse_scene  # noqa: E402
+
+BASE = {
+    "run": {"end_time": 0.02},
+    "mesh": {"shape": "bar", "size": [0.016, 0.016, 0.016], "element_size": 0.001},
+    "material": {"model": "linear_elastic", "density": 1000.0, "young": 1e6, "poisson": 0.3},
+    "initial": {"velocity": [0.0, 0.0, -0.1]},
+    "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1]}],
+    "output": {"frames": 0, "history_interval": 100, "plot": False},
+}
+VARIANTS = {
+    "base: linear elastic, fixed plane, free sliding": {},
+    "+ gravity": {"gravity": {"acceleration": [0, 0, -9.81]}},
+    "+ Coulomb friction": {"wall.0": {"slide": "friction", "friction": 0.3}},
+    "+ friction filter": {"wall.0": {"slide": "friction", "friction": 0.3,
+                                     "friction_filter": {"steps": 20}}},
+    "+ main-node wall (moving)": {"wall.0": {"motion": {"mass": 1.0, "velocity": [0, 0, 0.1]}}},
+    "+ history every step": {"output": {"history_interval": 1}},
+    "+ fields (10 snapshots)": {"output": {"fields": 10}},
+    "large deformation (neo-Hookean)": {"material": {"model": "neo_hookean"}},
+}
+
+
+def scene(changes):
+    raw = copy.deepcopy(BASE)
+    for key, value in changes.items():
+        if key.startswith("wall."):
+            raw["wall"][int(key.split(".")[1])] |= value
+        else:
+            raw[key] = raw.get(key, {}) | value
+    return parse_scene(raw, source="bench")
+
+
+def main():
+    comm = MPI.COMM_WORLD
+    rows = []
+    with tempfile.TemporaryDirectory() as out:
+        out = comm.bcast(out, root=0)
+        for name, changes in VARIANTS.items():
+            times = []
+            for _ in range(3):
+                sim = build_simulation(scene(changes), comm, out)
+                sim.run()
+                times.append(sim.wall_seconds / (sim.num_steps + 1))
+            rows.append((name, sim.history.info["cells"], sim.num_steps, statistics.median(times)))
+    if comm.rank == 0:
+        base = rows[0][3]
+        lines = [
+            "# Per-step cost of each effect",
+            "",
+            f"`python bench/effects.py` on {comm.size} rank(s); {rows[0][1]} hexahedra, "
+            f"{rows[0][2]} steps, median of 3 runs of the time loop.",
+            "",
+            "| scene | ms / step | x base |",
+            "|---|---|---|",
+        ]
+        lines += [f"| {n} | {t * 1e3:.3f} | {t / base:.2f} |" for n, _, _, t in rows]
+        Path(__file__).with_name("effects.md").write_text("\n".join(lines) + "\n")
+        print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
