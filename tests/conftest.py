@@ -16,6 +16,29 @@ from rwall_fem.history import WALL_COLUMNS
 
 COLUMN = {name: i for i, name in enumerate(WALL_COLUMNS)}  # columns of walls.csv
 
+# A small scene file for the command-line tests: a steel bar onto a fixed plane.
+SCENE = """
+[run]
+end_time = 2e-5
+[mesh]
+shape = "bar"
+size = [0.004, 0.004, 0.02]
+element_size = 0.002
+[material]
+model = "linear_elastic"
+density = 7850.0
+young = 210e9
+poisson = 0.3
+[initial]
+velocity = [0.0, 0.0, -5.0]
+[[wall]]
+kind = "plane"
+point = [0.0, 0.0, 0.0]
+normal_point = [0.0, 0.0, 1.0]
+[output]
+frames = 3
+"""
+
 STEEL_NU0 = {"model": "linear_elastic", "density": 7850.0, "young": 210.0e9, "poisson": 0.0}
 
 

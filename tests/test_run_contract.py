@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import bar_scene, run
+from conftest import SCENE, bar_scene, run
 from mpi4py import MPI
 
 from rwall_fem import SceneError, parse_scene
@@ -17,27 +17,6 @@ from rwall_fem.history import WALL_COLUMNS
 serial_only = pytest.mark.skipif(
     MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
 )
-SCENE = """
-[run]
-end_time = 2e-5
-[mesh]
-shape = "bar"
-size = [0.004, 0.004, 0.02]
-element_size = 0.002
-[material]
-model = "linear_elastic"
-density = 7850.0
-young = 210e9
-poisson = 0.3
-[initial]
-velocity = [0.0, 0.0, -5.0]
-[[wall]]
-kind = "plane"
-point = [0.0, 0.0, 0.0]
-normal_point = [0.0, 0.0, 1.0]
-[output]
-frames = 3
-"""
 
 
 def test_outputs_of_a_run(shared_dir):
