@@ -14,6 +14,14 @@ from mpi4py import MPI
 from rwall_fem.study import CASES, cost_at, run_study
 
 
+# The study measures wall time against accuracy on one rank; its runs are the same scenes
+# that the rest of the suite runs on 2 ranks. Running it twice would double the suite's
+# longest test for nothing new.
+pytestmark = pytest.mark.skipif(
+    MPI.COMM_WORLD.size > 1, reason="the accuracy study is a one-rank measurement"
+)
+
+
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     """One quick study for the whole module, in a directory every rank sees."""
