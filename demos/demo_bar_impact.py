@@ -11,7 +11,7 @@
 # Run it with `python demos/demo_bar_impact.py` (or under `mpirun -n 2`).
 
 # +
-from pathlib import Path
+from pathlib import Path  # noqa: I001  (rwall_fem must come before dolfinx, see below)
 
 import numpy as np
 from mpi4py import MPI

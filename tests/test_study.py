@@ -13,7 +13,6 @@ from mpi4py import MPI
 
 from rwall_fem.study import CASES, cost_at, run_study
 
-
 # The study measures wall time against accuracy on one rank; its runs are the same scenes
 # that the rest of the suite runs on 2 ranks. Running it twice would double the suite's
 # longest test for nothing new.
