@@ -107,6 +107,8 @@ def _run(scene_file, out, overrides, comm, quiet: bool) -> dict:
 def _check(scene_file, overrides, comm) -> int:
     """Build everything a run needs (mesh, mass, stiffness, stable step, effects) and print
     it, with the wall time estimated from the cost of the internal force."""
+    from mpi4py import MPI
+
     from rwall_fem.model import build_simulation
     from rwall_fem.scene import load_scene
 
@@ -115,7 +117,7 @@ def _check(scene_file, overrides, comm) -> int:
     started = time.perf_counter()
     for _ in range(5):
         sim.internal.accelerate(sim.state)
-    per_step = comm.allreduce(time.perf_counter() - started, op=_max()) / 5
+    per_step = comm.allreduce(time.perf_counter() - started, op=MPI.MAX) / 5
     info = sim.history.info
     walls = [comm.allreduce(len(w.nodes)) for w in sim.constraints]
     if comm.rank == 0:
@@ -153,9 +155,3 @@ def _render(directory: str, color: str) -> int:
     files = render_frames(directory, color)
     print(f"rwall-fem: {len(files)} frames and animation.gif in {directory}")
     return 0
-
-
-def _max():
-    from mpi4py import MPI
-
-    return MPI.MAX
