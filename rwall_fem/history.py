@@ -9,7 +9,8 @@ exactly (see ``../shared/notes/numerics.md``):
 - the work of every other force g (body forces, walls) is booked at mid-step
   velocities, 1/2 g^n . (v^{n-1/2} + v^{n+1/2}) dt; the wall work is that of
   the contact impulses relative to the wall (normal stop and friction), the
-  driving work of prescribed walls counts as external work;
+  driving work of prescribed walls and the reactions of velocity boundary
+  conditions count as external work;
 - the balance error is (K + U - W_ext - W_wall - E0) / E_ref with E0 the
   initial energy (kinetic, walls included) and E_ref the largest of E0, K + U,
   |W_ext| and |W_wall| so far (a body dropped from rest starts with E0 = 0).
@@ -68,12 +69,14 @@ class History:
         max_energy_error: float = 0.05,
         min_dt: float = 0.0,
         plot: bool = False,
+        boundaries=(),
     ):
         self.plot = plot  # draw histories.png at the end
         self.every, self.num_steps = every, num_steps
         self.node_ids = node_ids  # global index of each owned node, for messages
         self.max_energy_error, self.min_dt = max_energy_error, min_dt
         self.comm, self.info, self.walls = comm, info, walls
+        self.boundaries = boundaries  # velocity boundary conditions: their reactions' work
         self.directory = Path(directory)
         m = state.mass[:, None]
         moving = [w.motion for w in walls if w.motion.dynamic]
@@ -108,7 +111,11 @@ class History:
         """Sample step ``s.step``: needs ``v^{n-1/2}`` and ``a^n`` (before the update)."""
         kinetic = 0.5 * float(np.sum(s.mass[:, None] * s.v * (s.v + s.dt * s.a)))
         local = [kinetic, sim.internal.strain_energy(s)]
-        local.append(sum(f.work(s) for f in sim.forces) + sum(w.driving_work for w in self.walls))
+        local.append(
+            sum(f.work(s) for f in sim.forces)
+            + sum(w.driving_work for w in self.walls)
+            + sum(b.work for b in self.boundaries)
+        )
         local.append(float(sim.terminate_requested))
         for w in self.walls:
             local += [*w.normal_impulse, *w.tangential_impulse, w.contacts]
@@ -242,6 +249,15 @@ class History:
                 "max_balance_error": self.max_balance_error,
             },
             "walls": walls,
+            "boundaries": [
+                {
+                    "name": b.name,
+                    "nodes": comm.allreduce(len(b.nodes)),
+                    "reaction_impulse": comm.allreduce(b.impulse).tolist(),
+                    "work": comm.allreduce(b.work),
+                }
+                for b in self.boundaries
+            ],
         }
         self.summary = summary
         if comm.rank == 0:

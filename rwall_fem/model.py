@@ -14,6 +14,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rwall_fem import _compat
+from rwall_fem.boundary import VelocityBoundary
 from rwall_fem.effects import Gravity
 from rwall_fem.history import History
 from rwall_fem.mechanics import (
@@ -122,6 +123,7 @@ def build_simulation(
     state.v[:] = scene.initial.velocity
     forces = [] if scene.gravity is None else [Gravity(scene.gravity, state)]
     walls = [_wall(scene, i, V, body, state, comm) for i in range(len(scene.walls))]
+    boundaries = [_boundary(scene, i, V, body, owned) for i in range(len(scene.boundaries))]
     monitors = []
     if scene.material.model == "linear_elastic":
         internal = LinearElasticForce(K, state)
@@ -136,7 +138,7 @@ def build_simulation(
         end_time=scene.run.end_time,
         internal=internal,
         forces=forces,
-        constraints=walls,
+        constraints=[*walls, *boundaries],  # clamps last: they win over walls
     )
     info = {
         "scene": scene.source,
@@ -160,6 +162,7 @@ def build_simulation(
         max_energy_error=scene.run.max_energy_error,
         min_dt=scene.run.min_dt,
         plot=scene.output.plot,
+        boundaries=boundaries,
     )
     sim.recorders += [sim.history, *monitors]
     if scene.output.fields:
@@ -230,6 +233,19 @@ def _wall(scene: Scene, i: int, V, body, state: State, comm: MPI.Comm) -> RigidW
         motion=motion,
         comm=comm,
     )
+
+
+def _boundary(scene: Scene, i: int, V, body, owned: int) -> VelocityBoundary:
+    """Boundary condition ``i`` of the scene on the owned nodes of its named group."""
+    spec = scene.boundaries[i]
+    if spec.group not in body.groups:
+        known = ", ".join(sorted(body.groups)) or "none"
+        raise SceneError(
+            f"{scene.source}: boundary[{i}].group: unknown node set {spec.group!r}; "
+            f"the mesh has: {known}"
+        )
+    nodes = _owned(group_nodes(V, body, spec.group), owned)
+    return VelocityBoundary(f"boundary[{i}]", nodes, spec.velocity, spec.components)
 
 
 def _secondary_nodes(spec: WallSpec, where: str, shape, V, body, state: State) -> np.ndarray:

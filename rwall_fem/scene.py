@@ -123,6 +123,15 @@ class WallSpec:
 
 
 @dataclass(frozen=True)
+class BoundarySpec:
+    """Prescribed velocity (zero: a clamp) of some components of a named node set."""
+
+    group: str  # a named physical group of the mesh
+    velocity: tuple = (0.0, 0.0, 0.0)  # m/s: [vx, vy, vz], or rows (t, vx, vy, vz)
+    components: str = "xyz"  # the global components prescribed; the others stay free
+
+
+@dataclass(frozen=True)
 class Output:
     directory: Path = Path("results")
     frames: int = 0  # number of PNG frames over the run; 0: no pictures
@@ -142,6 +151,7 @@ class Scene:
     walls: tuple[WallSpec, ...] = ()
     output: Output = field(default_factory=Output)
     gravity: tuple[float, float, float] | None = None  # m/s^2
+    boundaries: tuple[BoundarySpec, ...] = ()
 
 
 # --- reading -----------------------------------------------------------------
@@ -287,7 +297,10 @@ class _Table:
 def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> Scene:
     """Validate the raw TOML mapping ``raw`` into a :class:`Scene`."""
     top = _Table(
-        raw, "", source, ("run", "mesh", "material", "initial", "gravity", "wall", "output")
+        raw,
+        "",
+        source,
+        ("run", "mesh", "material", "initial", "gravity", "boundary", "wall", "output"),
     )
 
     t = _Table(
@@ -357,6 +370,11 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         top.fail("wall", "must be an array of tables: write [[wall]]")
     walls = tuple(_wall(w, f"wall[{i}]", source) for i, w in enumerate(walls_raw))
 
+    boundaries_raw = top.get("boundary", [])
+    if not isinstance(boundaries_raw, list):
+        top.fail("boundary", "must be an array of tables: write [[boundary]]")
+    boundaries = tuple(_boundary(b, f"boundary[{i}]", source) for i, b in enumerate(boundaries_raw))
+
     t = _Table(
         top.get("output", {}),
         "output",
@@ -374,7 +392,28 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         color=t.choice("color", ("normal_velocity", "speed", "displacement"), "normal_velocity"),
         plot=t.choice("plot", (True, False), True),
     )
-    return Scene(source, run, mesh, material, initial, walls, output, gravity)
+    return Scene(source, run, mesh, material, initial, walls, output, gravity, boundaries)
+
+
+def _boundary(raw, path: str, source: str) -> BoundarySpec:
+    t = _Table(raw, path, source, ("group", "velocity", "components"))
+    group = t.get("group")
+    if not isinstance(group, str):
+        t.fail(t.key("group"), f"must be the name of a node set, got {group!r}")
+    velocity = t.get("velocity", [0.0, 0.0, 0.0])
+    if isinstance(velocity, list) and velocity and isinstance(velocity[0], list):
+        velocity = _velocity_table(t)
+    else:
+        velocity = t.vector("velocity", (0.0, 0.0, 0.0))
+    components = t.get("components", "xyz")
+    if (
+        not isinstance(components, str)
+        or not components
+        or any(c not in "xyz" for c in components)
+        or len(set(components)) != len(components)
+    ):
+        t.fail(t.key("components"), f"must be some of the letters x, y, z once, got {components!r}")
+    return BoundarySpec(group, velocity, "".join(sorted(components)))
 
 
 def _positive_vector(t: _Table, name: str):

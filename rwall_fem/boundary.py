@@ -1,0 +1,50 @@
+"""Velocity boundary conditions on named node sets (clamps, driven edges).
+
+LS-DYNA's ``*BOUNDARY_SPC`` / ``*BOUNDARY_PRESCRIBED_MOTION_SET`` and Radioss
+``/BCS`` / ``/IMPVEL`` in one: the chosen global components of the velocity of
+a set of nodes follow a history (zero: clamped). Applied after the walls, so a
+clamp wins over a wall on a node both act on.
+
+The reaction is the impulse that sets the step's velocity, m (v_p - v_pred);
+its work is booked at mid-step velocities like every other force (see
+:mod:`rwall_fem.history`): the half with v^{n-1/2} at step n, the half with
+v^{n+1/2} = v_p at the next step, so the balance closes exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rwall_fem.walls.motion import PrescribedMotion
+
+__all__ = ["VelocityBoundary"]
+
+
+class VelocityBoundary:
+    """Prescribed velocity of some components of the nodes ``nodes`` (local indices).
+
+    ``velocity`` is [vx, vy, vz] (m/s) or rows [t, vx, vy, vz] (s, m/s) interpolated
+    linearly; ``components`` (a subset of "xyz") are the global directions prescribed,
+    the others stay free.
+    """
+
+    def __init__(self, name: str, nodes: np.ndarray, velocity, components: str = "xyz"):
+        self.name = name
+        self.nodes = np.asarray(nodes, dtype=np.int32)
+        self.history = PrescribedMotion(velocity)
+        self.axes = np.array(["xyz".index(c) for c in components])
+        self.impulse = np.zeros(3)  # reaction on this rank's nodes so far, N s
+        self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
+        self._pending = 0.0  # the v^{n+1/2} half of the latest step's work, J
+
+    def constrain(self, state) -> None:
+        """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n + dt/2)."""
+        rows, cols = self.nodes[:, None], self.axes[None, :]
+        target = self.history.predict(state.t, state.dt)[self.axes]
+        v_old = state.v[rows, cols]
+        m = state.mass[self.nodes][:, None]
+        reaction = m * (target - v_old - state.dt * state.a[rows, cols])  # N s
+        state.a[rows, cols] = (target - v_old) / state.dt
+        self.work += self._pending + 0.5 * float(np.sum(reaction * v_old))
+        self._pending = 0.5 * float(np.sum(reaction * target))
+        self.impulse[self.axes] += reaction.sum(axis=0)
