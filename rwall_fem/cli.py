@@ -64,6 +64,8 @@ def main(argv: list[str] | None = None) -> int:
     quiet = getattr(args, "quiet", False)
     logging.getLogger().setLevel(logging.WARNING)  # the form compiler logs at INFO
     log = logging.getLogger("rwall_fem")
+    for old in list(log.handlers):  # main() may run more than once in a process (tests)
+        log.removeHandler(old)
     handler = logging.StreamHandler(sys.stdout)
     handler.setFormatter(logging.Formatter("rwall-fem: %(message)s"))
     log.addHandler(handler)
@@ -119,7 +121,8 @@ def _check(scene_file, overrides, comm) -> int:
         sim.internal.accelerate(sim.state)
     per_step = comm.allreduce(time.perf_counter() - started, op=MPI.MAX) / 5
     info = sim.history.info
-    walls = [comm.allreduce(len(w.nodes)) for w in sim.constraints]
+    walls = [comm.allreduce(len(w.nodes)) for w in sim.history.walls]
+    boundaries = [comm.allreduce(len(b.nodes)) for b in sim.history.boundaries]
     if comm.rank == 0:
         print(f"rwall-fem: scene {scene_file} is valid")
         print(
@@ -132,8 +135,10 @@ def _check(scene_file, overrides, comm) -> int:
             f"{sim.num_steps} steps to {sim.num_steps * sim.state.dt:.4g} s"
         )
         print(f"  effects: {', '.join(sim.effects)}")
-        for w, count in zip(sim.constraints, walls, strict=True):
+        for w, count in zip(sim.history.walls, walls, strict=True):
             print(f"  {w.name}: {w.shape.kind}, slide {w.slide}, {count} secondary nodes")
+        for b, count in zip(sim.history.boundaries, boundaries, strict=True):
+            print(f"  {b.name}: {count} nodes, components {''.join('xyz'[i] for i in b.axes)}")
         print(
             f"  estimated wall time: {1.2 * per_step * (sim.num_steps + 1):.3g} s "
             f"(internal force {per_step * 1e3:.3g} ms per step, + 20 % for the rest)"
