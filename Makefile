@@ -125,9 +125,9 @@ $(VENV)/pyvenv.cfg: | apt-0.5
 
 # numpy is pinned to Debian's: a newer numpy from PyPI breaks Debian's petsc4py (ABI).
 $(VENV)/.installed: pyproject.toml $(VENV)/pyvenv.cfg | apt-0.5
-	@echo ">>> pip install -e '.[test]' into $(VENV)"
+	@echo ">>> pip install -e '.[test,mp4]' into $(VENV)"
 	echo "numpy==$$($(SYS_PYTHON) -c 'import numpy; print(numpy.__version__)')" > $(VENV)/constraints.txt
-	$(call PIP_INSTALL,0.5,$(VENV)) -c $(VENV)/constraints.txt -e '.[test]'
+	$(call PIP_INSTALL,0.5,$(VENV)) -c $(VENV)/constraints.txt -e '.[test,mp4]'
 	touch $@
 
 venv-0.5: $(VENV)/.installed
@@ -158,8 +158,8 @@ $(VENV011)/pyvenv.cfg: | apt-0.11
 	$(PY011) -m venv $(VENV011)
 
 $(VENV011)/.installed: pyproject.toml $(VENV011)/pyvenv.cfg | apt-0.11
-	@echo ">>> pip install $(WHEEL_0.11) -e '.[test]' into $(VENV011)"
-	$(call PIP_INSTALL,0.11,$(VENV011)) $(WHEEL_0.11) -e '.[test]'
+	@echo ">>> pip install $(WHEEL_0.11) -e '.[test,mp4]' into $(VENV011)"
+	$(call PIP_INSTALL,0.11,$(VENV011)) $(WHEEL_0.11) -e '.[test,mp4]'
 	touch $@
 
 venv-0.11: $(VENV011)/.installed

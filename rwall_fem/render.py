@@ -2,8 +2,10 @@
 
 Reads the frame data that :class:`rwall_fem.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
-``DIR/animation.gif``. The body is drawn on its deformed geometry, coloured
-by the velocity component along the first wall's normal, with the walls.
+``DIR/animation.gif``, and ``DIR/animation.mp4`` when the ``imageio-ffmpeg``
+encoder is installed (``pip install rwall_fem[mp4]``). The body is drawn on
+its deformed geometry, coloured by the velocity component along the first
+wall's normal, with the walls.
 The camera and the colour range are fixed once for all frames. This module
 must not import DOLFINx (see :mod:`rwall_fem.frames`).
 """
@@ -80,7 +82,17 @@ def render_frames(directory: str | Path, colour: str = "normal_velocity") -> lis
     if files:
         images = [imageio.imread(p) for p in files]
         imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
+        if _has_mp4_encoder():
+            imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
     return files
+
+
+def _has_mp4_encoder() -> bool:
+    try:
+        import imageio_ffmpeg  # noqa: F401  (imageio's ffmpeg plugin runs its binary)
+    except ImportError:
+        return False
+    return True
 
 
 def _colour_label(colour: str, walls) -> str:

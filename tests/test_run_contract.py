@@ -1,6 +1,7 @@
 """The run contract: outputs, the command line, and refusals of bad input."""
 
 import csv
+import importlib.util
 import json
 import os
 import subprocess
@@ -70,6 +71,8 @@ def test_outputs_of_a_run(shared_dir):
         frames = sorted((out / "frames").glob("frame_*.png"))
         assert len(frames) == 3
         assert (out / "animation.gif").stat().st_size > 0
+        if importlib.util.find_spec("imageio_ffmpeg"):  # `make test` installs it (extra mp4)
+            assert (out / "animation.mp4").stat().st_size > 0
         assert (out / "histories.png").stat().st_size > 0
         xdmf = (out / "fields.xdmf").read_text()
         for name in ("displacement", "velocity", "von_mises_stress"):
