@@ -5,6 +5,7 @@
 #   make test DOLFINX=0.11     only the PyPI leg:    dolfinx-solver-real 0.11 + MPICH, venv .venv-0.11
 #   make venv                  set-up only (honours DOLFINX too)
 #   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
+#   make demos                 run every demo (scenes and Python scripts) into results/
 #   make study / make bench    accuracy vs wall time (results/study, copied to docs/); throughput
 #                              benchmark (bench/results.md); both on the Debian leg, long runs
 #   make clean                 remove both venvs, test logs and Python caches (results/ is kept)
@@ -102,7 +103,7 @@ ifneq ($(filter 0.11,$(LEGS)),)
   endif
 endif
 
-.PHONY: test venv demo study bench clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
+.PHONY: test venv demo demos study bench clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
         test-0.5 test-0.5-serial test-0.5-mpi test-0.11 test-0.11-serial test-0.11-mpi
 
 test: $(addprefix test-,$(LEGS))
@@ -187,6 +188,14 @@ FORCE:
 # ---- demo and clean ---------------------------------------------------------------------------
 demo: venv-0.5
 	$(RUN_ENV) $(VENV)/bin/rwall-fem run demos/bar_impact.toml --out results/bar_impact
+
+# Every demo at its full resolution, serially (~2 minutes): scenes into results/NAME/, the
+# Python demos write their own results/ folders.
+demos: venv-0.5
+	for scene in demos/*.toml; do \
+	  $(RUN_ENV) $(VENV)/bin/rwall-fem run $$scene --out results/$$(basename $$scene .toml); \
+	done
+	for script in demos/demo_*.py; do $(RUN_ENV) $(VENV)/bin/python $$script; done
 
 # The full study takes 10-20 minutes; its table and plots are copied into docs/ for the README.
 study: venv-0.5

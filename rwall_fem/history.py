@@ -15,8 +15,10 @@ exactly (see ``../shared/notes/numerics.md``):
   initial energy (kinetic, walls included) and E_ref the largest of E0, K + U,
   |W_ext| and |W_wall| so far (a body dropped from rest starts with E0 = 0).
 
-Every row is flushed as it is written, so a run that stops leaves complete
-lines up to its last sample. Rank 0 writes; all ranks take part in the sums.
+Rows are written in whole lines and flushed at least every ``FLUSH_SECONDS``
+of wall time and when the run ends or stops, so a killed run leaves complete
+lines up to its last flush. Rank 0 writes; all ranks take part in one sum per
+sample.
 
 The guards act at every sample, on the summed values, so every rank takes the
 same decision at the same step: non-finite energies (a NaN or Inf in a nodal
@@ -28,6 +30,7 @@ message naming the step, the time, the quantity and the worst node.
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +53,7 @@ WALL_COLUMNS = (
     + [f"velocity_{c}" for c in "xyz"]
 )
 _PER_WALL = 9  # reduced per wall: normal, tangential impulse (3 + 3), contacts, works (2)
+FLUSH_SECONDS = 1.0  # longest wall time between writes of the CSV files, s
 
 
 class History:
@@ -94,6 +98,11 @@ class History:
         self.energy_rows = []  # (t, K, U, W_ext, W_wall, error), as in energy.csv
         self.wall_rows = []  # rows of walls.csv
         self._energy = self._walls = None
+        self._unwritten = [0, 0]  # rows of energy_rows, wall_rows not yet in the files
+        self._written_at = time.monotonic()
+        self._local = np.zeros(4 + _PER_WALL * len(walls))  # what each sample reduces
+        self._total = np.zeros_like(self._local)
+        self._scratch = np.zeros_like(state.v)
 
     def _open(self) -> None:
         """Create the directory and the CSV files (rank 0) when the run starts writing."""
@@ -109,19 +118,23 @@ class History:
 
     def record(self, sim, s) -> None:
         """Sample step ``s.step``: needs ``v^{n-1/2}`` and ``a^n`` (before the update)."""
-        kinetic = 0.5 * float(np.sum(s.mass[:, None] * s.v * (s.v + s.dt * s.a)))
-        local = [kinetic, sim.internal.strain_energy(s)]
-        local.append(
+        ahead = np.multiply(s.a, s.dt, out=self._scratch)
+        ahead += s.v  # v^{n+1/2}
+        local = self._local
+        local[0] = 0.5 * np.einsum("i,ij,ij->", s.mass, s.v, ahead)
+        local[1] = sim.internal.strain_energy(s)
+        local[2] = (
             sum(f.work(s) for f in sim.forces)
             + sum(w.driving_work for w in self.walls)
             + sum(b.work for b in self.boundaries)
         )
-        local.append(float(sim.terminate_requested))
-        for w in self.walls:
-            local += [*w.normal_impulse, *w.tangential_impulse, w.contacts]
-            local += [w.normal_work, w.friction_work]
-        total = self.comm.allreduce(np.array(local))
-        kinetic, internal, external, terminate = total[:4]
+        local[3] = float(sim.terminate_requested)
+        for w, chunk in zip(self.walls, local[4:].reshape(-1, _PER_WALL), strict=True):
+            chunk[:3], chunk[3:6], chunk[6] = w.normal_impulse, w.tangential_impulse, w.contacts
+            chunk[7:] = w.normal_work, w.friction_work
+        total = self._total
+        self.comm.Allreduce(local, total)
+        kinetic, internal, external, terminate = map(float, total[:4])
         per_wall = total[4:].reshape(-1, _PER_WALL)
         wall_work = float(per_wall[:, 7:9].sum())
         for w in self.walls:
@@ -140,7 +153,7 @@ class History:
         self._last_step = s.step
         rows = []
         for i, (w, chunk) in enumerate(zip(self.walls, per_wall, strict=True)):
-            impulses, contacts = chunk[:6], int(chunk[6])
+            impulses, contacts = chunk[:6].copy(), int(chunk[6])
             self.peak_contacts[i] = max(self.peak_contacts[i], contacts)
             forces = (impulses - self._last_impulse[i]) / interval
             self._last_impulse[i] = impulses
@@ -150,15 +163,24 @@ class History:
                  *w.position, *w.motion.velocity)
             )  # fmt: skip
         self.wall_rows += rows
-        if self.comm.rank == 0:
-            if self._energy is None:
-                self._open()
-            self._energy.write(",".join(f"{x:.17g}" for x in row) + "\n")
-            self._energy.flush()
-            if rows:
-                self._walls.writelines(",".join(f"{x:.17g}" for x in r) + "\n" for r in rows)
-                self._walls.flush()
+        if time.monotonic() - self._written_at > FLUSH_SECONDS:
+            self._write()
         self._guard(s, error, terminate, np.isfinite(total).all())
+
+    def _write(self) -> None:
+        """Append the rows not yet written, as whole lines, and flush (rank 0)."""
+        self._written_at = time.monotonic()
+        if self.comm.rank != 0:
+            return
+        if self._energy is None:
+            self._open()
+        start, start_walls = self._unwritten
+        self._unwritten = [len(self.energy_rows), len(self.wall_rows)]
+        self._energy.write("".join(_line(r) for r in self.energy_rows[start:]))
+        self._energy.flush()
+        if self._walls:
+            self._walls.write("".join(_line(r) for r in self.wall_rows[start_walls:]))
+            self._walls.flush()
 
     def _guard(self, s, error: float, terminate: float, finite: bool) -> None:
         """Stop the run (on every rank alike) when a guard trips at this sample."""
@@ -260,9 +282,8 @@ class History:
             ],
         }
         self.summary = summary
+        self._write()
         if comm.rank == 0:
-            if self._energy is None:
-                self._open()
             (self.directory / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
             self._energy.close()
             if self._walls:
@@ -271,6 +292,12 @@ class History:
                 from rwall_fem.plots import plot_histories
 
                 plot_histories(self.directory)
+
+
+def _line(row) -> str:
+    """A CSV line of the numbers in ``row``: integers as such, floats as their shortest
+    exact decimal."""
+    return ",".join(repr(x) if isinstance(x, int) else repr(float(x)) for x in row) + "\n"
 
 
 def _finite_or_none(x: float):
