@@ -17,13 +17,18 @@ from rwall_fem import _compat
 
 __all__ = [
     "BodyMesh",
+    "Refinement",
     "bar_mesh",
+    "body_mesh",
     "boundary_nodes",
     "coordinate_noise",
     "group_nodes",
     "perturb",
+    "plate_mesh",
+    "plate_with_hole_mesh",
     "read_mesh",
     "rotation_to",
+    "round_bar_mesh",
 ]
 
 GEOMETRY_DIR = Path(__file__).resolve().parent.parent / "meshes"
@@ -44,20 +49,143 @@ class BodyMesh:
         return imap.size_global
 
 
+@dataclass(frozen=True)
+class Refinement:
+    """Smaller cells near ``point`` (m, scene coordinates): the element size is ``size`` (m) at
+    the point and grows linearly back to the body's element size over ``radius`` (m).
+
+    A gmsh Threshold field in the body's section, and layers graded by the same law along
+    the sweep of the bars (``meshes/refine.geo``).
+    """
+
+    point: tuple[float, float, float]
+    size: float
+    radius: float
+
+
+def body_mesh(comm: MPI.Comm, spec) -> BodyMesh:
+    """The body a scene's ``[mesh]`` table (a :class:`~rwall_fem.scene.MeshSpec`) describes."""
+    if spec.file is not None:
+        return read_mesh(comm, spec.file)
+    common = {"element_size": spec.element_size, "cell": spec.cell, "axis": spec.axis}
+    if spec.refine_point is not None:
+        common["refine"] = Refinement(spec.refine_point, spec.refine_size, spec.refine_radius)
+    if spec.shape == "bar":
+        return bar_mesh(comm, spec.origin, spec.size, **common)
+    if spec.shape == "round_bar":
+        return round_bar_mesh(comm, spec.origin, spec.radius, spec.length, **common)
+    if spec.shape == "plate":
+        return plate_mesh(comm, spec.origin, spec.size, layers=spec.layers, **common)
+    if spec.shape == "plate_with_hole":
+        return plate_with_hole_mesh(
+            comm,
+            spec.origin,
+            spec.size,
+            spec.hole_radius,
+            hole_offset=spec.hole_offset,
+            layers=spec.layers,
+            **common,
+        )
+    raise ValueError(f"unknown mesh shape {spec.shape!r}")
+
+
 def bar_mesh(
-    comm: MPI.Comm, origin, size, element_size: float, cell: str, axis=(0.0, 0.0, 1.0)
+    comm: MPI.Comm,
+    origin,
+    size,
+    element_size: float,
+    cell: str,
+    axis=(0.0, 0.0, 1.0),
+    refine: Refinement | None = None,
 ) -> BodyMesh:
     """Rectangular bar ``meshes/bar.geo``: the box ``origin`` + [0, size] (m), turned about
     ``origin`` so that its own z axis points along ``axis``.
 
     ``cell`` is "hexahedron" or "tetrahedron"; layers are at most ``element_size`` (m) thick.
+    Structured unless ``refine`` is given (then an unstructured section swept in graded layers).
     """
-    params = dict(zip(("x0", "y0", "z0"), origin, strict=True))
-    params |= dict(zip(("lx", "ly", "lz"), size, strict=True))
-    params |= {"h": element_size, "hexahedra": int(cell == "hexahedron")}
-    body = read_mesh(comm, GEOMETRY_DIR / "bar.geo", params)
+    params = dict(zip(("lx", "ly", "lz"), size, strict=True))
+    return _swept_body(comm, "bar.geo", params, origin, axis, element_size, cell, refine)
+
+
+def round_bar_mesh(
+    comm: MPI.Comm,
+    origin,
+    radius: float,
+    length: float,
+    element_size: float,
+    cell: str,
+    axis=(0.0, 0.0, 1.0),
+    refine: Refinement | None = None,
+) -> BodyMesh:
+    """Cylinder ``meshes/round_bar.geo`` of ``radius`` and ``length`` (m): its own z axis from
+    ``origin`` (the centre of its bottom face) turned onto ``axis``.
+
+    The disc is meshed at ``element_size`` (quadrangles or triangles) and swept along the
+    axis in layers at most ``element_size`` thick: hexahedra, or prisms split into tetrahedra.
+    """
+    params = {"radius": radius, "length": length}
+    return _swept_body(comm, "round_bar.geo", params, origin, axis, element_size, cell, refine)
+
+
+def plate_mesh(
+    comm: MPI.Comm,
+    origin,
+    size,
+    element_size: float,
+    cell: str,
+    axis=(0.0, 0.0, 1.0),
+    layers: int = 0,
+    refine: Refinement | None = None,
+) -> BodyMesh:
+    """Plate ``meshes/plate.geo``: the box ``origin`` + [0, size] (m) with the thickness
+    ``size[2]`` along its own z, turned about ``origin`` so that its own z points along ``axis``.
+
+    ``layers`` elements through the thickness (0: the fewest at most ``element_size`` thick).
+    """
+    params = dict(zip(("lx", "ly", "thickness"), size, strict=True)) | {"layers": layers}
+    return _swept_body(comm, "plate.geo", params, origin, axis, element_size, cell, refine)
+
+
+def plate_with_hole_mesh(
+    comm: MPI.Comm,
+    origin,
+    size,
+    hole_radius: float,
+    element_size: float,
+    cell: str,
+    axis=(0.0, 0.0, 1.0),
+    hole_offset=(0.0, 0.0),
+    layers: int = 0,
+    refine: Refinement | None = None,
+) -> BodyMesh:
+    """:func:`plate_mesh` with a circular through-hole (``meshes/plate_with_hole.geo``) of
+    ``hole_radius`` (m), its centre ``hole_offset`` (m, own x and y) from the plate's centre.
+
+    The faces of the hole are the group ``hole``.
+    """
+    params = dict(zip(("lx", "ly", "thickness"), size, strict=True))
+    params |= {"hole_radius": hole_radius, "layers": layers}
+    params |= dict(zip(("hole_dx", "hole_dy"), hole_offset, strict=True))
+    return _swept_body(
+        comm, "plate_with_hole.geo", params, origin, axis, element_size, cell, refine
+    )
+
+
+def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine) -> BodyMesh:
+    """Mesh ``meshes/<geo>`` in the body's own frame and turn it about ``origin`` onto ``axis``."""
+    origin = np.asarray(origin, dtype=float)
+    R = rotation_to(axis)
+    params = dict(params) | dict(zip(("x0", "y0", "z0"), origin, strict=True))
+    params |= {"h": element_size, "hexahedra": int(cell == "hexahedron"), "refine_size": 0}
+    if refine is not None:
+        # The .geo works in the body's own frame: take the point back there.
+        own = (np.asarray(refine.point, dtype=float) - origin) @ R + origin
+        params |= dict(zip(("refine_x", "refine_y", "refine_z"), own, strict=True))
+        params |= {"refine_size": refine.size, "refine_radius": refine.radius}
+    body = read_mesh(comm, GEOMETRY_DIR / geo, params)
     x = body.msh.geometry.x
-    x[:] = (x - origin) @ rotation_to(axis).T + origin
+    x[:] = (x - origin) @ R.T + origin
     return body
 
 
@@ -76,13 +204,16 @@ def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = 
     """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``."""
     import gmsh
 
-    groups = None
+    groups, error = None, None
     if comm.rank == 0:
         argv = [""]
         for name, value in (parameters or {}).items():
             argv += ["-setnumber", name, repr(float(value))]
         gmsh.initialize(argv)
         gmsh.option.setNumber("General.Terminal", 0)
+        # ONELAB keeps DefineConstant values across sessions in a process: start afresh, so
+        # that a parameter not given takes its default in the .geo, not the last file's value.
+        gmsh.onelab.clear()
         gmsh.open(str(path))
         if len(gmsh.model.mesh.getElements(3)[0]) == 0:
             gmsh.model.mesh.generate(3)
@@ -94,7 +225,19 @@ def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = 
         if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
             # DOLFINx reads only cells that belong to a physical group.
             gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
-    groups = comm.bcast(groups, root=0)
+        kinds = [
+            gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)
+        ]
+        if len(kinds) > 1:
+            error = (
+                f"{path.name}: mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
+                " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
+            )
+    groups, error = comm.bcast((groups, error), root=0)
+    if error:
+        if comm.rank == 0:
+            gmsh.finalize()
+        raise ValueError(error)
     try:
         msh, _, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
     finally:

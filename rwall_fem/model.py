@@ -25,12 +25,11 @@ from rwall_fem.mechanics import (
 )
 from rwall_fem.meshing import (
     BodyMesh,
-    bar_mesh,
+    body_mesh,
     boundary_nodes,
     coordinate_noise,
     group_nodes,
     perturb,
-    read_mesh,
 )
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import LinearElasticForce, Simulation, State
@@ -76,10 +75,11 @@ def build_simulation(
         comm = body.msh.comm
     elif spec is None:
         raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
-    elif spec.file is not None:
-        body = read_mesh(comm, spec.file)
     else:
-        body = bar_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell, spec.axis)
+        try:
+            body = body_mesh(comm, spec)
+        except ValueError as err:  # e.g. a file with mixed cell types
+            raise SceneError(f"{scene.source}: mesh: {err}") from None
     if spec is not None and spec.noise is not None:
         perturb(body, *spec.noise)
     msh = body.msh

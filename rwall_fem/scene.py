@@ -50,14 +50,23 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class MeshSpec:
-    shape: str | None  # "bar", or None when ``file`` is given
+    shape: str | None  # one of MESH_SHAPES, or None when ``file`` is given
     file: Path | None = None
-    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)  # m, lowest corner
-    size: tuple[float, float, float] = (0.01, 0.01, 0.1)  # m, along the bar's own x, y, z
-    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)  # direction of the bar's own z
+    # m: lowest corner (bar, plates), centre of the bottom face (round bar); before turning
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    size: tuple[float, float, float] = (0.01, 0.01, 0.1)  # m, along the body's own x, y, z
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)  # direction of the body's own z
     element_size: float = 2e-3  # m
     cell: str = "hexahedron"
     noise: tuple[float, int] | None = None  # (amplitude in m, seed) on initial coordinates
+    radius: float | None = None  # m, round bar
+    length: float | None = None  # m, round bar, along its own z
+    layers: int = 0  # plates: elements through the thickness; 0: the fewest <= element_size
+    hole_radius: float | None = None  # m, plate with a hole
+    hole_offset: tuple[float, float] = (0.0, 0.0)  # m, hole centre - plate centre (own x, y)
+    refine_point: tuple[float, float, float] | None = None  # m, scene coordinates
+    refine_size: float | None = None  # m, element size at refine_point
+    refine_radius: float | None = None  # m, over which the size grows back to element_size
 
 
 @dataclass(frozen=True)
@@ -317,36 +326,7 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
         min_dt=t.number("min_dt", 0.0, low=0.0, low_open=False),
     )
 
-    t = _Table(
-        top.get("mesh", {}),
-        "mesh",
-        source,
-        ("shape", "file", "origin", "size", "axis", "element_size", "cell", "noise"),
-    )
-    if not t.raw:
-        mesh = None  # a mesh of one's own, given to build_simulation
-    elif "file" in t.raw:
-        if "shape" in t.raw:
-            t.fail("mesh", "give either 'shape' or 'file', not both")
-        file = t.get("file")
-        if not isinstance(file, str):
-            t.fail(t.key("file"), f"must be a path string, got {file!r}")
-        file = (base / file).resolve()
-        if not file.is_file():
-            t.fail(t.key("file"), f"mesh file not found: {file}")
-        if file.suffix not in (".msh", ".geo"):
-            t.fail(t.key("file"), f"must be a gmsh .msh or .geo file, got {file.name}")
-        mesh = MeshSpec(shape=None, file=file, noise=_noise(t))
-    else:
-        mesh = MeshSpec(
-            shape=t.choice("shape", ("bar",)),
-            origin=t.vector("origin", (0.0, 0.0, 0.0)),
-            size=_positive_vector(t, "size"),
-            axis=_direction(t, "axis"),
-            element_size=t.number("element_size", low=0.0),
-            cell=t.choice("cell", ("hexahedron", "tetrahedron"), "hexahedron"),
-            noise=_noise(t),
-        )
+    mesh = _mesh(top.get("mesh", {}), source, base)
 
     t = _Table(top.get("material"), "material", source, ("model", "density", "young", "poisson"))
     material = Material(
@@ -414,6 +394,103 @@ def _boundary(raw, path: str, source: str) -> BoundarySpec:
     ):
         t.fail(t.key("components"), f"must be some of the letters x, y, z once, got {components!r}")
     return BoundarySpec(group, velocity, "".join(sorted(components)))
+
+
+# The keys of each mesh shape besides "shape", "noise" and the refinement keys.
+MESH_SHAPES = {
+    "bar": ("origin", "size", "axis", "element_size", "cell"),
+    "round_bar": ("origin", "radius", "length", "axis", "element_size", "cell"),
+    "plate": ("origin", "size", "layers", "axis", "element_size", "cell"),
+    "plate_with_hole": (
+        "origin",
+        "size",
+        "hole_radius",
+        "hole_offset",
+        "layers",
+        "axis",
+        "element_size",
+        "cell",
+    ),
+}
+_REFINE_KEYS = ("refine_point", "refine_size", "refine_radius")
+
+
+def _mesh(raw: Any, source: str, base: Path) -> MeshSpec | None:
+    shape_keys = tuple(dict.fromkeys(sum(MESH_SHAPES.values(), ())))
+    t = _Table(raw, "mesh", source, ("shape", "file", *shape_keys, *_REFINE_KEYS, "noise"))
+    if not t.raw:
+        return None  # a mesh of one's own, given to build_simulation
+    if "file" in t.raw:
+        if "shape" in t.raw:
+            t.fail("mesh", "give either 'shape' or 'file', not both")
+        for key in (*shape_keys, *_REFINE_KEYS):
+            if key in t.raw:
+                t.fail(t.key(key), "is not a key of a mesh file (only 'file' and 'noise')")
+        file = t.get("file")
+        if not isinstance(file, str):
+            t.fail(t.key("file"), f"must be a path string, got {file!r}")
+        file = (base / file).resolve()
+        if not file.is_file():
+            t.fail(t.key("file"), f"mesh file not found: {file}")
+        if file.suffix not in (".msh", ".geo"):
+            t.fail(t.key("file"), f"must be a gmsh .msh or .geo file, got {file.name}")
+        return MeshSpec(shape=None, file=file, noise=_noise(t))
+
+    shape = t.choice("shape", tuple(MESH_SHAPES))
+    for key in shape_keys:
+        if key in t.raw and key not in MESH_SHAPES[shape]:
+            owners = " or ".join(name for name, keys in MESH_SHAPES.items() if key in keys)
+            allowed = ", ".join(MESH_SHAPES[shape])
+            t.fail(
+                t.key(key),
+                f"is not a key of a {shape} (it belongs to a {owners}); "
+                f"allowed: {allowed}, {', '.join(_REFINE_KEYS)}, noise",
+            )
+    values: dict[str, Any] = {}
+    if shape == "round_bar":
+        values["radius"] = t.number("radius", low=0.0)
+        values["length"] = t.number("length", low=0.0)
+    else:
+        values["size"] = _positive_vector(t, "size")
+    if shape in ("plate", "plate_with_hole") and "layers" in t.raw:
+        values["layers"] = t.integer("layers", low=1)
+    if shape == "plate_with_hole":
+        values["hole_radius"] = r = t.number("hole_radius", low=0.0)
+        values["hole_offset"] = dx, dy = _pair(t, "hole_offset", (0.0, 0.0))
+        lx, ly, _ = values["size"]
+        if abs(dx) + r >= lx / 2 or abs(dy) + r >= ly / 2:
+            t.fail(
+                t.key("hole_radius"),
+                f"the hole (radius {r:g} m, centre {dx:g}, {dy:g} m from the plate's centre) "
+                f"does not fit in the plate ({lx:g} x {ly:g} m): "
+                "it needs |dx| + r < lx/2 and |dy| + r < ly/2",
+            )
+    element_size = t.number("element_size", low=0.0)
+    if any(key in t.raw for key in _REFINE_KEYS):
+        values["refine_point"] = t.vector("refine_point")
+        values["refine_size"] = t.number("refine_size", low=0.0, high=element_size, high_open=True)
+        values["refine_radius"] = t.number("refine_radius", 4 * element_size, low=0.0)
+    return MeshSpec(
+        shape=shape,
+        origin=t.vector("origin", (0.0, 0.0, 0.0)),
+        axis=_direction(t, "axis"),
+        element_size=element_size,
+        cell=t.choice("cell", ("hexahedron", "tetrahedron"), "hexahedron"),
+        noise=_noise(t),
+        **values,
+    )
+
+
+def _pair(t: _Table, name: str, default):
+    value = t.get(name, default)
+    if (
+        not isinstance(value, (list, tuple))
+        or len(value) != 2
+        or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in value)
+        or not all(math.isfinite(c) for c in value)
+    ):
+        t.fail(t.key(name), f"must be 2 finite numbers [x, y], got {value!r}")
+    return tuple(float(c) for c in value)
 
 
 def _positive_vector(t: _Table, name: str):
