@@ -39,8 +39,7 @@ body = rwall_fem.BodyMesh(msh)
 scene = rwall_fem.parse_scene(
     {
         "run": {"end_time": 6e-5},
-        "material": {"model": "linear_elastic", "density": 7850.0, "young": 210e9,
-                     "poisson": 0.3},
+        "material": {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.3},
         "initial": {"velocity": [0.0, 0.0, -10.0]},
         "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1]}],
         "output": {"frames": 12},
@@ -64,6 +63,8 @@ if MPI.COMM_WORLD.rank == 0:
     mass = summary["mass"]
     print(f"{summary['cells']} cells, {summary['steps']} steps of {summary['dt']:.3g} s")
     print(f"rebound velocity {summary['final_momentum'][2] / mass:.3f} m/s (was -10)")
-    print(f"wall impulse {summary['walls'][0]['impulse'][2]:.4g} N s, "
-          f"energy balance error {summary['energy']['max_balance_error']:.1e}")
+    print(
+        f"wall impulse {summary['walls'][0]['impulse'][2]:.4g} N s, "
+        f"energy balance error {summary['energy']['max_balance_error']:.1e}"
+    )
     print(f"pictures in {out}/frames, animation {out}/animation.gif")

@@ -11,8 +11,11 @@ __version__ = "0.1.0"
 
 _API = {
     "BodyMesh": "rwall_fem.meshing",
+    "CylinderWall": "rwall_fem.walls",
+    "ParallelogramWall": "rwall_fem.walls",
     "PlaneWall": "rwall_fem.walls",
     "RigidWall": "rwall_fem.walls",
+    "SphereWall": "rwall_fem.walls",
     "Scene": "rwall_fem.scene",
     "SceneError": "rwall_fem.scene",
     "load_scene": "rwall_fem.scene",

@@ -348,7 +348,10 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
     walls_raw = top.get("wall", [])
     if not isinstance(walls_raw, list):
         top.fail("wall", "must be an array of tables: write [[wall]]")
-    walls = tuple(_wall(w, f"wall[{i}]", source) for i, w in enumerate(walls_raw))
+    walls = tuple(
+        _wall(_shape_table(w, f"wall[{i}]", source), f"wall[{i}]", source)
+        for i, w in enumerate(walls_raw)
+    )
 
     boundaries_raw = top.get("boundary", [])
     if not isinstance(boundaries_raw, list):
@@ -530,6 +533,26 @@ SHAPE_KEYS = {
     "parallelogram": ("corner1", "corner2"),
 }
 _COMMON_KEYS = ("kind", "point", "slide", "friction", "friction_filter", "secondary", "motion")
+
+
+def _shape_table(raw: Any, path: str, source: str) -> Any:
+    """A wall given with a shape object (the Python API) as the table a scene file has:
+    ``PlaneWall(...)`` alone, or a dict with ``shape = CylinderWall(...)`` and other keys."""
+    if hasattr(raw, "kind") and hasattr(raw, "parameters"):
+        return {"kind": raw.kind, **raw.parameters()}
+    if not isinstance(raw, dict) or "shape" not in raw:
+        return raw
+    t = _Table(raw, path, source, tuple(raw))  # keys are checked with the table it becomes
+    shape = raw["shape"]
+    if not (hasattr(shape, "kind") and hasattr(shape, "parameters")):
+        t.fail(
+            t.key("shape"),
+            "must be a wall shape: PlaneWall, CylinderWall, SphereWall or ParallelogramWall",
+        )
+    if "kind" in raw:
+        t.fail(t.key("kind"), "give either 'kind' or 'shape', not both")
+    rest = {key: value for key, value in raw.items() if key != "shape"}
+    return {"kind": shape.kind, **shape.parameters(), **rest}
 
 
 def _wall(raw: Any, path: str, source: str) -> WallSpec:

@@ -271,3 +271,28 @@ def test_a_surface_mesh_is_refused(tmp_path):
     result = _cli("run", "scene.toml", cwd=tmp_path)
     assert result.returncode == 2
     assert "mesh: triangle cells; allowed: tetrahedra or hexahedra" in result.stderr
+
+
+def test_walls_given_as_shape_objects_equal_their_tables():
+    """The Python API takes a wall as a shape object, alone or as ``shape`` beside options;
+    it is validated as the table a scene file would have."""
+    from rwall_fem import CylinderWall, PlaneWall
+
+    raw = bar_scene(elements=4)
+    tables = [
+        {"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1]},
+        {"kind": "cylinder", "point": [0, 0, -1], "axis_point": [0, 1, -1], "diameter": 0.5,
+         "slide": "friction", "friction": 0.3},
+    ]  # fmt: skip
+    objects = [
+        PlaneWall([0, 0, 0], [0, 0, 2]),
+        {"shape": CylinderWall([0, 0, -1], [0, 1, -1], 0.5), "slide": "friction", "friction": 0.3},
+    ]
+    assert parse_scene(raw | {"wall": objects}).walls == parse_scene(raw | {"wall": tables}).walls
+    for wall, message in [
+        ({"shape": "plane"}, r"wall\[0\]\.shape: must be a wall shape: PlaneWall"),
+        ({"shape": objects[0], "kind": "plane"}, r"wall\[0\]\.kind: give either 'kind' or"),
+        ({"shape": objects[0], "diameter": 1.0}, r"wall\[0\]\.diameter: is not a key of a plane"),
+    ]:
+        with pytest.raises(SceneError, match=message):
+            parse_scene(raw | {"wall": [wall]}, source="api")
