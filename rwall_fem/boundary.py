@@ -8,7 +8,8 @@ clamp wins over a wall on a node both act on.
 The reaction is the impulse that sets the step's velocity, m (v_p - v_pred);
 its work is booked at mid-step velocities like every other force (see
 :mod:`rwall_fem.history`): the half with v^{n-1/2} at step n, the half with
-v^{n+1/2} = v_p at the next step, so the balance closes exactly.
+v^{n+1/2} at the next step, read from the state then (so that whatever acted
+after it on the same node, the balance closes exactly).
 """
 
 from __future__ import annotations
@@ -35,16 +36,18 @@ class VelocityBoundary:
         self.axes = np.array(["xyz".index(c) for c in components])
         self.impulse = np.zeros(3)  # reaction on this rank's nodes so far, N s
         self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
-        self._pending = 0.0  # the v^{n+1/2} half of the latest step's work, J
+        self._reaction = None  # the latest step's reaction (N s), for its v^{n+1/2} half
 
     def constrain(self, state) -> None:
         """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n + dt/2)."""
         rows, cols = self.nodes[:, None], self.axes[None, :]
         target = self.history.predict(state.t, state.dt)[self.axes]
         v_old = state.v[rows, cols]
+        if self._reaction is not None:
+            self.work += 0.5 * float(np.sum(self._reaction * v_old))
         m = state.mass[self.nodes][:, None]
         reaction = m * (target - v_old - state.dt * state.a[rows, cols])  # N s
         state.a[rows, cols] = (target - v_old) / state.dt
-        self.work += self._pending + 0.5 * float(np.sum(reaction * v_old))
-        self._pending = 0.5 * float(np.sum(reaction * target))
+        self.work += 0.5 * float(np.sum(reaction * v_old))
+        self._reaction = reaction
         self.impulse[self.axes] += reaction.sum(axis=0)
