@@ -64,7 +64,9 @@ class LinearElasticForce:
         comm, size = K.comm, (state.u.size, PETSc.DECIDE)
         self._u = PETSc.Vec().createWithArray(state.u.reshape(-1), size=size, bsize=3, comm=comm)
         self._ku = PETSc.Vec().createWithArray(self.ku.reshape(-1), size=size, bsize=3, comm=comm)
-        self._minus_inv_mass = -state.inv_mass  # one pass per step instead of two
+        # -1/m per component: one pass per step, and a contiguous (n, 3) operand is several
+        # times faster than broadcasting an (n, 1) column over rows of 3.
+        self._minus_inv_mass = -np.repeat(state.inv_mass, 3, axis=1)
 
     def accelerate(self, state: State) -> None:
         self.K.mult(self._u, self._ku)

@@ -31,9 +31,21 @@ relative to the wall, 1/2 I . (w^{n-1/2} + w^{n+1/2}) with w = v - V, split into
 normal and tangential (friction) parts; it is the energy the wall dissipates.
 A prescribed wall also does driving work 1/2 I . (V^{n-1/2} + V^{n+1/2}), booked
 as external work.
+
+Cost: each step tests only the *near set*, the secondary nodes whose clearance
+(``shape.clearance``, a lower bound on how far a node must travel relative to the
+wall before the wall can treat it) was within a travel budget when the set was
+selected. Every step bounds how far any node and the wall may have travelled
+since (largest velocity and acceleration components of the rank's nodes, the
+wall's exact translation) and selects the set again, from all secondary nodes,
+before that bound passes the budget. No node the wall would treat is ever left
+out, so the results are those of testing every secondary node; each rank
+decides on its own nodes, without communication.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from mpi4py import MPI
@@ -43,6 +55,16 @@ from rwall_fem.walls.motion import FixedMotion
 __all__ = ["RigidWall"]
 
 SLIDES = ("free", "tied", "friction")
+# The near set is selected for this many steps of travel at the speed bound of the moment.
+_HORIZON = 16
+# sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
+# covers rounding (a float sum u + dt v moves u by at most twice the increment).
+_TRAVEL = 2.0 * math.sqrt(3.0)
+
+
+def _largest(values: np.ndarray) -> float:
+    """Largest absolute component of ``values`` (two reductions, no temporary)."""
+    return float(max(values.max(), -values.min()))
 
 
 class RigidWall:
@@ -84,6 +106,12 @@ class RigidWall:
         self._pending = np.zeros(3)  # (normal, friction, driving) halves for the next step
         filtered = slide == "friction" and self.filter_alpha < 1.0
         self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
+        self._filtered_rows = self.nodes[:0]  # rows of it written in the latest step
+        # Near set: the secondary nodes (positions in ``nodes``) tested this step; selected
+        # at the first step (the budget, m, is -inf until then).
+        self._near = self._near_nodes = self.nodes[:0]
+        self._near_X, self._near_mass = np.zeros((0, 3)), np.zeros((0, 1))
+        self._budget, self._travel, self._anchor = -np.inf, 0.0, [0.0, 0.0, 0.0]
 
     @property
     def work(self) -> float:
@@ -102,23 +130,27 @@ class RigidWall:
 
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
-        dt, idx, motion, shape = state.dt, self.nodes, self.motion, self.shape
+        dt, motion, shape = state.dt, self.motion, self.shape
         wall_velocity = motion.predict(state.t, dt)
         offset = motion.offset
-        v_old = state.v[idx]
-        v_pred = v_old + dt * state.a[idx]
-        x_now = state.X[idx] + state.u[idx]
+        wall_next = offset + dt * wall_velocity
+        if len(self.nodes):
+            self._follow(state, wall_velocity, wall_next)
+        near = self._near_nodes
+        v_old = state.v[near]
+        v_pred = v_old + dt * state.a[near]
+        x_now = self._near_X + state.u[near]
         x_pred = x_now + dt * v_pred
-        hit = shape.distance(x_pred, offset + dt * wall_velocity) < 0.0
+        hit = shape.distance(x_pred, wall_next) < 0.0
         if self.finite:
-            hit &= shape.inside_patch(x_pred, offset + dt * wall_velocity)
+            hit &= shape.inside_patch(x_pred, wall_next)
         h = np.flatnonzero(hit)
         target = np.zeros(len(h))  # normal velocity relative to the wall after the step
         if self.finite and len(h):
             d_now = shape.distance(x_now[h], offset)
             normal_speed = np.abs((v_pred[h] - wall_velocity) @ shape.normal)
-            near = d_now >= -2.0 * dt * normal_speed  # deeper nodes pass behind the wall
-            h, d_now = h[near], d_now[near]
+            shallow = d_now >= -2.0 * dt * normal_speed  # deeper nodes pass behind the wall
+            h, d_now = h[shallow], d_now[shallow]
             target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
 
         self.normal_work += self._pending[0]
@@ -126,21 +158,24 @@ class RigidWall:
         self.driving_work += self._pending[2]
         self._pending[:] = 0.0
         self.contacts = len(h)
-        self.touching = idx[h]  # nodes treated in the latest step
+        self.touching = near[h]  # nodes treated in the latest step
         kept = None
         if self._previous_tangential is not None:
-            kept = self._previous_tangential[h]
-            self._previous_tangential[:] = 0.0
+            # Only the rows written in the previous step are non-zero: clear those alone.
+            rows = self._near[h]
+            kept = self._previous_tangential[rows]
+            self._previous_tangential[self._filtered_rows] = 0.0
+            self._filtered_rows = rows
         if not len(h) and not motion.dynamic:
             motion.advance(wall_velocity, dt)
             return
 
         n = np.broadcast_to(shape.normals(x_now[h], offset), (len(h), 3))
-        m = state.mass[idx[h]][:, None]
+        m = self._near_mass[h]
         vs = v_pred[h]
-        tied = np.full(len(h), self.slide == "tied")
         if motion.dynamic:
             predicted = wall_velocity
+            tied = np.full(len(h), self.slide == "tied")
             wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, tied)
         normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
         if motion.dynamic and self.slide == "friction":
@@ -149,9 +184,9 @@ class RigidWall:
             wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, ~slip, extra)
             normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
         if self._previous_tangential is not None:
-            self._previous_tangential[h] = tangential
-        impulse = normal + tangential
-        state.a[idx[h]] += impulse / (m * dt)
+            self._previous_tangential[self._filtered_rows] = tangential
+        impulse = normal if tangential is None else normal + tangential
+        state.a[self.touching] += impulse / (m * dt)
 
         final = wall_velocity
         if motion.dynamic:
@@ -161,18 +196,59 @@ class RigidWall:
         motion.advance(final, dt)
         w_old = v_old[h] - before
         w_new = vs + impulse / m - final
-        self.normal_work += 0.5 * np.sum(normal * w_old)
-        self.friction_work += 0.5 * np.sum(tangential * w_old)
-        self._pending[0] = 0.5 * np.sum(normal * w_new)
-        self._pending[1] = 0.5 * np.sum(tangential * w_new)
+        self.normal_work += 0.5 * (normal * w_old).sum()
+        self._pending[0] = 0.5 * (normal * w_new).sum()
+        if tangential is not None:
+            self.friction_work += 0.5 * (tangential * w_old).sum()
+            self._pending[1] = 0.5 * (tangential * w_new).sum()
+            self.tangential_impulse -= tangential.sum(axis=0)
         if motion.prescribed:
             self.driving_work += 0.5 * impulse.sum(axis=0) @ before
             self._pending[2] = 0.5 * impulse.sum(axis=0) @ final
         self.normal_impulse -= normal.sum(axis=0)
-        self.tangential_impulse -= tangential.sum(axis=0)
         if len(h):
             self.first_contact = min(self.first_contact, state.t)
             self.last_contact = state.t
+
+    def _follow(self, state, wall_velocity, wall_next) -> None:
+        """Keep the near set valid for this step's test; select it again when the nodes
+        and the wall may have travelled, relative to each other, more than its budget.
+
+        A node outside the set had a clearance above the budget when the set was
+        selected, and clearance changes by at most the relative travel, so the test
+        ``distance(x*, wall_next) < 0`` cannot be true for it while the travel bound
+        ``reach`` (m) stays within the budget. The bound uses the largest velocity
+        component of all owned nodes (two reductions each for ``v`` and ``a``, no
+        gather) and the wall's exact translation.
+        """
+        dt = state.dt
+        speed = _largest(state.v)  # bounds the components of v^{n-1/2}, m/s
+        self._travel += dt * speed  # of x^n from where the set was selected
+        ahead = speed + dt * _largest(state.a)  # bounds the components of v*, m/s
+        wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster
+        reach = _TRAVEL * (self._travel + dt * ahead) + wall_travel
+        if not reach <= self._budget:  # also when NaN
+            self._select(state, ahead, wall_velocity)
+
+    def _select(self, state, ahead: float, wall_velocity) -> None:
+        """Select the near set: the secondary nodes that can reach the wall within about
+        ``_HORIZON`` steps at the current bound ``ahead`` (m/s) of the velocity
+        components and the wall's velocity (m/s)."""
+        dt = state.dt
+        self._budget = _HORIZON * dt * (_TRAVEL * ahead + math.hypot(*wall_velocity))
+        self._travel = 0.0
+        self._anchor = self.motion.offset.tolist()
+        x = state.X[self.nodes] + state.u[self.nodes]
+        clearance = self.shape.clearance(x, self.motion.offset)
+        # Rounding in positions and distances is far below 1e-12 of their size.
+        size = np.abs(x).max() + np.abs(self.position).max() + self._budget
+        slack = self._budget + 1e-12 * size
+        if not np.isfinite(slack):
+            slack = np.inf  # every node with a finite position
+        self._near = np.flatnonzero(clearance <= slack)
+        self._near_nodes = self.nodes[self._near]
+        self._near_X = state.X[self._near_nodes]
+        self._near_mass = state.mass[self._near_nodes][:, None]
 
     def _coupled_velocity(self, predicted, m, n, vs, target, tied, extra=None) -> np.ndarray:
         """Velocity (m/s) of a main-node wall over the step when it moves with the mass of
@@ -191,13 +267,13 @@ class RigidWall:
 
     def _impulses(self, m, n, w, target, kept):
         """Normal and tangential impulses (N s) for predicted relative velocities ``w``
-        (n, 3), and which nodes slip."""
+        (n, 3), and which nodes slip; no tangential impulse (None) for free sliding."""
         wn = np.einsum("ij,ij->i", w, n)
         normal = m * (target - wn)[:, None] * n
-        stick = -m * (w - wn[:, None] * n)
         slip = np.zeros(len(w), dtype=bool)
         if self.slide == "free":
-            return normal, np.zeros_like(stick), slip
+            return normal, None, slip
+        stick = -m * (w - wn[:, None] * n)
         if self.slide == "tied":
             return normal, stick, slip
         if kept is not None:

@@ -4,6 +4,11 @@ A shape answers for many nodes at once: ``x`` has shape (n, 3) in metres and
 ``offset`` (3,) is the wall's translation from its initial position (moving
 walls translate, never rotate). Distances are in metres, negative on the
 forbidden side.
+
+``clearance`` is what the wall constraint uses to skip nodes far from the wall:
+a lower bound (m) on how far a point must move, relative to the wall, before
+the wall can treat it (zero or negative if it may treat it now). It changes by
+at most |dx| when the point moves by dx.
 """
 
 from __future__ import annotations
@@ -52,6 +57,10 @@ class PlaneWall:
         """Signed distance (m) of the points ``x`` (n, 3) to the plane."""
         return (x - (self.point + offset)) @ self.normal
 
+    def clearance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        """Signed distance (m): a node can be treated only once it is behind the plane."""
+        return self.distance(x, offset)
+
     def normals(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Unit normal (3,) toward the allowed side, the same for every point."""
         return self.normal
@@ -76,6 +85,9 @@ class ParallelogramWall(PlaneWall):
         self.normal = _unit(np.cross(*self.sides), "(M1 - M) x (M2 - M)")
         # (a, b) = inverse Gram matrix @ (L1 . r, L2 . r) for r in the plane.
         self._dual = np.linalg.solve(self.sides @ self.sides.T, self.sides)
+        # Width (m) of the parallelogram across each pair of sides: a moves by at most
+        # |dx| / width_a when x moves by dx.
+        self._widths = 1.0 / np.linalg.norm(self._dual, axis=1)
 
     def parameters(self) -> dict:
         return {
@@ -89,6 +101,14 @@ class ParallelogramWall(PlaneWall):
         ab = (x - (self.point + offset)) @ self._dual.T
         return np.all((ab >= 0.0) & (ab <= 1.0), axis=1)
 
+    def clearance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        """The larger of the signed distance to the plane and a lower bound on the distance
+        to the prism over the parallelogram (m): a node is treated only inside the prism
+        and behind the plane."""
+        ab = (x - (self.point + offset)) @ self._dual.T
+        beside = np.maximum(-ab, ab - 1.0) * self._widths
+        return np.maximum(self.distance(x, offset), beside.max(axis=1))
+
 
 class _RoundWall:
     """Shared by the cylinder and the sphere: distance and normal from a radial vector."""
@@ -97,6 +117,10 @@ class _RoundWall:
 
     def distance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         return np.linalg.norm(self._radial(x, offset), axis=1) - self.radius
+
+    def clearance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
+        """Signed distance (m): a node can be treated only once it is inside."""
+        return self.distance(x, offset)
 
     def normals(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Unit radial normals (n, 3); a point on the axis or at the centre gets ``fallback``."""
