@@ -376,7 +376,7 @@ def report(info, stream, results, profiles, startup, load0, load1, seconds, wait
             s = r["setup"]
             w(
                 f"| {cell[:3]} | {label} | {r['first_step_seconds']:.2f} | "
-                f"{s.get('bar_mesh', 0):.2f} | {s.get('lumped_mass', 0):.2f} | "
+                f"{s.get('body_mesh', 0):.2f} | {s.get('lumped_mass', 0):.2f} | "
                 f"{s.get('stiffness_matrix', 0):.2f} | {s.get('critical_time_step', 0):.2f} |"
             )
     w("")

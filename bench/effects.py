@@ -29,8 +29,9 @@ VARIANTS = {
     "base: linear elastic, fixed plane, free sliding": {},
     "+ gravity": {"gravity": {"acceleration": [0, 0, -9.81]}},
     "+ Coulomb friction": {"wall.0": {"slide": "friction", "friction": 0.3}},
-    "+ friction filter": {"wall.0": {"slide": "friction", "friction": 0.3,
-                                     "friction_filter": {"steps": 20}}},
+    "+ friction filter": {
+        "wall.0": {"slide": "friction", "friction": 0.3, "friction_filter": {"steps": 20}}
+    },
     "+ main-node wall (moving)": {"wall.0": {"motion": {"mass": 1.0, "velocity": [0, 0, 0.1]}}},
     "+ history every step": {"output": {"history_interval": 1}},
     "+ fields (10 snapshots)": {"output": {"fields": 10}},
