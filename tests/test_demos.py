@@ -17,6 +17,7 @@ COARSE = {  # scene -> overrides that keep it to a few seconds
     "plate_on_cylinder": ["mesh.element_size=0.004", "run.end_time=0.005"],
     "plate_on_sphere": ["mesh.element_size=0.003", "run.end_time=0.005"],
     "bar_on_parallelogram_edge": ["mesh.element_size=0.005", "run.end_time=2e-4"],
+    "every_key": ["mesh.element_size=0.005", "run.end_time=5e-5"],
 }
 
 

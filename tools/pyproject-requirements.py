@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Print what installing a local project needs from an index, one requirement per line.
 
-    tools/pyproject-requirements.py DIR[EXTRA,...]      e.g.  tools/pyproject-requirements.py '.[test]'
+    tools/pyproject-requirements.py DIR[EXTRA,...]   e.g. tools/pyproject-requirements.py '.[test]'
 
 That is: DIR/pyproject.toml's [build-system] requires (pip's build isolation installs them
 to build even an editable install), its [project] dependencies, and the optional

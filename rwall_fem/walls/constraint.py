@@ -103,7 +103,11 @@ class RigidWall:
         self.touching = self.nodes[:0]  # those nodes (local indices)
         self.first_contact = np.inf  # s
         self.last_contact = -np.inf  # s
-        self._pending = np.zeros(3)  # (normal, friction, driving) halves for the next step
+        # The latest step's treated nodes, impulses (N s) and wall velocity (m/s): the
+        # v^{n+1/2} halves of their work are booked at the next step, from the velocities
+        # the nodes then have (whatever acted on them after the wall).
+        self._latest = None
+        self._pending_driving = 0.0  # J
         filtered = slide == "friction" and self.filter_alpha < 1.0
         self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
         self._filtered_rows = self.nodes[:0]  # rows of it written in the latest step
@@ -153,10 +157,15 @@ class RigidWall:
             h, d_now = h[shallow], d_now[shallow]
             target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
 
-        self.normal_work += self._pending[0]
-        self.friction_work += self._pending[1]
-        self.driving_work += self._pending[2]
-        self._pending[:] = 0.0
+        if self._latest is not None:
+            nodes, normal, tangential, final = self._latest
+            w_new = state.v[nodes] - final
+            self.normal_work += 0.5 * (normal * w_new).sum()
+            if tangential is not None:
+                self.friction_work += 0.5 * (tangential * w_new).sum()
+            self._latest = None
+        self.driving_work += self._pending_driving
+        self._pending_driving = 0.0
         self.contacts = len(h)
         self.touching = near[h]  # nodes treated in the latest step
         kept = None
@@ -195,16 +204,14 @@ class RigidWall:
         before = motion.velocity
         motion.advance(final, dt)
         w_old = v_old[h] - before
-        w_new = vs + impulse / m - final
         self.normal_work += 0.5 * (normal * w_old).sum()
-        self._pending[0] = 0.5 * (normal * w_new).sum()
         if tangential is not None:
             self.friction_work += 0.5 * (tangential * w_old).sum()
-            self._pending[1] = 0.5 * (tangential * w_new).sum()
             self.tangential_impulse -= tangential.sum(axis=0)
+        self._latest = (self.touching, normal, tangential, final)
         if motion.prescribed:
             self.driving_work += 0.5 * impulse.sum(axis=0) @ before
-            self._pending[2] = 0.5 * impulse.sum(axis=0) @ final
+            self._pending_driving = 0.5 * impulse.sum(axis=0) @ final
         self.normal_impulse -= normal.sum(axis=0)
         if len(h):
             self.first_contact = min(self.first_contact, state.t)
