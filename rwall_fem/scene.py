@@ -284,15 +284,17 @@ class _Table:
             self.fail(self.key(name), f"must be an integer >= {low}, got {value!r}")
         return value
 
-    def vector(self, name, default=...) -> tuple[float, float, float]:
+    def vector(self, name, default=..., size: int = 3) -> tuple[float, ...]:
+        """``size`` finite numbers: the components x, y (, z)."""
         value = self.get(name, default)
         if (
             not isinstance(value, (list, tuple))
-            or len(value) != 3
+            or len(value) != size
             or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in value)
             or not all(math.isfinite(c) for c in value)
         ):
-            self.fail(self.key(name), f"must be 3 finite numbers [x, y, z], got {value!r}")
+            names = ", ".join("xyz"[:size])
+            self.fail(self.key(name), f"must be {size} finite numbers [{names}], got {value!r}")
         return tuple(float(c) for c in value)
 
     def choice(self, name, choices: tuple[str, ...], default=...) -> str:
@@ -459,7 +461,7 @@ def _mesh(raw: Any, source: str, base: Path) -> MeshSpec | None:
         values["layers"] = t.integer("layers", low=1)
     if shape == "plate_with_hole":
         values["hole_radius"] = r = t.number("hole_radius", low=0.0)
-        values["hole_offset"] = dx, dy = _pair(t, "hole_offset", (0.0, 0.0))
+        values["hole_offset"] = dx, dy = t.vector("hole_offset", (0.0, 0.0), size=2)
         lx, ly, _ = values["size"]
         if abs(dx) + r >= lx / 2 or abs(dy) + r >= ly / 2:
             t.fail(
@@ -482,18 +484,6 @@ def _mesh(raw: Any, source: str, base: Path) -> MeshSpec | None:
         noise=_noise(t),
         **values,
     )
-
-
-def _pair(t: _Table, name: str, default):
-    value = t.get(name, default)
-    if (
-        not isinstance(value, (list, tuple))
-        or len(value) != 2
-        or not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in value)
-        or not all(math.isfinite(c) for c in value)
-    ):
-        t.fail(t.key(name), f"must be 2 finite numbers [x, y], got {value!r}")
-    return tuple(float(c) for c in value)
 
 
 def _positive_vector(t: _Table, name: str):
