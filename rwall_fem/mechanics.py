@@ -87,9 +87,8 @@ def stiffness_matrix(V, material: Material) -> PETSc.Mat:
     per product K u than AIJ, the format DOLFINx assembles into (bench/results.md).
     """
     u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-    K = fem.petsc.assemble_matrix(fem.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx))
-    K.assemble()
-    return K.convert(PETSc.Mat.Type.BAIJ)  # in place
+    a = fem.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx)
+    return _compat.assemble_matrix(a, PETSc.Mat.Type.BAIJ)
 
 
 def critical_time_step(K: PETSc.Mat, mass: np.ndarray, coords: np.ndarray) -> float:
