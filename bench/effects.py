@@ -7,6 +7,7 @@ pipeline, so the base line is what every scene pays.
 """
 
 import copy
+import os
 import statistics
 import sys
 import tempfile
@@ -51,6 +52,7 @@ def scene(changes):
 
 def main():
     comm = MPI.COMM_WORLD
+    load = [os.getloadavg()[0]]
     rows = []
     with tempfile.TemporaryDirectory() as out:
         out = comm.bcast(out, root=0)
@@ -61,13 +63,16 @@ def main():
                 sim.run()
                 times.append(sim.wall_seconds / (sim.num_steps + 1))
             rows.append((name, sim.history.info["cells"], sim.num_steps, statistics.median(times)))
+    load.append(os.getloadavg()[0])
     if comm.rank == 0:
         base = rows[0][3]
         lines = [
             "# Per-step cost of each effect",
             "",
             f"`python bench/effects.py` on {comm.size} rank(s); {rows[0][1]} hexahedra, "
-            f"{rows[0][2]} steps, median of 3 runs of the time loop.",
+            f"{rows[0][2]} steps, median of 3 runs of the time loop. 1-minute load average "
+            f"before / after: {load[0]:.2f} / {load[1]:.2f} (above about 1, another job "
+            "shares the cores and the ratios are noise).",
             "",
             "| scene | ms / step | x base |",
             "|---|---|---|",
