@@ -27,6 +27,7 @@ __all__ = [
     "create_vector",
     "expression",
     "scalar_space",
+    "scatter_reverse_add",
     "model_to_mesh",
     "vector_space",
     "vtk_mesh",
@@ -104,3 +105,10 @@ def expression(expr, V) -> fem.Expression:
     """``expr`` compiled for interpolation into ``V``."""
     points = V.element.interpolation_points
     return fem.Expression(expr, points() if callable(points) else points)
+
+
+def scatter_reverse_add(x) -> None:
+    """Add the ghost entries of the DOLFINx vector ``x`` to their owners' entries."""
+    from dolfinx import la
+
+    x.scatter_reverse(la.InsertMode.add if hasattr(la, "InsertMode") else la.ScatterMode.add)

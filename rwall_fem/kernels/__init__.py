@@ -1,0 +1,144 @@
+"""Compiled element kernels: C compiled at first use through cffi and cached.
+
+The C sources beside this file (one per element family, with the formulas in
+their header comments) are compiled into one extension module the first time a
+process needs them, the way FFCx compiles forms, and cached per user under
+``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
+``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
+compiler flags, the Python and cffi versions and the processor's instruction
+sets, so a cached module never runs on a machine it was not built for.
+
+Flags: ``-O3 -march=native`` (the host's vector instructions) when the compiler
+accepts them, else portable ``-O3``; ``-fopenmp-simd`` lets the per-cell loops
+over a batch of cells become SIMD instructions without an OpenMP runtime.
+
+Each compile happens in a private temporary folder and the finished module is
+moved into the cache with one atomic rename, so concurrent processes (MPI ranks
+starting together) never load a half-written file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import importlib.util
+import io
+import os
+import platform
+import sys
+import tempfile
+from functools import cache
+from pathlib import Path
+
+__all__ = ["KernelBuildError", "load"]
+
+SOURCES = ("batch.h", "materials.h", "tetrahedron.c", "hexahedron.c",
+           "hexahedron_reduced.c", "update.c")  # fmt: skip
+FLAG_SETS = (
+    ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno"],
+    ["-O3", "-fopenmp-simd", "-fno-math-errno"],
+)
+MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
+HOURGLASS = ("none", "physical", "stiffness", "viscous")
+
+_CDEF = """
+typedef struct {
+  double lmbda, mu, density, wave_speed, hourglass_coefficient, dt;
+} element_params;
+void accelerate(int64_t n, const double *f, const double *inv_mass, double *a);
+void advance(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
+             const double *f, double out[3]);
+""" + "".join(
+    f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"
+    " const element_params *p, double *f, double *energy);\n"
+    for family in ("tet4", "hex8")
+    for model in MODELS
+) + "".join(
+    f"void hex8r_{model}_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
+    " const double *u, const double *v, const element_params *p, double *f, double *energy);\n"
+    for model in MODELS
+    for hourglass in HOURGLASS
+)
+
+
+class KernelBuildError(RuntimeError):
+    """The C compiler could not build the element kernels; the message is one line."""
+
+
+def _cache_dir() -> Path:
+    if "RWALL_FEM_CACHE" in os.environ:
+        return Path(os.environ["RWALL_FEM_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "rwall_fem" / "kernels"
+
+
+def _cpu() -> str:
+    """The machine and its instruction-set flags (what -march=native compiles for)."""
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+        flags = next((line for line in text.splitlines() if line.startswith("flags")), "")
+    except OSError:
+        flags = platform.processor()
+    return f"{platform.machine()} {flags}"
+
+
+def _key(flags: list[str]) -> str:
+    import cffi
+
+    digest = hashlib.sha256()
+    here = Path(__file__).parent
+    for name in SOURCES:
+        digest.update((here / name).read_bytes())
+    for part in (_CDEF, " ".join(flags), sys.version, cffi.__version__, _cpu()):
+        digest.update(part.encode())
+    return digest.hexdigest()[:16]
+
+
+def _import(name: str, path: Path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _compile(name: str, flags: list[str], folder: Path) -> Path:
+    """Compile the kernels as extension module ``name`` into ``folder``; returns its path."""
+    import cffi
+
+    ffi = cffi.FFI()
+    ffi.cdef(_CDEF)
+    here = Path(__file__).parent
+    source = "".join(f'#include "{n}"\n' for n in SOURCES if n.endswith(".c"))
+    ffi.set_source(name, source, include_dirs=[str(here)], extra_compile_args=flags)
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=folder) as work:
+        # setuptools reports each compiler command on stdout: keep it out of the run's output.
+        with contextlib.redirect_stdout(io.StringIO()):
+            built = Path(ffi.compile(tmpdir=work, verbose=False))
+        final = folder / built.name
+        os.replace(built, final)  # atomic: a concurrent process sees all of it or nothing
+    return final
+
+
+@cache
+def load():
+    """The compiled kernels ``(ffi, lib)``, built on first use (a few seconds) and cached."""
+    failures = []
+    for flags in FLAG_SETS:
+        name = f"_rwall_kernels_{_key(flags)}"
+        folder = _cache_dir()
+        found = sorted(folder.glob(f"{name}.*.so")) + sorted(folder.glob(f"{name}.so"))
+        try:
+            path = found[0] if found else _compile(name, flags, folder)
+        except PermissionError:  # a read-only cache: compile for this process only
+            path = _compile(name, flags, Path(tempfile.mkdtemp(prefix="rwall_fem_kernels_")))
+        except Exception as err:  # the compiler's failure, whatever setuptools wraps it in
+            failures.append(f"{' '.join(flags)}: {str(err).strip().splitlines()[-1:]}")
+            continue
+        module = _import(name, path)
+        return module.ffi, module.lib
+    raise KernelBuildError(
+        "could not compile the element kernels with the C compiler "
+        f"({os.environ.get('CC', 'cc')}; tried {'; '.join(failures)}): install gcc (Debian: "
+        "apt-get install gcc libc6-dev) or set CC"
+    )

@@ -1,0 +1,124 @@
+/* Batches of cells for the element kernels.
+ *
+ * A kernel works on LANES cells at a time: it gathers their nodal values into
+ * `vec`s (GCC vector types of LANES doubles, one lane per cell), computes the
+ * batch with the per-cell formulas written on `vec`s, which the compiler
+ * emits as SIMD instructions of the host's width (AVX-512: one instruction per
+ * operation; narrower hosts: several), and scatters the nodal forces back.  A
+ * short last batch repeats its first cell in the unused lanes, whose results
+ * are dropped.
+ *
+ * Node arrays are (num_nodes, 3) row-major float64: node i's x, y, z are at
+ * 3i, 3i + 1, 3i + 2.  Cells are (num_cells, nodes_per_cell) int32 rows of node
+ * indices in DOLFINx's reference-cell order.
+ */
+#ifndef RWALL_BATCH_H
+#define RWALL_BATCH_H
+
+#include <math.h>
+#include <stdint.h>
+
+#define LANES 4
+#define INLINE static inline __attribute__((always_inline))
+
+typedef double vec __attribute__((vector_size(LANES * sizeof(double))));
+typedef int64_t ivec __attribute__((vector_size(LANES * sizeof(int64_t))));
+#define VZERO ((vec){0.0})
+
+/* Material and technology constants of one kernel call. */
+typedef struct
+{
+  double lmbda;       /* first Lame parameter lambda, Pa */
+  double mu;          /* shear modulus, Pa */
+  double density;     /* kg/m^3 */
+  double wave_speed;  /* dilatational wave speed sqrt((lambda + 2 mu)/density), m/s */
+  double hourglass_coefficient; /* scales the hourglass forces (one-point hexahedra) */
+  double dt;          /* time step, s (viscous hourglass dissipation) */
+} element_params;
+
+/* Gather the 3 components of the npe nodes of cells c0 .. c0 + LANES - 1 into
+ * out[3 I + i][lane]; lanes from nb on repeat cell c0. */
+INLINE void gather(const int32_t *restrict cells, int npe, int64_t c0, int nb,
+                   const double *restrict values, vec *restrict out)
+{
+  for (int k = 0; k < LANES; ++k)
+  {
+    const int32_t *cell = cells + (c0 + (k < nb ? k : 0)) * npe;
+    for (int I = 0; I < npe; ++I)
+      for (int i = 0; i < 3; ++i)
+        out[3 * I + i][k] = values[3 * (int64_t)cell[I] + i];
+  }
+}
+
+/* Add the nodal forces in[3 I + i][lane] of the nb valid lanes to f. */
+INLINE void scatter_add(const int32_t *restrict cells, int npe, int64_t c0, int nb,
+                        const vec *restrict in, double *restrict f)
+{
+  for (int k = 0; k < nb; ++k)
+  {
+    const int32_t *cell = cells + (c0 + k) * npe;
+    for (int I = 0; I < npe; ++I)
+      for (int i = 0; i < 3; ++i)
+        f[3 * (int64_t)cell[I] + i] += in[3 * I + i][k];
+  }
+}
+
+INLINE void cross(const vec a[3], const vec b[3], vec out[3])
+{
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+INLINE vec dot3(const vec a[3], const vec b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Lane-wise |x| (the sign bit cleared), log and cbrt: the vector types have no such
+ * operators.  Divisions are slow SIMD instructions: the kernels divide once and multiply. */
+INLINE vec vabs(vec x)
+{
+  return (vec)((ivec)x & ((ivec){0} + INT64_MAX));
+}
+
+/* Natural log to about one ulp, all lanes at once: x = m 2^e with m in [sqrt(1/2), sqrt(2)),
+ * log x = e log 2 + 2 atanh(s), s = (m - 1)/(m + 1), |s| < 0.172, by 14 terms of the series
+ * 2 (s + s^3/3 + s^5/5 + ...) (the next term is below 1e-19 of the sum).  NaN for x <= 0
+ * and for NaN, +inf for +inf, like log(). */
+INLINE vec vlog(vec x)
+{
+  const ivec bits = (ivec)x;
+  ivec e = ((bits >> 52) & 0x7ff) - 1023;
+  vec m = (vec)((bits & 0x000fffffffffffffLL) | 0x3ff0000000000000LL); /* in [1, 2) */
+  const ivec big = m > 1.41421356237309504880;
+  m = (vec)(((ivec)(0.5 * m) & big) | ((ivec)m & ~big));
+  e -= big; /* big is -1 where true */
+  const vec s = (m - 1.0) / (m + 1.0), s2 = s * s;
+  vec series = VZERO + 1.0 / 27.0;
+  for (int k = 12; k >= 0; --k)
+    series = series * s2 + 1.0 / (2 * k + 1);
+  const vec r = 2.0 * s * series + 0.69314718055994530942 * __builtin_convertvector(e, vec);
+  const ivec finite = (x > 0.0) & (x < INFINITY), infinite = x == INFINITY;
+  const ivec special = ((ivec)(VZERO + INFINITY) & infinite) | ((ivec)(VZERO + NAN) & ~infinite);
+  return (vec)(((ivec)r & finite) | (special & ~finite));
+}
+
+INLINE vec vcbrt(vec x)
+{
+  vec r;
+  for (int k = 0; k < LANES; ++k)
+    r[k] = cbrt(x[k]);
+  return r;
+}
+
+/* The sum of the first nb lanes. */
+INLINE double lane_sum(vec x, int nb)
+{
+  double s = 0.0;
+  for (int k = 0; k < nb; ++k)
+    s += x[k];
+  return s;
+}
+
+#endif

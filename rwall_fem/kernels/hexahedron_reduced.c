@@ -1,0 +1,260 @@
+/* Internal force of the one-point Q1 hexahedron with hourglass control.
+ *
+ * Notation (docs/theory.md, "One-point hexahedra"): node I of DOLFINx's
+ * numbering has reference signs Lambda_I = (xi_I, eta_I, zeta_I) and hourglass
+ * signs h_I = (eta_I zeta_I, xi_I zeta_I, xi_I eta_I, xi_I eta_I zeta_I).  From
+ * the nodal coordinates,
+ *     e_k = 1/8 sum_I Lambda_kI x_I   (the columns of the Jacobian at the centre),
+ *     c_a = 1/8 sum_I h_aI x_I        (the coordinates' hourglass parts),
+ * the exact volume is the cubic
+ *     V = 8 [e0.(e1 x e2) + (e0.(c2 x c1) + c1.(c0 x e2) + c2.(e1 x c0)) / 3]
+ * and its gradient dV/dx_I gives the uniform (mean) gradient of Flanagan and
+ * Belytschko (1981), b_I = (1/V) int grad N_I dV = (dV/dx_I) / V.  The centre
+ * point integrates f_I = |V| T(grad u) b_I, with grad u = sum_I u_I (x) b_I
+ * (a linear field gives exactly zero force on interior nodes: the patch test).
+ *
+ * Hourglass modes: q_a = sum_I gamma_aI u_I with gamma_aI = h_aI / 8 - c_a . b_I,
+ * orthogonal to every linear field.  The hourglass generalized forces Q_a act
+ * back through f_I += sum_a gamma_aI Q_a:
+ * - "physical" (assumed strain, Belytschko and Bindeman 1993, the kind of
+ *   Radioss's HEPH): the trilinear field's strain at xi is eps_0 plus
+ *   xi A_xi + eta A_eta + zeta A_zeta + eta zeta A_etazeta + ..., with
+ *   A_xi = sym(q1 (x) g2 + q2 (x) g1), ..., A_etazeta = sym(q3 (x) g0), ... and
+ *   g_k = grad xi_k at the centre (rows of J0^-1).  Integrating its energy over
+ *   the cube (means 1/3 and 1/9 of the squared monomials) gives
+ *   Q0 = |V|/3 (S_zeta g1 + S_eta g2), Q1 = |V|/3 (S_zeta g0 + S_xi g2),
+ *   Q2 = |V|/3 (S_eta g0 + S_xi g1), Q3 = |V|/9 (S_etazeta g0 + S_xizeta g1 + S_xieta g2)
+ *   with S = lambda tr(A) I + 2 mu A: on a parallelepiped exactly the fully
+ *   integrated Q1 element for linear elasticity; stored energy 1/2 sum Q_a . q_a.
+ * - "stiffness" (Flanagan-Belytschko): Q_a = kappa q_a,
+ *   kappa = (lambda + 2 mu) |V| (sum_I b_I . b_I) / 3; stored energy 1/2 kappa |q|^2.
+ * - "viscous" (Flanagan-Belytschko with LS-DYNA's scaling of its type 1-3 forms):
+ *   Q_a = 16 rho c |V|^(2/3) qdot_a, qdot_a = sum_I gamma_aI v_I; dissipates
+ *   dt sum_a Q_a . qdot_a per step.
+ * each times the hourglass coefficient.  energy[0] += stored elastic energy,
+ * energy[1] += hourglass energy (stored) or its dissipation in this step.
+ */
+#include "materials.h"
+
+enum
+{
+  HOURGLASS_NONE = 0,
+  HOURGLASS_PHYSICAL = 1,
+  HOURGLASS_STIFFNESS = 2,
+  HOURGLASS_VISCOUS = 3
+};
+
+static const double LAMBDA_SIGN[3][8] = {{-1, 1, -1, 1, -1, 1, -1, 1},
+                                         {-1, -1, 1, 1, -1, -1, 1, 1},
+                                         {-1, -1, -1, -1, 1, 1, 1, 1}};
+static const double H_SIGN[4][8] = {{1, 1, -1, -1, -1, -1, 1, 1},
+                                    {1, -1, 1, -1, -1, 1, -1, 1},
+                                    {1, -1, -1, 1, 1, -1, -1, 1},
+                                    {-1, 1, 1, -1, 1, -1, -1, 1}};
+
+/* (lambda tr(A) I + 2 mu A) y with A = sym(a (x) g + b (x) h): an hourglass stress applied to y. */
+INLINE void hourglass_stress_times(const vec a[3], const vec g[3], const vec b[3], const vec h[3],
+                                   const vec y[3], double lambda, double mu, vec out[3])
+{
+  const vec tr = dot3(a, g) + dot3(b, h);
+  const vec gy = dot3(g, y), ay = dot3(a, y), hy = dot3(h, y), by = dot3(b, y);
+  for (int i = 0; i < 3; ++i)
+    out[i] = lambda * tr * y[i] + mu * (a[i] * gy + g[i] * ay + b[i] * hy + h[i] * by);
+}
+
+/* The nodal forces f[3 I + i] of a batch; *stored += elastic energy, *hourglass_energy +=
+ * hourglass energy (stored) or dissipation (viscous), per cell. */
+INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const vec *restrict u,
+                       const vec *restrict v, vec *restrict f, vec *restrict stored,
+                       vec *restrict hourglass_energy, const element_params *p)
+{
+  vec e[3][3], c[4][3];
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int m = 0; m < 3; ++m)
+    {
+      e[m][i] = VZERO;
+      for (int I = 0; I < 8; ++I)
+        e[m][i] += (0.125 * LAMBDA_SIGN[m][I]) * x[3 * I + i];
+    }
+    for (int a = 0; a < 4; ++a)
+    {
+      c[a][i] = VZERO;
+      for (int I = 0; I < 8; ++I)
+        c[a][i] += (0.125 * H_SIGN[a][I]) * x[3 * I + i];
+    }
+  }
+  /* dV/dx_I = sum_m Lambda_mI D_m + sum_a<3 h_aI M_a */
+  vec E[3][3], D[3][3], M[3][3], t1[3], t2[3];
+  cross(e[1], e[2], E[0]);
+  cross(e[2], e[0], E[1]);
+  cross(e[0], e[1], E[2]);
+  cross(c[2], c[1], t1);
+  for (int i = 0; i < 3; ++i)
+    D[0][i] = E[0][i] + (1.0 / 3.0) * t1[i];
+  cross(c[0], c[2], t1);
+  for (int i = 0; i < 3; ++i)
+    D[1][i] = E[1][i] + (1.0 / 3.0) * t1[i];
+  cross(c[1], c[0], t1);
+  for (int i = 0; i < 3; ++i)
+    D[2][i] = E[2][i] + (1.0 / 3.0) * t1[i];
+  cross(e[2], c[1], t1);
+  cross(c[2], e[1], t2);
+  for (int i = 0; i < 3; ++i)
+    M[0][i] = (1.0 / 3.0) * (t1[i] + t2[i]);
+  cross(e[0], c[2], t1);
+  cross(c[0], e[2], t2);
+  for (int i = 0; i < 3; ++i)
+    M[1][i] = (1.0 / 3.0) * (t1[i] + t2[i]);
+  cross(c[1], e[0], t1);
+  cross(e[1], c[0], t2);
+  for (int i = 0; i < 3; ++i)
+    M[2][i] = (1.0 / 3.0) * (t1[i] + t2[i]);
+
+  const vec det0 = dot3(e[0], E[0]);
+  cross(c[2], c[1], t1);
+  vec V = dot3(e[0], t1);
+  cross(c[0], e[2], t1);
+  V += dot3(c[1], t1);
+  cross(e[1], c[0], t1);
+  V += dot3(c[2], t1);
+  V = 8.0 * det0 + (8.0 / 3.0) * V;
+  const vec volume = vabs(V), inv_V = 1.0 / V;
+
+  vec b[8][3], L[9], T[9];
+  for (int I = 0; I < 8; ++I)
+    for (int j = 0; j < 3; ++j)
+      b[I][j] = (LAMBDA_SIGN[0][I] * D[0][j] + LAMBDA_SIGN[1][I] * D[1][j]
+                 + LAMBDA_SIGN[2][I] * D[2][j] + H_SIGN[0][I] * M[0][j] + H_SIGN[1][I] * M[1][j]
+                 + H_SIGN[2][I] * M[2][j]) * inv_V;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+    {
+      L[3 * i + j] = VZERO;
+      for (int I = 0; I < 8; ++I)
+        L[3 * i + j] += u[3 * I + i] * b[I][j];
+    }
+  *stored = volume * stress(model, L, p->lmbda, p->mu, T);
+  for (int I = 0; I < 8; ++I)
+    for (int i = 0; i < 3; ++i)
+      f[3 * I + i] = volume * (T[3 * i] * b[I][0] + T[3 * i + 1] * b[I][1] + T[3 * i + 2] * b[I][2]);
+  *hourglass_energy = VZERO;
+  if (hourglass == HOURGLASS_NONE)
+    return;
+
+  /* gamma_aI = h_aI / 8 - c_a . b_I, and the hourglass amplitudes of u (v for the viscous form). */
+  const vec *field = hourglass == HOURGLASS_VISCOUS ? v : u;
+  vec gamma[4][8], q[4][3], Q[4][3];
+  for (int a = 0; a < 4; ++a)
+  {
+    for (int I = 0; I < 8; ++I)
+      gamma[a][I] = 0.125 * H_SIGN[a][I] - dot3(c[a], b[I]);
+    for (int i = 0; i < 3; ++i)
+    {
+      q[a][i] = VZERO;
+      for (int I = 0; I < 8; ++I)
+        q[a][i] += gamma[a][I] * field[3 * I + i];
+    }
+  }
+  const double scale = p->hourglass_coefficient;
+  if (hourglass == HOURGLASS_PHYSICAL)
+  {
+    const double lambda = p->lmbda, mu = p->mu;
+    const vec zero[3] = {VZERO, VZERO, VZERO};
+    vec g[3][3], s1[3], s2[3], s3[3];
+    const vec inv_det0 = 1.0 / det0;
+    for (int m = 0; m < 3; ++m)
+      for (int i = 0; i < 3; ++i)
+        g[m][i] = E[m][i] * inv_det0;
+    const vec third = (scale / 3.0) * volume, ninth = (scale / 9.0) * volume;
+    /* Q0 = |V|/3 (S_zeta g1 + S_eta g2); A_zeta = sym(q0 g1 + q1 g0), A_eta = sym(q0 g2 + q2 g0) */
+    hourglass_stress_times(q[0], g[1], q[1], g[0], g[1], lambda, mu, s1);
+    hourglass_stress_times(q[0], g[2], q[2], g[0], g[2], lambda, mu, s2);
+    for (int i = 0; i < 3; ++i)
+      Q[0][i] = third * (s1[i] + s2[i]);
+    /* Q1 = |V|/3 (S_zeta g0 + S_xi g2); A_xi = sym(q1 g2 + q2 g1) */
+    hourglass_stress_times(q[0], g[1], q[1], g[0], g[0], lambda, mu, s1);
+    hourglass_stress_times(q[1], g[2], q[2], g[1], g[2], lambda, mu, s2);
+    for (int i = 0; i < 3; ++i)
+      Q[1][i] = third * (s1[i] + s2[i]);
+    /* Q2 = |V|/3 (S_eta g0 + S_xi g1) */
+    hourglass_stress_times(q[0], g[2], q[2], g[0], g[0], lambda, mu, s1);
+    hourglass_stress_times(q[1], g[2], q[2], g[1], g[1], lambda, mu, s2);
+    for (int i = 0; i < 3; ++i)
+      Q[2][i] = third * (s1[i] + s2[i]);
+    /* Q3 = |V|/9 (S_etazeta g0 + S_xizeta g1 + S_xieta g2), A_.. = sym(q3 g_k) */
+    hourglass_stress_times(q[3], g[0], zero, zero, g[0], lambda, mu, s1);
+    hourglass_stress_times(q[3], g[1], zero, zero, g[1], lambda, mu, s2);
+    hourglass_stress_times(q[3], g[2], zero, zero, g[2], lambda, mu, s3);
+    for (int i = 0; i < 3; ++i)
+      Q[3][i] = ninth * (s1[i] + s2[i] + s3[i]);
+  }
+  else
+  {
+    vec kappa;
+    if (hourglass == HOURGLASS_STIFFNESS)
+    {
+      vec bb = VZERO;
+      for (int I = 0; I < 8; ++I)
+        bb += dot3(b[I], b[I]);
+      kappa = (scale * (p->lmbda + 2.0 * p->mu) / 3.0) * volume * bb;
+    }
+    else
+      kappa = (scale * 16.0 * p->density * p->wave_speed) * vcbrt(volume * volume);
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i)
+        Q[a][i] = kappa * q[a][i];
+  }
+  vec work = VZERO;
+  for (int a = 0; a < 4; ++a)
+    work += dot3(Q[a], q[a]);
+  *hourglass_energy = hourglass == HOURGLASS_VISCOUS ? p->dt * work : 0.5 * work;
+  for (int I = 0; I < 8; ++I)
+    for (int i = 0; i < 3; ++i)
+      f[3 * I + i] += gamma[0][I] * Q[0][i] + gamma[1][I] * Q[1][i] + gamma[2][I] * Q[2][i]
+                      + gamma[3][I] * Q[3][i];
+}
+
+INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
+                        const int32_t *restrict cells, const double *restrict X,
+                        const double *restrict u, const double *restrict v,
+                        const element_params *p, double *restrict f, double *restrict energy)
+{
+  vec x[24], ue[24], ve[24], fe[24], stored, hourglass_energy;
+  double total = 0.0, hourglass_total = 0.0;
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 8, c0, nb, X, x);
+    gather(cells, 8, c0, nb, u, ue);
+    if (hourglass == HOURGLASS_VISCOUS)
+      gather(cells, 8, c0, nb, v, ve);
+    hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p);
+    scatter_add(cells, 8, c0, nb, fe, f);
+    total += lane_sum(stored, nb);
+    hourglass_total += lane_sum(hourglass_energy, nb);
+  }
+  energy[0] += total;
+  energy[1] += hourglass_total;
+}
+
+/* One function per law and hourglass control: f += f_int(u) on the cells (N); energy[0] +=
+ * stored elastic energy (J), energy[1] += hourglass energy or dissipation (J). v (m/s) is
+ * read by the viscous form only. */
+#define HEX8R(MODEL, model_name, HOURGLASS, hourglass_name)                                    \
+  void hex8r_##model_name##_##hourglass_name(int64_t n, const int32_t *cells, const double *X, \
+                                             const double *u, const double *v,                 \
+                                             const element_params *p, double *f,               \
+                                             double *energy)                                   \
+  {                                                                                            \
+    hex8r_force(MODEL, HOURGLASS, n, cells, X, u, v, p, f, energy);                            \
+  }
+#define HEX8R_ALL_HOURGLASS(MODEL, model_name)                                                 \
+  HEX8R(MODEL, model_name, HOURGLASS_NONE, none)                                               \
+  HEX8R(MODEL, model_name, HOURGLASS_PHYSICAL, physical)                                       \
+  HEX8R(MODEL, model_name, HOURGLASS_STIFFNESS, stiffness)                                     \
+  HEX8R(MODEL, model_name, HOURGLASS_VISCOUS, viscous)
+
+HEX8R_ALL_HOURGLASS(LINEAR_ELASTIC, linear_elastic)
+HEX8R_ALL_HOURGLASS(SAINT_VENANT_KIRCHHOFF, saint_venant_kirchhoff)
+HEX8R_ALL_HOURGLASS(NEO_HOOKEAN, neo_hookean)

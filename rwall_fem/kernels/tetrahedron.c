@@ -1,0 +1,78 @@
+/* Internal force of the P1 (constant-strain) tetrahedron.
+ *
+ * With d_k = x_k - x_0 (k = 1, 2, 3) and det = d_1 . (d_2 x d_3), the shape
+ * function gradients are grad N_1 = d_2 x d_3 / det, grad N_2 = d_3 x d_1 / det,
+ * grad N_3 = d_1 x d_2 / det, grad N_0 = -(grad N_1 + grad N_2 + grad N_3), and
+ * the volume is |det| / 6 (either vertex orientation).  One integration point
+ * is exact for P1: f_I = V T(grad u) grad N_I (materials.h).
+ */
+#include "materials.h"
+
+/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell. */
+INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, vec *restrict f,
+                     const element_params *p)
+{
+  vec d[3][3], g[4][3];
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < 3; ++i)
+      d[a][i] = x[3 * (a + 1) + i] - x[i];
+  cross(d[1], d[2], g[1]);
+  cross(d[2], d[0], g[2]);
+  cross(d[0], d[1], g[3]);
+  const vec det = dot3(d[0], g[1]), inv_det = 1.0 / det;
+  for (int i = 0; i < 3; ++i)
+  {
+    g[1][i] *= inv_det;
+    g[2][i] *= inv_det;
+    g[3][i] *= inv_det;
+    g[0][i] = -(g[1][i] + g[2][i] + g[3][i]);
+  }
+  const vec volume = (1.0 / 6.0) * vabs(det);
+  vec L[9], T[9];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      L[3 * i + j] = u[i] * g[0][j] + u[3 + i] * g[1][j] + u[6 + i] * g[2][j] + u[9 + i] * g[3][j];
+  const vec w = volume * stress(model, L, p->lmbda, p->mu, T);
+  for (int I = 0; I < 4; ++I)
+    for (int i = 0; i < 3; ++i)
+      f[3 * I + i] = volume * (T[3 * i] * g[I][0] + T[3 * i + 1] * g[I][1] + T[3 * i + 2] * g[I][2]);
+  return w;
+}
+
+INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cells,
+                       const double *restrict X, const double *restrict u,
+                       const element_params *p, double *restrict f, double *restrict energy)
+{
+  vec x[12], ue[12], fe[12];
+  double total = 0.0;
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 4, c0, nb, X, x);
+    gather(cells, 4, c0, nb, u, ue);
+    const vec w = tet4_cell(model, x, ue, fe, p);
+    scatter_add(cells, 4, c0, nb, fe, f);
+    total += lane_sum(w, nb);
+  }
+  energy[0] += total;
+}
+
+/* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */
+void tet4_linear_elastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                         const element_params *p, double *f, double *energy)
+{
+  tet4_force(LINEAR_ELASTIC, n, cells, X, u, p, f, energy);
+}
+
+void tet4_saint_venant_kirchhoff(int64_t n, const int32_t *cells, const double *X,
+                                 const double *u, const element_params *p, double *f,
+                                 double *energy)
+{
+  tet4_force(SAINT_VENANT_KIRCHHOFF, n, cells, X, u, p, f, energy);
+}
+
+void tet4_neo_hookean(int64_t n, const int32_t *cells, const double *X, const double *u,
+                      const element_params *p, double *f, double *energy)
+{
+  tet4_force(NEO_HOOKEAN, n, cells, X, u, p, f, energy);
+}
