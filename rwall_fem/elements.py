@@ -205,12 +205,21 @@ class ElementForce:
         """
         if self._probe is None:
             V = self._space
-            fields = GhostedField(V), GhostedField(V), GhostedField(V)
-            self._probe = (*fields, self._bind(*(g.array for g in fields), np.zeros(2)))
-        u_probe, _, f_probe, kernel = self._probe
+            fields, energy = (GhostedField(V), GhostedField(V), GhostedField(V)), np.zeros(2)
+            self._probe = (*fields, self._bind(*(g.array for g in fields), energy), energy)
+        u_probe, _, f_probe, kernel, energy = self._probe
         u_probe.owned[:] = u
         u_probe.scatter_forward()
         f_probe.array.fill(0.0)
+        energy[:] = 0.0
         kernel()
         f_probe.scatter_reverse_add()
         return f_probe.owned.copy()
+
+    def stored_energy_at(self, u: np.ndarray) -> float:
+        """Elastic plus stored hourglass energy (J) of the whole body at a displacement ``u``
+        (owned, (n, 3)), summed over ranks; the body's state is left as it is."""
+        self.forces(u)
+        energy = self._probe[4]
+        stored = energy[0] + (energy[1] if self.conservative else 0.0)
+        return self._space.mesh.comm.allreduce(float(stored))

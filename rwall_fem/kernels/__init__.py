@@ -32,8 +32,8 @@ from pathlib import Path
 
 __all__ = ["KernelBuildError", "load"]
 
-SOURCES = ("batch.h", "materials.h", "tetrahedron.c", "hexahedron.c",
-           "hexahedron_reduced.c", "update.c")  # fmt: skip
+SOURCES = ("batch.h", "materials.h", "plasticity.h", "tetrahedron.c", "hexahedron.c",
+           "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
 FLAG_SETS = (
     ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno"],
     ["-O3", "-fopenmp-simd", "-fno-math-errno"],
@@ -44,7 +44,28 @@ HOURGLASS = ("none", "physical", "stiffness", "viscous")
 _CDEF = """
 typedef struct {
   double lmbda, mu, density, wave_speed, hourglass_coefficient, dt;
+  int hardening;
+  double yield_stress, hardening_modulus, hardening_coefficient, hardening_exponent;
+  double rate_coefficient, reference_rate;
+  int thermal;
+  double thermal_exponent, melting_temperature, room_temperature, specific_heat, taylor_quinney;
+  int table_size;
+  double table_strain[64], table_stress[64];
 } element_params;
+double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
+                     const double dL[9]);
+void tet4_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                  const double *v, const element_params *p, double *state, int64_t stride,
+                  double *f, double *energy);
+void hex8_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                  const double *v, const element_params *p, double *state, int64_t stride,
+                  double *f, double *energy);
+""" + "".join(
+    f"void hex8r_plastic_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
+    " const double *u, const double *v, const element_params *p, double *state,"
+    " int64_t stride, double *f, double *energy);\n"
+    for hourglass in HOURGLASS
+) + """
 void accelerate(int64_t n, const double *f, const double *inv_mass, double *a);
 void advance(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
              const double *f, double out[3]);

@@ -25,6 +25,8 @@ typedef double vec __attribute__((vector_size(LANES * sizeof(double))));
 typedef int64_t ivec __attribute__((vector_size(LANES * sizeof(int64_t))));
 #define VZERO ((vec){0.0})
 
+#define TABLE_ROWS 64
+
 /* Material and technology constants of one kernel call. */
 typedef struct
 {
@@ -33,7 +35,23 @@ typedef struct
   double density;     /* kg/m^3 */
   double wave_speed;  /* dilatational wave speed sqrt((lambda + 2 mu)/density), m/s */
   double hourglass_coefficient; /* scales the hourglass forces (one-point hexahedra) */
-  double dt;          /* time step, s (viscous hourglass dissipation) */
+  double dt;          /* time step, s (viscous hourglass, plastic strain rates) */
+  /* plasticity (plasticity.h) */
+  int hardening;                /* HARDENING_LINEAR, _POWER, _TABLE or JOHNSON_COOK */
+  double yield_stress;          /* A, Pa */
+  double hardening_modulus;     /* H, Pa (linear) */
+  double hardening_coefficient; /* B, Pa (power law, Johnson-Cook) */
+  double hardening_exponent;    /* n */
+  double rate_coefficient;      /* C (Johnson-Cook) */
+  double reference_rate;        /* 1/s (Johnson-Cook) */
+  int thermal;                  /* adiabatic heating and thermal softening (Johnson-Cook) */
+  double thermal_exponent;      /* m */
+  double melting_temperature;   /* K */
+  double room_temperature;      /* K */
+  double specific_heat;         /* J/(kg K) */
+  double taylor_quinney;        /* share of plastic work turned into heat */
+  int table_size;               /* rows of the table */
+  double table_strain[TABLE_ROWS], table_stress[TABLE_ROWS]; /* eps_p (increasing), Pa */
 } element_params;
 
 /* Gather the 3 components of the npe nodes of cells c0 .. c0 + LANES - 1 into
@@ -109,6 +127,14 @@ INLINE vec vcbrt(vec x)
   vec r;
   for (int k = 0; k < LANES; ++k)
     r[k] = cbrt(x[k]);
+  return r;
+}
+
+INLINE vec vsqrt(vec x)
+{
+  vec r;
+  for (int k = 0; k < LANES; ++k)
+    r[k] = sqrt(x[k]);
   return r;
 }
 

@@ -35,6 +35,7 @@
  * energy[1] += hourglass energy (stored) or its dissipation in this step.
  */
 #include "materials.h"
+#include "plasticity.h"
 
 enum
 {
@@ -62,13 +63,19 @@ INLINE void hourglass_stress_times(const vec a[3], const vec g[3], const vec b[3
     out[i] = lambda * tr * y[i] + mu * (a[i] * gy + g[i] * ay + b[i] * hy + h[i] * by);
 }
 
-/* The nodal forces f[3 I + i] of a batch; *stored += elastic energy, *hourglass_energy +=
- * hourglass energy (stored) or dissipation (viscous), per cell. */
-INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const vec *restrict u,
-                       const vec *restrict v, vec *restrict f, vec *restrict stored,
-                       vec *restrict hourglass_energy, const element_params *p)
+/* What the one-point hexahedron needs of its nodal coordinates. */
+typedef struct
 {
-  vec e[3][3], c[4][3];
+  vec c[4][3];   /* hourglass parts of the coordinates, m */
+  vec E[3][3];   /* e1 x e2, e2 x e0, e0 x e1: det0 times the rows of J0^-1, m^2 */
+  vec det0;      /* det J0, m^3 / 8 */
+  vec volume;    /* |V|, m^3 */
+  vec b[8][3];   /* uniform gradient, 1/m */
+} hex8r_geometry_t;
+
+INLINE void hex8r_geometry(const vec *restrict x, hex8r_geometry_t *geo)
+{
+  vec e[3][3], (*c)[3] = geo->c, (*E)[3] = geo->E;
   for (int i = 0; i < 3; ++i)
   {
     for (int m = 0; m < 3; ++m)
@@ -85,7 +92,7 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
     }
   }
   /* dV/dx_I = sum_m Lambda_mI D_m + sum_a<3 h_aI M_a */
-  vec E[3][3], D[3][3], M[3][3], t1[3], t2[3];
+  vec D[3][3], M[3][3], t1[3], t2[3];
   cross(e[1], e[2], E[0]);
   cross(e[2], e[0], E[1]);
   cross(e[0], e[1], E[2]);
@@ -111,62 +118,76 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
   for (int i = 0; i < 3; ++i)
     M[2][i] = (1.0 / 3.0) * (t1[i] + t2[i]);
 
-  const vec det0 = dot3(e[0], E[0]);
+  geo->det0 = dot3(e[0], E[0]);
   cross(c[2], c[1], t1);
   vec V = dot3(e[0], t1);
   cross(c[0], e[2], t1);
   V += dot3(c[1], t1);
   cross(e[1], c[0], t1);
   V += dot3(c[2], t1);
-  V = 8.0 * det0 + (8.0 / 3.0) * V;
-  const vec volume = vabs(V), inv_V = 1.0 / V;
-
-  vec b[8][3], L[9], T[9];
+  V = 8.0 * geo->det0 + (8.0 / 3.0) * V;
+  geo->volume = vabs(V);
+  const vec inv_V = 1.0 / V;
   for (int I = 0; I < 8; ++I)
     for (int j = 0; j < 3; ++j)
-      b[I][j] = (LAMBDA_SIGN[0][I] * D[0][j] + LAMBDA_SIGN[1][I] * D[1][j]
-                 + LAMBDA_SIGN[2][I] * D[2][j] + H_SIGN[0][I] * M[0][j] + H_SIGN[1][I] * M[1][j]
-                 + H_SIGN[2][I] * M[2][j]) * inv_V;
+      geo->b[I][j] = (LAMBDA_SIGN[0][I] * D[0][j] + LAMBDA_SIGN[1][I] * D[1][j]
+                      + LAMBDA_SIGN[2][I] * D[2][j] + H_SIGN[0][I] * M[0][j]
+                      + H_SIGN[1][I] * M[1][j] + H_SIGN[2][I] * M[2][j]) * inv_V;
+}
+
+/* L = sum_I w_I (x) b_I for nodal vectors w[3 I + i]. */
+INLINE void hex8r_gradient(const vec *restrict w, const hex8r_geometry_t *geo, vec L[9])
+{
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
     {
       L[3 * i + j] = VZERO;
       for (int I = 0; I < 8; ++I)
-        L[3 * i + j] += u[3 * I + i] * b[I][j];
+        L[3 * i + j] += w[3 * I + i] * geo->b[I][j];
     }
-  *stored = volume * stress(model, L, p->lmbda, p->mu, T);
+}
+
+/* f_I = |V| T b_I */
+INLINE void hex8r_nodal_forces(const hex8r_geometry_t *geo, const vec T[9], vec *restrict f)
+{
   for (int I = 0; I < 8; ++I)
     for (int i = 0; i < 3; ++i)
-      f[3 * I + i] = volume * (T[3 * i] * b[I][0] + T[3 * i + 1] * b[I][1] + T[3 * i + 2] * b[I][2]);
-  *hourglass_energy = VZERO;
-  if (hourglass == HOURGLASS_NONE)
-    return;
+      f[3 * I + i] = geo->volume * (T[3 * i] * geo->b[I][0] + T[3 * i + 1] * geo->b[I][1]
+                                    + T[3 * i + 2] * geo->b[I][2]);
+}
 
-  /* gamma_aI = h_aI / 8 - c_a . b_I, and the hourglass amplitudes of u (v for the viscous form). */
-  const vec *field = hourglass == HOURGLASS_VISCOUS ? v : u;
-  vec gamma[4][8], q[4][3], Q[4][3];
+/* gamma_aI = h_aI / 8 - c_a . b_I, and the hourglass amplitudes q_a = sum_I gamma_aI w_I. */
+INLINE void hourglass_modes(const hex8r_geometry_t *geo, const vec *restrict w, vec gamma[4][8],
+                            vec q[4][3])
+{
   for (int a = 0; a < 4; ++a)
   {
     for (int I = 0; I < 8; ++I)
-      gamma[a][I] = 0.125 * H_SIGN[a][I] - dot3(c[a], b[I]);
+      gamma[a][I] = 0.125 * H_SIGN[a][I] - dot3(geo->c[a], geo->b[I]);
     for (int i = 0; i < 3; ++i)
     {
       q[a][i] = VZERO;
       for (int I = 0; I < 8; ++I)
-        q[a][i] += gamma[a][I] * field[3 * I + i];
+        q[a][i] += gamma[a][I] * w[3 * I + i];
     }
   }
+}
+
+/* The generalized hourglass forces Q_a of amplitudes q_a: linear in q (see the header). */
+INLINE void hourglass_forces(int hourglass, const hex8r_geometry_t *geo, const vec q[4][3],
+                             const element_params *p, vec Q[4][3])
+{
   const double scale = p->hourglass_coefficient;
   if (hourglass == HOURGLASS_PHYSICAL)
   {
     const double lambda = p->lmbda, mu = p->mu;
     const vec zero[3] = {VZERO, VZERO, VZERO};
     vec g[3][3], s1[3], s2[3], s3[3];
-    const vec inv_det0 = 1.0 / det0;
+    const vec inv_det0 = 1.0 / geo->det0;
     for (int m = 0; m < 3; ++m)
       for (int i = 0; i < 3; ++i)
-        g[m][i] = E[m][i] * inv_det0;
-    const vec third = (scale / 3.0) * volume, ninth = (scale / 9.0) * volume;
+        g[m][i] = geo->E[m][i] * inv_det0;
+    const vec third = (scale / 3.0) * geo->volume, ninth = (scale / 9.0) * geo->volume;
     /* Q0 = |V|/3 (S_zeta g1 + S_eta g2); A_zeta = sym(q0 g1 + q1 g0), A_eta = sym(q0 g2 + q2 g0) */
     hourglass_stress_times(q[0], g[1], q[1], g[0], g[1], lambda, mu, s1);
     hourglass_stress_times(q[0], g[2], q[2], g[0], g[2], lambda, mu, s2);
@@ -188,31 +209,55 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
     hourglass_stress_times(q[3], g[2], zero, zero, g[2], lambda, mu, s3);
     for (int i = 0; i < 3; ++i)
       Q[3][i] = ninth * (s1[i] + s2[i] + s3[i]);
+    return;
+  }
+  vec kappa;
+  if (hourglass == HOURGLASS_STIFFNESS)
+  {
+    vec bb = VZERO;
+    for (int I = 0; I < 8; ++I)
+      bb += dot3(geo->b[I], geo->b[I]);
+    kappa = (scale * (p->lmbda + 2.0 * p->mu) / 3.0) * geo->volume * bb;
   }
   else
-  {
-    vec kappa;
-    if (hourglass == HOURGLASS_STIFFNESS)
-    {
-      vec bb = VZERO;
-      for (int I = 0; I < 8; ++I)
-        bb += dot3(b[I], b[I]);
-      kappa = (scale * (p->lmbda + 2.0 * p->mu) / 3.0) * volume * bb;
-    }
-    else
-      kappa = (scale * 16.0 * p->density * p->wave_speed) * vcbrt(volume * volume);
-    for (int a = 0; a < 4; ++a)
-      for (int i = 0; i < 3; ++i)
-        Q[a][i] = kappa * q[a][i];
-  }
-  vec work = VZERO;
+    kappa = (scale * 16.0 * p->density * p->wave_speed) * vcbrt(geo->volume * geo->volume);
   for (int a = 0; a < 4; ++a)
-    work += dot3(Q[a], q[a]);
-  *hourglass_energy = hourglass == HOURGLASS_VISCOUS ? p->dt * work : 0.5 * work;
+    for (int i = 0; i < 3; ++i)
+      Q[a][i] = kappa * q[a][i];
+}
+
+/* f_I += sum_a gamma_aI Q_a */
+INLINE void hourglass_nodal_forces(const vec gamma[4][8], const vec Q[4][3], vec *restrict f)
+{
   for (int I = 0; I < 8; ++I)
     for (int i = 0; i < 3; ++i)
       f[3 * I + i] += gamma[0][I] * Q[0][i] + gamma[1][I] * Q[1][i] + gamma[2][I] * Q[2][i]
                       + gamma[3][I] * Q[3][i];
+}
+
+/* The nodal forces f[3 I + i] of a batch; *stored = elastic energy, *hourglass_energy =
+ * hourglass energy (stored) or dissipation in this step (viscous), per cell. */
+INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const vec *restrict u,
+                       const vec *restrict v, vec *restrict f, vec *restrict stored,
+                       vec *restrict hourglass_energy, const element_params *p)
+{
+  hex8r_geometry_t geo;
+  hex8r_geometry(x, &geo);
+  vec L[9], T[9];
+  hex8r_gradient(u, &geo, L);
+  *stored = geo.volume * stress(model, L, p->lmbda, p->mu, T);
+  hex8r_nodal_forces(&geo, T, f);
+  *hourglass_energy = VZERO;
+  if (hourglass == HOURGLASS_NONE)
+    return;
+  vec gamma[4][8], q[4][3], Q[4][3];
+  hourglass_modes(&geo, hourglass == HOURGLASS_VISCOUS ? v : u, gamma, q);
+  hourglass_forces(hourglass, &geo, q, p, Q);
+  vec work = VZERO;
+  for (int a = 0; a < 4; ++a)
+    work += dot3(Q[a], q[a]);
+  *hourglass_energy = hourglass == HOURGLASS_VISCOUS ? p->dt * work : 0.5 * work;
+  hourglass_nodal_forces(gamma, Q, f);
 }
 
 INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
@@ -238,6 +283,96 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
   energy[1] += hourglass_total;
 }
 
+/* Elasto-plastic one-point hexahedra (updated Lagrangian, plasticity.h): the increment
+ * du = dt v (dt = 0 at the first step) has its gradient taken with the uniform gradient of
+ * the mid-step configuration; the force is that of the updated stress in the current one,
+ * x = X + u.  The hourglass forces are incremental, Q^n = R Q^{n-1} + dQ(dq) with the
+ * element's rotation R and dq the hourglass amplitudes of du in the current configuration
+ * (the viscous form: Q = Q(dq / dt)); the state keeps Q after the point's slots.
+ * energy[0] += stored elastic energy (J), energy[1] += hourglass work of the step,
+ * energy[2] += plastic dissipation of the step. */
+INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restrict cells,
+                          const double *restrict X, const double *restrict u,
+                          const double *restrict v, const element_params *p,
+                          double *restrict state, int64_t stride, double *restrict f,
+                          double *restrict energy)
+{
+  vec Xe[24], ue[24], ve[24], fe[24];
+  double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0;
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 8, c0, nb, X, Xe);
+    gather(cells, 8, c0, nb, u, ue);
+    gather(cells, 8, c0, nb, v, ve);
+    vec x[24], xm[24], du[24], dL[9], sigma[9], eps_p, T;
+    for (int i = 0; i < 24; ++i)
+    {
+      du[i] = p->dt * ve[i];
+      x[i] = Xe[i] + ue[i];
+      xm[i] = x[i] - 0.5 * du[i];
+    }
+    hex8r_geometry_t geo;
+    hex8r_geometry(xm, &geo);
+    const vec mid_volume = geo.volume;
+    hex8r_gradient(du, &geo, dL);
+    load_point(state, stride, c0, nb, 0, sigma, &eps_p, &T);
+    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
+    store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
+    hex8r_geometry(x, &geo);
+    hex8r_nodal_forces(&geo, sigma, fe);
+    stored += lane_sum(geo.volume * elastic_energy_density(p, sigma), nb);
+    dissipated += lane_sum(mid_volume * dissipation, nb);
+    if (hourglass != HOURGLASS_NONE)
+    {
+      vec gamma[4][8], dq[4][3], Q[4][3], work = VZERO;
+      hourglass_modes(&geo, du, gamma, dq);
+      if (hourglass == HOURGLASS_VISCOUS)
+      {
+        const double rate = p->dt > 0.0 ? 1.0 / p->dt : 0.0;
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i)
+            dq[a][i] *= rate;
+        hourglass_forces(hourglass, &geo, dq, p, Q);
+        for (int a = 0; a < 4; ++a)
+          work += p->dt * dot3(Q[a], dq[a]);
+      }
+      else
+      {
+        vec R[9], Q_old[4][3], dQ[4][3];
+        rotation(dL, R);
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i)
+          {
+            vec value = VZERO;
+            for (int k = 0; k < LANES; ++k)
+              value[k] = state[(POINT_SLOTS + 3 * a + i) * stride + c0 + (k < nb ? k : 0)];
+            Q_old[a][i] = value;
+          }
+        hourglass_forces(hourglass, &geo, dq, p, dQ);
+        for (int a = 0; a < 4; ++a)
+        {
+          for (int i = 0; i < 3; ++i)
+          {
+            const vec rotated = R[3 * i] * Q_old[a][0] + R[3 * i + 1] * Q_old[a][1]
+                                + R[3 * i + 2] * Q_old[a][2];
+            Q[a][i] = rotated + dQ[a][i];
+            work += (rotated + 0.5 * dQ[a][i]) * dq[a][i];
+            for (int k = 0; k < nb; ++k)
+              state[(POINT_SLOTS + 3 * a + i) * stride + c0 + k] = Q[a][i][k];
+          }
+        }
+      }
+      hourglass_nodal_forces(gamma, Q, fe);
+      hourglass_work += lane_sum(work, nb);
+    }
+    scatter_add(cells, 8, c0, nb, fe, f);
+  }
+  energy[0] += stored;
+  energy[1] += hourglass_work;
+  energy[2] += dissipated;
+}
+
 /* One function per law and hourglass control: f += f_int(u) on the cells (N); energy[0] +=
  * stored elastic energy (J), energy[1] += hourglass energy or dissipation (J). v (m/s) is
  * read by the viscous form only. */
@@ -258,3 +393,16 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
 HEX8R_ALL_HOURGLASS(LINEAR_ELASTIC, linear_elastic)
 HEX8R_ALL_HOURGLASS(SAINT_VENANT_KIRCHHOFF, saint_venant_kirchhoff)
 HEX8R_ALL_HOURGLASS(NEO_HOOKEAN, neo_hookean)
+
+/* Elasto-plastic one-point hexahedra, one function per hourglass control (hex8r_plastic). */
+#define HEX8R_PLASTIC(HOURGLASS, hourglass_name)                                                \
+  void hex8r_plastic_##hourglass_name(int64_t n, const int32_t *cells, const double *X,        \
+                                      const double *u, const double *v, const element_params *p, \
+                                      double *state, int64_t stride, double *f, double *energy)  \
+  {                                                                                             \
+    hex8r_plastic(HOURGLASS, n, cells, X, u, v, p, state, stride, f, energy);                   \
+  }
+HEX8R_PLASTIC(HOURGLASS_NONE, none)
+HEX8R_PLASTIC(HOURGLASS_PHYSICAL, physical)
+HEX8R_PLASTIC(HOURGLASS_STIFFNESS, stiffness)
+HEX8R_PLASTIC(HOURGLASS_VISCOUS, viscous)

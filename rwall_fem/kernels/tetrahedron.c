@@ -4,15 +4,17 @@
  * function gradients are grad N_1 = d_2 x d_3 / det, grad N_2 = d_3 x d_1 / det,
  * grad N_3 = d_1 x d_2 / det, grad N_0 = -(grad N_1 + grad N_2 + grad N_3), and
  * the volume is |det| / 6 (either vertex orientation).  One integration point
- * is exact for P1: f_I = V T(grad u) grad N_I (materials.h).
+ * is exact for P1: f_I = V T(grad u) grad N_I (materials.h).  In isochoric
+ * plastic flow constant-strain tetrahedra lock (one volume constraint per cell):
+ * prefer hexahedra there (docs/theory.md).
  */
 #include "materials.h"
+#include "plasticity.h"
 
-/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell. */
-INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, vec *restrict f,
-                     const element_params *p)
+/* Shape function gradients g[I] (1/m) and volume (m^3) of the tetrahedra at x[3 I + i]. */
+INLINE vec tet4_geometry(const vec *restrict x, vec g[4][3])
 {
-  vec d[3][3], g[4][3];
+  vec d[3][3];
   for (int a = 0; a < 3; ++a)
     for (int i = 0; i < 3; ++i)
       d[a][i] = x[3 * (a + 1) + i] - x[i];
@@ -27,15 +29,34 @@ INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, ve
     g[3][i] *= inv_det;
     g[0][i] = -(g[1][i] + g[2][i] + g[3][i]);
   }
-  const vec volume = (1.0 / 6.0) * vabs(det);
-  vec L[9], T[9];
+  return (1.0 / 6.0) * vabs(det);
+}
+
+/* L = sum_I w_I (x) g_I for nodal vectors w[3 I + i]. */
+INLINE void tet4_gradient(const vec *restrict w, vec g[4][3], vec L[9])
+{
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      L[3 * i + j] = u[i] * g[0][j] + u[3 + i] * g[1][j] + u[6 + i] * g[2][j] + u[9 + i] * g[3][j];
-  const vec w = volume * stress(model, L, p->lmbda, p->mu, T);
+      L[3 * i + j] = w[i] * g[0][j] + w[3 + i] * g[1][j] + w[6 + i] * g[2][j] + w[9 + i] * g[3][j];
+}
+
+/* f_I = V T g_I */
+INLINE void tet4_nodal_forces(vec volume, const vec T[9], vec g[4][3], vec *restrict f)
+{
   for (int I = 0; I < 4; ++I)
     for (int i = 0; i < 3; ++i)
       f[3 * I + i] = volume * (T[3 * i] * g[I][0] + T[3 * i + 1] * g[I][1] + T[3 * i + 2] * g[I][2]);
+}
+
+/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell. */
+INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, vec *restrict f,
+                     const element_params *p)
+{
+  vec g[4][3], L[9], T[9];
+  const vec volume = tet4_geometry(x, g);
+  tet4_gradient(u, g, L);
+  const vec w = volume * stress(model, L, p->lmbda, p->mu, T);
+  tet4_nodal_forces(volume, T, g, f);
   return w;
 }
 
@@ -55,6 +76,46 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
     total += lane_sum(w, nb);
   }
   energy[0] += total;
+}
+
+/* Elasto-plastic tetrahedra (updated Lagrangian, plasticity.h): the increment du = dt v
+ * (dt = 0 at the first step: the state is the initial one) has its gradient taken in the
+ * mid-step configuration; the force is that of the updated stress in the current one,
+ * x = X + u.  energy[0] += stored elastic energy, energy[2] += plastic dissipation of the
+ * step (J).  state: POINT_SLOTS rows of `stride` (>= cells rounded up to LANES) values. */
+void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
+                  const double *restrict u, const double *restrict v, const element_params *p,
+                  double *restrict state, int64_t stride, double *restrict f,
+                  double *restrict energy)
+{
+  vec Xe[12], ue[12], ve[12], fe[12];
+  double stored = 0.0, dissipated = 0.0;
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 4, c0, nb, X, Xe);
+    gather(cells, 4, c0, nb, u, ue);
+    gather(cells, 4, c0, nb, v, ve);
+    vec x[12], xm[12], du[12], g[4][3], dL[9], sigma[9], eps_p, T;
+    for (int i = 0; i < 12; ++i)
+    {
+      du[i] = p->dt * ve[i];
+      x[i] = Xe[i] + ue[i];
+      xm[i] = x[i] - 0.5 * du[i];
+    }
+    const vec mid_volume = tet4_geometry(xm, g);
+    tet4_gradient(du, g, dL);
+    load_point(state, stride, c0, nb, 0, sigma, &eps_p, &T);
+    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
+    store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
+    const vec volume = tet4_geometry(x, g);
+    tet4_nodal_forces(volume, sigma, g, fe);
+    scatter_add(cells, 4, c0, nb, fe, f);
+    stored += lane_sum(volume * elastic_energy_density(p, sigma), nb);
+    dissipated += lane_sum(mid_volume * dissipation, nb);
+  }
+  energy[0] += stored;
+  energy[2] += dissipated;
 }
 
 /* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */
