@@ -27,7 +27,7 @@ class StaysInFront:
     is found behind it at the next (nodes beyond its edges may legitimately pass under it)."""
 
     def __init__(self, sim, wall=0):
-        self.wall, self.comm = sim.constraints[wall], sim.history.comm
+        self.wall, self.comm = sim.walls[wall], sim.comm
         self.facing, self.deepest = None, 0.0
         sim.recorders.append(self)
 
@@ -64,7 +64,7 @@ def check_stable(sim, probe, *, balance=1e-10, inside=1e-12, dissipative=True):
         f" {summary['wall_seconds']:.2f} s"
     )
     if dissipative:  # fixed or main-node walls only take energy out
-        scale = sim.history.reference_energy  # E0, or the largest energy if E0 = 0
+        scale = sim.history.balance.reference  # E0, or the largest energy if E0 = 0
         assert all(w["work"] <= 1e-12 * scale for w in summary["walls"])
     return summary
 

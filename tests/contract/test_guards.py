@@ -15,11 +15,7 @@ from conftest import SCENE, bar_scene, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
-from rwall_fem.history import WALL_COLUMNS
-
-serial_only = pytest.mark.skipif(
-    MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
-)
+from rwall_fem.output.wall_table import WALL_COLUMNS
 
 
 def complete_rows(path: Path, columns: int) -> list[list[float]]:
@@ -51,7 +47,7 @@ def test_energy_error_guard(shared_dir):
     assert "energy balance error" in sim.status and "exceeds run.max_energy_error" in sim.status
     assert "fastest node" in sim.status and "|v| = " in sim.status
     assert sim.history.summary["status"] == "stopped"
-    assert len(sim.history.energy_rows) < sim.num_steps + 1
+    assert len(sim.history.energy) < sim.num_steps + 1
 
 
 def test_min_dt_guard(shared_dir):
@@ -85,7 +81,7 @@ def _start_long_run(tmp_path):
     return process
 
 
-@serial_only
+@pytest.mark.serial
 def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     process = _start_long_run(tmp_path)
     process.send_signal(signal.SIGTERM)
@@ -100,7 +96,7 @@ def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
 
 
-@serial_only
+@pytest.mark.serial
 def test_sigkill_leaves_complete_csv_lines(tmp_path):
     process = _start_long_run(tmp_path)
     process.kill()
