@@ -4,3 +4,5 @@ Open and edit the ``.geo`` files here with gmsh. pyproject.toml installs this fo
 as the package ``rwall_fem.meshes``, so that the shapes work from an installed wheel;
 :mod:`rwall_fem.meshing` finds the files through ``importlib.resources``.
 """
+
+__all__: list[str] = []

@@ -49,7 +49,7 @@ class History:
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
         )
-        self.walls = WallTable(walls)
+        self.wall_table = WallTable(walls)
         self.summary: dict | None = None
         self._energy_csv = CsvTable(self.directory / "energy.csv", self.balance.columns, comm)
         self._walls_csv = CsvTable(self.directory / "walls.csv", WALL_COLUMNS, comm)
@@ -59,7 +59,7 @@ class History:
             comm,
             {name: () for name in self.balance.stored}
             | {"external_work": (), "wall_work": (len(walls), 2), "terminate": ()}
-            | self.walls.sums,
+            | self.wall_table.sums,
         )
         self._scratch = np.zeros_like(sim.state.v)
 
@@ -79,8 +79,9 @@ class History:
         )
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
+        # Sent with the sums, so that every rank stops at the same step when any got SIGTERM.
         local["terminate"][...] = sim.terminate_requested
-        self.walls.fill(local)
+        self.wall_table.fill(local)
         total = self._sums.reduce()
 
         energies = {name: float(total[name]) for name in self.balance.stored}
@@ -92,7 +93,7 @@ class History:
         energies["wall_work"] = float(total["wall_work"].sum())
         row = self.balance.sample(s.t, energies)
         self._energy_csv.rows.append(row)
-        self._walls_csv.rows += self.walls.rows(s, total)
+        self._walls_csv.rows += self.wall_table.rows(s, total)
         if time.monotonic() - self._written_at > FLUSH_SECONDS:
             self._flush()
         self.guards.check(
@@ -116,7 +117,7 @@ class History:
     def close(self, sim) -> None:
         """Write ``summary.json`` and the rows not yet written, close the CSV files (rank 0)
         and draw ``histories.png`` if asked."""
-        peaks = self.walls.peak_contacts
+        peaks = self.wall_table.peak_contacts
         self.summary = run_summary(sim, self.balance, peaks, self.initial_momentum)
         for table in self._tables:
             table.close()

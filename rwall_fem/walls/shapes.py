@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "SHAPES",
     "CylinderWall",
     "ParallelogramWall",
     "PlaneWall",
