@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
-import rwall_fem.model as model  # noqa: E402
+import rwall_fem.build as build  # noqa: E402
 from rwall_fem import build_simulation, parse_scene  # noqa: E402
 
 comm = MPI.COMM_WORLD
@@ -82,8 +82,8 @@ class FirstStep:
 
 
 def timed(name, table):
-    """Wrap model.<name> to add its duration to table[name] (start-up breakdown)."""
-    inner = getattr(model, name)
+    """Wrap build.<name> to add its duration to table[name] (start-up breakdown)."""
+    inner = getattr(build, name)
 
     def wrapper(*args, **kwargs):
         t0 = time.perf_counter()
@@ -92,7 +92,7 @@ def timed(name, table):
         finally:
             table[name] = table.get(name, 0.0) + time.perf_counter() - t0
 
-    setattr(model, name, wrapper)
+    setattr(build, name, wrapper)
 
 
 def mult_seconds(K, x, y, repeats):
@@ -128,7 +128,7 @@ def main():
         # Throughput only: a safe step from the element size instead of the eigenvalue
         # solve (which takes minutes on large hexahedral meshes; its cost is measured
         # with --real-dt at 10k cells).
-        model.critical_time_step = lambda K, mass, X: 0.3e-3 / 6000.0
+        build.critical_time_step = lambda K, mass, X: 0.3e-3 / 6000.0
     raw = scene(a.cell, a.n, a.steps, a.history_interval, wall=not a.no_wall)
     sc = parse_scene(raw, source="bench")
     t_build = time.perf_counter()
@@ -233,7 +233,7 @@ def extras(sim, K, x, y, a):
 
     out["update_seconds"] = best(update_now)
     # The wall alone: all boundary nodes (the default) against the bottom face only.
-    wall = sim.constraints[0]
+    wall = sim.walls[0]
     out["wall_nodes_default"] = comm.allreduce(len(wall.nodes))
     out["wall_seconds_default"] = best(lambda: wall.constrain(s), 100)
     out["wall_contacts"] = comm.allreduce(wall.contacts)
@@ -253,7 +253,7 @@ def extras(sim, K, x, y, a):
             other.run()
             steps[label].append(other.history.summary["wall_seconds"] / (a.steps + 1))
             if label == "bottom_only":
-                out["wall_nodes_bottom"] = comm.allreduce(len(other.constraints[0].nodes))
+                out["wall_nodes_bottom"] = comm.allreduce(len(other.walls[0].nodes))
     for label, times in steps.items():
         out[f"step_seconds_{label}"] = statistics.median(times)
     # Stable step: SLEPc as the solver does it (tol 1e-8), against a looser tolerance.

@@ -62,7 +62,7 @@ def main():
                 sim = build_simulation(scene(changes), comm, out)
                 sim.run()
                 times.append(sim.wall_seconds / (sim.num_steps + 1))
-            rows.append((name, sim.history.info["cells"], sim.num_steps, statistics.median(times)))
+            rows.append((name, sim.info["cells"], sim.num_steps, statistics.median(times)))
     load.append(os.getloadavg()[0])
     if comm.rank == 0:
         base = rows[0][3]

@@ -1,6 +1,6 @@
 """rwall_fem: explicit elastodynamics on DOLFINx meshes with Radioss-style rigid walls.
 
-The public names are imported lazily, so that ``python -m rwall_fem.render``
+The public names are imported lazily, so that ``python -m rwall_fem.output.render``
 (off-screen pictures) runs without DOLFINx in the process: VTK's wheels and
 DOLFINx's C++ libraries must not share a process that renders.
 """
@@ -20,8 +20,8 @@ _API = {
     "SceneError": "rwall_fem.scene",
     "load_scene": "rwall_fem.scene",
     "parse_scene": "rwall_fem.scene",
-    "build_simulation": "rwall_fem.model",
-    "run_scene": "rwall_fem.model",
+    "build_simulation": "rwall_fem.build",
+    "run_scene": "rwall_fem.build",
 }
 
 __all__ = sorted(_API)

@@ -7,7 +7,7 @@ clamp wins over a wall on a node both act on.
 
 The reaction is the impulse that sets the step's velocity, m (v_p - v_pred);
 its work is booked at mid-step velocities like every other force (see
-:mod:`rwall_fem.history`): the half with v^{n-1/2} at step n, the half with
+:mod:`rwall_fem.output.energy`): the half with v^{n-1/2} at step n, the half with
 v^{n+1/2} at the next step, read from the state then (so that whatever acted
 after it on the same node, the balance closes exactly).
 """
@@ -32,7 +32,7 @@ class VelocityBoundary:
     def __init__(self, name: str, nodes: np.ndarray, velocity, components: str = "xyz"):
         self.name = name
         self.nodes = np.asarray(nodes, dtype=np.int32)
-        self.history = PrescribedMotion(velocity)
+        self.prescribed = PrescribedMotion(velocity)  # the velocity history
         self.axes = np.array(["xyz".index(c) for c in components])
         self.impulse = np.zeros(3)  # reaction on this rank's nodes so far, N s
         self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
@@ -41,7 +41,7 @@ class VelocityBoundary:
     def constrain(self, state) -> None:
         """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n + dt/2)."""
         rows, cols = self.nodes[:, None], self.axes[None, :]
-        target = self.history.predict(state.t, state.dt)[self.axes]
+        target = self.prescribed.predict(state.t, state.dt)[self.axes]
         v_old = state.v[rows, cols]
         if self._reaction is not None:
             self.work += 0.5 * float(np.sum(self._reaction * v_old))

@@ -6,7 +6,8 @@
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback), 3 run stopped by a
-guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept).
+guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept), 4 an output
+could not be written at the end of the run (one line on stderr; the others are written).
 """
 
 from __future__ import annotations
@@ -16,9 +17,12 @@ import logging
 import sys
 import time
 
+__all__ = ["main"]
+
 
 def main(argv: list[str] | None = None) -> int:
     from rwall_fem import __version__
+    from rwall_fem.output.render import COLORS
 
     parser = argparse.ArgumentParser(
         prog="rwall-fem", description="Solid bodies striking rigid walls (explicit FEM on DOLFINx)."
@@ -41,9 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--quiet", action="store_true", help="print only errors")
     render = commands.add_parser("render", help="draw the frames of a results folder again")
     render.add_argument("directory", help="results folder of a run with output.frames > 0")
-    render.add_argument(
-        "--color", default="normal_velocity", choices=("normal_velocity", "speed", "displacement")
-    )
+    render.add_argument("--color", default=COLORS[0], choices=COLORS)
     study = commands.add_parser("study", help="accuracy against wall time, on exact references")
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
@@ -58,6 +60,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from mpi4py import MPI
 
+    from rwall_fem.output import OutputError
     from rwall_fem.scene import SceneError
 
     comm = MPI.COMM_WORLD
@@ -79,6 +82,9 @@ def main(argv: list[str] | None = None) -> int:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
+    except (OutputError, OSError) as err:
+        print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
+        return 4
     if summary["status"] != "done":
         if comm.rank == 0:
             print(f"rwall-fem: stopped: {summary['reason']}", file=sys.stderr)
@@ -94,12 +100,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(scene_file, out, overrides, comm, quiet: bool) -> dict:
-    from rwall_fem.model import build_simulation
+    from rwall_fem.build import build_simulation
     from rwall_fem.scene import load_scene
 
     sim = build_simulation(load_scene(scene_file, overrides), comm, out)
     if comm.rank == 0 and not quiet and sys.stderr.isatty():
-        from rwall_fem.progress import Progress
+        from rwall_fem.output.progress import Progress
 
         sim.recorders.append(Progress(sim.num_steps))
     sim.run()
@@ -111,7 +117,7 @@ def _check(scene_file, overrides, comm) -> int:
     it, with the wall time estimated from the cost of the internal force."""
     from mpi4py import MPI
 
-    from rwall_fem.model import build_simulation
+    from rwall_fem.build import build_simulation
     from rwall_fem.scene import load_scene
 
     scene = load_scene(scene_file, overrides)
@@ -120,9 +126,9 @@ def _check(scene_file, overrides, comm) -> int:
     for _ in range(5):
         sim.internal.accelerate(sim.state)
     per_step = comm.allreduce(time.perf_counter() - started, op=MPI.MAX) / 5
-    info = sim.history.info
-    walls = [comm.allreduce(len(w.nodes)) for w in sim.history.walls]
-    boundaries = [comm.allreduce(len(b.nodes)) for b in sim.history.boundaries]
+    info = sim.info
+    walls = [comm.allreduce(len(w.nodes)) for w in sim.walls]
+    boundaries = [comm.allreduce(len(b.nodes)) for b in sim.boundaries]
     if comm.rank == 0:
         print(f"rwall-fem: scene {scene_file} is valid")
         print(
@@ -135,9 +141,9 @@ def _check(scene_file, overrides, comm) -> int:
             f"{sim.num_steps} steps to {sim.num_steps * sim.state.dt:.4g} s"
         )
         print(f"  effects: {', '.join(sim.effects)}")
-        for w, count in zip(sim.history.walls, walls, strict=True):
+        for w, count in zip(sim.walls, walls, strict=True):
             print(f"  {w.name}: {w.shape.kind}, slide {w.slide}, {count} secondary nodes")
-        for b, count in zip(sim.history.boundaries, boundaries, strict=True):
+        for b, count in zip(sim.boundaries, boundaries, strict=True):
             print(f"  {b.name}: {count} nodes, components {''.join('xyz'[i] for i in b.axes)}")
         print(
             f"  estimated wall time: {1.2 * per_step * (sim.num_steps + 1):.3g} s "
@@ -149,7 +155,7 @@ def _check(scene_file, overrides, comm) -> int:
 def _render(directory: str, color: str) -> int:
     from pathlib import Path
 
-    from rwall_fem.render import render_frames
+    from rwall_fem.output.render import render_frames
 
     if not (Path(directory) / "frames" / "data" / "mesh.npz").is_file():
         print(

@@ -2,7 +2,7 @@
 
 An effect adds its acceleration to ``state.a`` and knows the work (J) it has
 done on this rank's nodes, booked like every other force at mid-step
-velocities (see :mod:`rwall_fem.history`).
+velocities (see :mod:`rwall_fem.output.energy`).
 """
 
 from __future__ import annotations

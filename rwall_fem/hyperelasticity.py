@@ -18,6 +18,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rwall_fem import _compat
+from rwall_fem.mechanics import coordinate_pattern
 from rwall_fem.scene import Material
 from rwall_fem.solver import RunStopped
 
@@ -42,6 +43,8 @@ def strain_energy_density(F, material: Material):
 class HyperelasticForce:
     """Internal force of a hyperelastic body; *sets* ``state.a`` like the linear force."""
 
+    energy_names = ("internal",)
+
     def __init__(self, V, material: Material, state):
         self.name = material.model
         self.V = V
@@ -58,7 +61,7 @@ class HyperelasticForce:
         self._energy = fem.form(psi * dx)
         self._vector = _compat.create_vector(V, self._force)
         self._owned = state.u.size
-        self.assemblies = 0  # force assemblies so far (a cost counter)
+        self._mode = None  # the latest eigenvector estimate of largest_eigenvalue
 
     def forces(self, u: np.ndarray) -> np.ndarray:
         """Internal forces (N) on the owned nodes for the displacement ``u`` (n, 3), a view."""
@@ -69,16 +72,16 @@ class HyperelasticForce:
             local.set(0.0)
         fem.petsc.assemble_vector(b, self._force)
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.assemblies += 1
         return b.array.reshape(-1, 3)
 
     def accelerate(self, state) -> None:
         np.multiply(self.forces(state.u), state.inv_mass, out=state.a)
         np.negative(state.a, out=state.a)
 
-    def strain_energy(self, state) -> float:
-        """Strain energy (J) of this rank's cells at the displacement of the latest step."""
-        return fem.assemble_scalar(self._energy)
+    def energies(self, state) -> dict[str, float]:
+        """Strain energy (J) of this rank's cells at the displacement of the latest step,
+        as ``{"internal": ...}``."""
+        return {"internal": fem.assemble_scalar(self._energy)}
 
     def largest_eigenvalue(self, state, iterations: int, tolerance: float = 1e-3) -> float:
         """Rayleigh quotient (1/s^2) of a power iteration on M^-1/2 K_t M^-1/2, the tangent
@@ -89,9 +92,9 @@ class HyperelasticForce:
         comm = self.V.mesh.comm
         scale = np.sqrt(state.inv_mass)
         base = self.forces(state.u).copy()
-        x = getattr(self, "_mode", None)
-        if x is None:  # a start that depends only on coordinates: the same on any partition
-            x = np.sin(state.X @ np.array([12.9898, 78.233, 37.719]) * 1e3)[:, None] * [1, -1, 1]
+        x = self._mode
+        if x is None:
+            x = coordinate_pattern(state.X)[:, None] * [1, -1, 1]
             x = x / np.sqrt(comm.allreduce(float(np.sum(x * x))))
         size = comm.allreduce(float(np.ptp(state.X, axis=0).max(initial=0.0)), op=MPI.MAX)
         rayleigh = previous = 0.0
@@ -133,7 +136,6 @@ class StableStepMonitor:
         self.force, self.every, self.dt_stable = force, every, dt_stable
         self.reference = force.largest_eigenvalue(state, iterations=60, tolerance=1e-6)
         self.estimates = []  # (t, estimated stable step in s) at every check
-        self.checks = 0  # a cost counter
         self._next, self._interval, self._last = 0, 1, (0, dt_stable)
 
     def due(self, step: int) -> bool:
@@ -143,7 +145,6 @@ class StableStepMonitor:
         ratio = self.force.largest_eigenvalue(s, iterations=8) / self.reference
         estimate = self.dt_stable / np.sqrt(max(ratio, 1e-300))
         self.estimates.append((s.t, estimate))
-        self.checks += 1
         limit = self.SAFETY * estimate
         if s.dt > limit:
             raise RunStopped(

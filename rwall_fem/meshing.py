@@ -1,4 +1,4 @@
-"""Bodies from gmsh: the geometry files in ``meshes/`` or a user's .msh/.geo file.
+"""Bodies from gmsh: the built-in shapes (``meshes/*.geo``) or a user's .msh/.geo file.
 
 The mesh is generated (or read) on rank 0 and distributed by DOLFINx. Named
 gmsh physical groups travel with it as facet tags so that scenes can refer to
@@ -7,6 +7,7 @@ boundary node sets by name.
 
 from __future__ import annotations
 
+import importlib.resources
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,8 +31,6 @@ __all__ = [
     "rotation_to",
     "round_bar_mesh",
 ]
-
-GEOMETRY_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
 
 @dataclass
@@ -183,7 +182,10 @@ def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine) -> 
         own = (np.asarray(refine.point, dtype=float) - origin) @ R + origin
         params |= dict(zip(("refine_x", "refine_y", "refine_z"), own, strict=True))
         params |= {"refine_size": refine.size, "refine_radius": refine.radius}
-    body = read_mesh(comm, GEOMETRY_DIR / geo, params)
+    # Shipped as the package rwall_fem.meshes (the repository's meshes/ folder); gmsh reads
+    # the file from disk and finds its Include "refine.geo" beside it.
+    with importlib.resources.as_file(importlib.resources.files("rwall_fem.meshes") / geo) as path:
+        body = read_mesh(comm, path, params)
     x = body.msh.geometry.x
     x[:] = (x - origin) @ R.T + origin
     return body

@@ -1,28 +1,39 @@
-"""Explicit central-difference time stepping with a pipeline of effects.
+"""The time loop: explicit central differences over a pipeline of effects.
 
-One step, in the order of the spec (section 4):
+One step, in the order of ``docs/theory.md`` (section "The step"):
 
-1. forces -> acceleration ``a^n`` (``forces``: the internal force first, then
-   body forces; each adds to ``a``);
-2. constraints edit ``a^n`` (rigid walls);
-3. bookkeeping at sample steps (energies need ``v^{n-1/2}`` and ``a^n``);
+1. forces -> acceleration ``a^n``: the internal force *sets* ``a``, body forces add to it;
+2. constraints edit ``a^n``: the rigid walls, then the velocity boundary conditions;
+3. recorders sample the steps they are due (energies need ``v^{n-1/2}`` and ``a^n``);
 4. ``v^{n+1/2} = v^{n-1/2} + dt a^n``; ``u^{n+1} = u^n + dt v^{n+1/2}``.
 
-Only the effects a scene asks for are in the lists, so nothing else runs.
+Each effect is an object with a small interface (:class:`Force`, :class:`Constraint`,
+:class:`Recorder`), and only the effects a scene asks for are in the lists, so nothing
+else runs.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import signal
 import threading
 import time
 from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 import numpy as np
-from petsc4py import PETSc
 
-__all__ = ["LinearElasticForce", "RunStopped", "Simulation", "State"]
+__all__ = [
+    "BodyForce",
+    "Constraint",
+    "Force",
+    "InternalForce",
+    "Recorder",
+    "RunStopped",
+    "Simulation",
+    "State",
+]
 
 
 class RunStopped(Exception):
@@ -46,35 +57,53 @@ class State:
         for name in ("u", "v", "a"):
             if getattr(self, name) is None:
                 setattr(self, name, np.zeros_like(self.X))
-        self.inv_mass = (1.0 / self.mass)[:, None]
+        self.inv_mass = (1.0 / self.mass)[:, None]  # 1/kg, shape (n, 1)
 
 
-class LinearElasticForce:
-    """Internal force -K u of small-strain linear elasticity with a constant stiffness K.
+class Force(Protocol):
+    """An effect on the acceleration ``state.a`` (m/s^2) of step n."""
 
-    It *sets* ``state.a`` (it is always first in the force list). The strain
-    energy 1/2 u.Ku comes for free from the product already computed.
+    name: str
+
+    def accelerate(self, state: State) -> None: ...
+
+
+class InternalForce(Force, Protocol):
+    """The body's internal force: first in the pipeline, it *sets* ``state.a``.
+
+    ``energy_names`` are the energies it stores (``("internal",)``); :meth:`energies`
+    gives them (J) on this rank's share of the body at the latest step.
     """
 
-    name = "linear_elastic"
+    energy_names: tuple[str, ...]
 
-    def __init__(self, K: PETSc.Mat, state: State):
-        self.K = K
-        self.ku = np.zeros_like(state.u)
-        comm, size = K.comm, (state.u.size, PETSc.DECIDE)
-        self._u = PETSc.Vec().createWithArray(state.u.reshape(-1), size=size, bsize=3, comm=comm)
-        self._ku = PETSc.Vec().createWithArray(self.ku.reshape(-1), size=size, bsize=3, comm=comm)
-        # -1/m per component: one pass per step, and a contiguous (n, 3) operand is several
-        # times faster than broadcasting an (n, 1) column over rows of 3.
-        self._minus_inv_mass = -np.repeat(state.inv_mass, 3, axis=1)
+    def energies(self, state: State) -> dict[str, float]: ...
 
-    def accelerate(self, state: State) -> None:
-        self.K.mult(self._u, self._ku)
-        np.multiply(self.ku, self._minus_inv_mass, out=state.a)
 
-    def strain_energy(self, state: State) -> float:
-        """Strain energy 1/2 u.Ku (J) on this rank's rows."""
-        return 0.5 * float(np.vdot(state.u, self.ku))
+class BodyForce(Force, Protocol):
+    """An external force that adds to ``state.a``; :meth:`work` is its work (J) on this
+    rank's nodes up to step n, booked at mid-step velocities."""
+
+    def work(self, state: State) -> float: ...
+
+
+class Constraint(Protocol):
+    """A kinematic condition that edits ``state.a`` after the forces (a wall, a clamp)."""
+
+    name: str
+
+    def constrain(self, state: State) -> None: ...
+
+
+class Recorder(Protocol):
+    """Samples the run at the steps it is :meth:`due` (before the update of that step) and
+    is closed once when the run ends, however it ends."""
+
+    def due(self, step: int) -> bool: ...
+
+    def record(self, sim: Simulation, state: State) -> None: ...
+
+    def close(self, sim: Simulation) -> None: ...
 
 
 @dataclass
@@ -83,13 +112,17 @@ class Simulation:
 
     state: State
     end_time: float  # s
-    internal: LinearElasticForce
-    forces: list = field(default_factory=list)
-    constraints: list = field(default_factory=list)
-    recorders: list = field(default_factory=list)
-    history: object = None  # the History among the recorders
-    wall_seconds: float = 0.0
-    status: str = "not run"  # "done", or "stopped: <reason>"
+    internal: InternalForce
+    comm: Any  # the body's MPI communicator
+    forces: list[BodyForce] = field(default_factory=list)
+    walls: list[Constraint] = field(default_factory=list)  # RigidWall
+    boundaries: list[Constraint] = field(default_factory=list)  # VelocityBoundary
+    recorders: list[Recorder] = field(default_factory=list)
+    # What was built: scene, cells, nodes, mass (kg), dt_stable (s), ... (summary.json)
+    info: dict = field(default_factory=dict)
+    history: Any = None  # the History among the recorders (rwall_fem.output.history)
+    wall_seconds: float = 0.0  # of the time loop, on this rank
+    status: str = "not run"  # "done", "stopped: <reason>" or "failed: <error>"
     terminate_requested: bool = False  # set by SIGTERM; acted on at the next history sample
 
     @property
@@ -97,54 +130,88 @@ class Simulation:
         return math.ceil(self.end_time / self.state.dt - 1e-9)
 
     @property
+    def constraints(self) -> list[Constraint]:
+        """Walls, then boundary conditions: a clamp acts last and wins over a wall."""
+        return [*self.walls, *self.boundaries]
+
+    @property
     def effects(self) -> list[str]:
         """Names of the effects in the step pipeline, in the order they act."""
         return [e.name for e in [self.internal, *self.forces, *self.constraints]]
 
     def run(self) -> str:
-        """Advance from t = 0 to ``end_time`` (s), then close the recorders.
+        """Advance from t = 0 to ``end_time`` (s), then close every recorder.
 
         Returns ``self.status``: "done", or "stopped: ..." when a guard (see
-        :class:`~rwall_fem.history.History`) or SIGTERM stopped the run. Either way
-        every recorder is closed, so the outputs up to the last sample stay valid.
+        :mod:`rwall_fem.output.guards`) or SIGTERM stopped the run; the outputs up to
+        the last sample stay valid. Any other error propagates after every recorder
+        was closed; a recorder that fails to close does not keep the others from
+        closing, and never hides an error raised before it (it is noted on it).
         """
-        s, forces, last = self.state, [self.internal, *self.forces], self.num_steps
+        s, last = self.state, self.num_steps
+        forces, constraints = [self.internal, *self.forces], self.constraints
         scratch = np.empty_like(s.u)
-        started = time.perf_counter()
-        previous = _on_sigterm(self)
-        try:
-            for step in range(last + 1):
-                s.step, s.t = step, step * s.dt
-                for effect in forces:
-                    effect.accelerate(s)
-                for constraint in self.constraints:
-                    constraint.constrain(s)
-                for recorder in self.recorders:
-                    if recorder.due(step):
-                        recorder.record(self, s)
-                np.multiply(s.a, s.dt, out=scratch)
-                s.v += scratch
-                np.multiply(s.v, s.dt, out=scratch)
-                s.u += scratch
-            self.status = "done"
-        except RunStopped as stop:
-            self.status = f"stopped: {stop}"
-        finally:
-            if previous is not None:
-                signal.signal(signal.SIGTERM, previous)
-            self.wall_seconds = time.perf_counter() - started
-            for recorder in self.recorders:
-                recorder.close(self)
+        with contextlib.ExitStack() as closing:
+            for recorder in reversed(self.recorders):  # closed in the order of the list
+                closing.push(_closer(recorder, self))
+            closing.enter_context(_sigterm_requests(self))
+            started = time.perf_counter()
+            try:
+                for step in range(last + 1):
+                    s.step, s.t = step, step * s.dt
+                    for force in forces:
+                        force.accelerate(s)
+                    for constraint in constraints:
+                        constraint.constrain(s)
+                    for recorder in self.recorders:
+                        if recorder.due(step):
+                            recorder.record(self, s)
+                    np.multiply(s.a, s.dt, out=scratch)
+                    s.v += scratch
+                    np.multiply(s.v, s.dt, out=scratch)
+                    s.u += scratch
+                self.status = "done"
+            except RunStopped as stop:
+                self.status = f"stopped: {stop}"
+            except Exception as error:
+                self.status = f"failed: {type(error).__name__}: {error}"
+                raise
+            finally:
+                self.wall_seconds = time.perf_counter() - started
         return self.status
 
 
-def _on_sigterm(sim: Simulation):
-    """Make SIGTERM a request to stop cleanly; returns the previous handler (None if the
-    handler cannot be set, outside the main thread)."""
+def _closer(recorder: Recorder, sim: Simulation):
+    """An exit callback that closes ``recorder``. When an error is already on its way
+    (from the run or from an earlier close), a failure to close is noted on that error
+    instead of replacing it."""
+
+    def close(kind, error, traceback) -> bool:
+        try:
+            recorder.close(sim)
+        except Exception as failure:
+            if error is None:
+                raise
+            error.add_note(f"closing {type(recorder).__name__} failed too: {failure!r}")
+        return False
+
+    return close
+
+
+@contextlib.contextmanager
+def _sigterm_requests(sim: Simulation):
+    """While the loop runs, SIGTERM only sets ``sim.terminate_requested``: the history's
+    guard stops the run at its next sample, on every rank at the same step. Signals can
+    be handled in the main thread only; elsewhere SIGTERM keeps its handler."""
     if threading.current_thread() is not threading.main_thread():
-        return None
+        yield
+        return
 
     def request(signum, frame):
         sim.terminate_requested = True
 
-    return signal.signal(signal.SIGTERM, request)
+    previous = signal.signal(signal.SIGTERM, request)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

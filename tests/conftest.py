@@ -1,7 +1,14 @@
 """Shared helpers: scenes as dictionaries, run in-process on a chosen communicator.
 
 The suite runs serially and under ``mpirun -n 2``; a test that runs a scene
-uses ``MPI.COMM_WORLD`` unless it says otherwise, and every rank asserts.
+uses ``MPI.COMM_WORLD`` unless it says otherwise, and every rank asserts. A test
+marked ``@pytest.mark.serial`` runs on one rank only (it starts subprocesses, or
+measures one rank); under ``mpirun`` it is skipped.
+
+- ``unit/``: one module against hand values or closed forms;
+- ``verification/``: runs against independent references (wave theory, closed forms);
+- ``contract/``: what a user relies on (outputs, command line, refusals, the wheel);
+- ``hard/``: numerically hard scenes that must stay stable (``--full``: finer).
 """
 
 import copy
@@ -12,7 +19,8 @@ import pytest
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
-from rwall_fem.history import WALL_COLUMNS
+from rwall_fem.output.wall_table import WALL_COLUMNS
+from rwall_fem.study.cases import SOFT, STEEL_NU0
 
 COLUMN = {name: i for i, name in enumerate(WALL_COLUMNS)}  # columns of walls.csv
 
@@ -38,8 +46,6 @@ normal_point = [0.0, 0.0, 1.0]
 [output]
 frames = 3
 """
-
-STEEL_NU0 = {"model": "linear_elastic", "density": 7850.0, "young": 210.0e9, "poisson": 0.0}
 
 
 def bar_scene(
@@ -84,6 +90,19 @@ def pytest_addoption(parser):
     )
 
 
+def pytest_configure(config):
+    config.addinivalue_line("markers", "serial: runs on one rank only, skipped under mpirun")
+
+
+def pytest_collection_modifyitems(config, items):
+    if MPI.COMM_WORLD.size == 1:
+        return
+    skip = pytest.mark.skip(reason="serial only: starts subprocesses or measures one rank")
+    for item in items:
+        if item.get_closest_marker("serial"):
+            item.add_marker(skip)
+
+
 @pytest.fixture
 def refine(request) -> int:
     """Refinement factor of the hard cases: 1, or 2 with --full."""
@@ -97,13 +116,9 @@ def shared_dir(tmp_path_factory):
     return MPI.COMM_WORLD.bcast(path, root=0)
 
 
-def run(raw, directory, comm=MPI.COMM_WORLD, **overrides):
+def run(raw, directory, comm=MPI.COMM_WORLD):
     """Run the scene ``raw`` (a dict) into ``directory``; returns the finished Simulation."""
-    raw = copy.deepcopy(raw)
-    for key, value in overrides.items():
-        section, name = key.split("__")
-        raw[section][name] = value
-    sim = build_simulation(parse_scene(raw, source="test"), comm, directory)
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, directory)
     sim.run()
     return sim
 
@@ -117,9 +132,9 @@ class Probe:
     """
 
     def __init__(self, sim):
-        self.comm = sim.history.comm
+        self.comm = sim.comm
         self.mass = self.comm.allreduce(float(sim.state.mass.sum()))
-        self.walls = sim.constraints
+        self.walls = sim.walls
         self.t, self.x, self.v, self.distances = [], [], [], []
         sim.recorders.append(self)
 
@@ -156,9 +171,6 @@ def run_probed(raw, directory, comm=MPI.COMM_WORLD):
     probe = Probe(sim)
     sim.run()
     return sim, probe
-
-
-SOFT = {"model": "linear_elastic", "density": 1000.0, "young": 1.0e6, "poisson": 0.3}
 
 
 def block_scene(

@@ -1,4 +1,4 @@
-"""The kinematic rigid-wall condition (spec sections 2-4), shared by all shapes.
+"""The kinematic rigid-wall condition, shared by all shapes (``docs/theory.md``, "Rigid walls").
 
 After the acceleration solve, each secondary node's velocity and position are
 predicted, ``v* = v^{n-1/2} + dt a^n`` and ``x* = x^n + dt v*``, and so is the
@@ -16,15 +16,15 @@ applies to the node the impulse ``I`` that
 ``I`` is added to ``a^n`` as ``I / (m dt)``, which gives the same ``v^{n+1/2}``
 as editing both ``v^{n-1/2}`` and ``a^n``. A node stops where it is, at most
 one step of travel short of the surface; it is never projected. A node
-already behind the surface stays there unless one step takes it out (6.3).
+already behind the surface stays there unless one step takes it out.
 
 A wall carried by a main node (``MainNodeMotion``) receives minus the sum of
 the impulses, so momentum is conserved to round-off. The coupling is done in
 the same step: the wall's velocity over the step solves
 ``(M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i)`` (P_i = n_i n_i^T, or
 the identity for tied nodes; b_i the target normal velocity), i.e. the wall
-moves with the mass of the nodes it treats, the spec's one-step mass coupling
-without a lag. Tied and sticking nodes then follow the wall exactly.
+moves with the mass of the nodes it treats: the reference's one-step mass
+coupling, without its lag of one step. Tied and sticking nodes then follow the wall exactly.
 
 Energy: the work of the contact impulses is booked at mid-step velocities
 relative to the wall, 1/2 I . (w^{n-1/2} + w^{n+1/2}) with w = v - V, split into
@@ -145,16 +145,16 @@ class RigidWall:
         v_pred = v_old + dt * state.a[near]
         x_now = self._near_X + state.u[near]
         x_pred = x_now + dt * v_pred
-        hit = shape.distance(x_pred, wall_next) < 0.0
+        crossing = shape.distance(x_pred, wall_next) < 0.0
         if self.finite:
-            hit &= shape.inside_patch(x_pred, wall_next)
-        h = np.flatnonzero(hit)
-        target = np.zeros(len(h))  # normal velocity relative to the wall after the step
-        if self.finite and len(h):
-            d_now = shape.distance(x_now[h], offset)
-            normal_speed = np.abs((v_pred[h] - wall_velocity) @ shape.normal)
+            crossing &= shape.inside_patch(x_pred, wall_next)
+        hits = np.flatnonzero(crossing)  # positions in the near set of the nodes treated
+        target = np.zeros(len(hits))  # normal velocity relative to the wall after the step
+        if self.finite and len(hits):
+            d_now = shape.distance(x_now[hits], offset)
+            normal_speed = np.abs((v_pred[hits] - wall_velocity) @ shape.normal)
             shallow = d_now >= -2.0 * dt * normal_speed  # deeper nodes pass behind the wall
-            h, d_now = h[shallow], d_now[shallow]
+            hits, d_now = hits[shallow], d_now[shallow]
             target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
 
         if self._latest is not None:
@@ -166,25 +166,25 @@ class RigidWall:
             self._latest = None
         self.driving_work += self._pending_driving
         self._pending_driving = 0.0
-        self.contacts = len(h)
-        self.touching = near[h]  # nodes treated in the latest step
+        self.contacts = len(hits)
+        self.touching = near[hits]  # nodes treated in the latest step
         kept = None
         if self._previous_tangential is not None:
             # Only the rows written in the previous step are non-zero: clear those alone.
-            rows = self._near[h]
+            rows = self._near[hits]
             kept = self._previous_tangential[rows]
             self._previous_tangential[self._filtered_rows] = 0.0
             self._filtered_rows = rows
-        if not len(h) and not motion.dynamic:
+        if not len(hits) and not motion.dynamic:
             motion.advance(wall_velocity, dt)
             return
 
-        n = np.broadcast_to(shape.normals(x_now[h], offset), (len(h), 3))
-        m = self._near_mass[h]
-        vs = v_pred[h]
+        n = np.broadcast_to(shape.normals(x_now[hits], offset), (len(hits), 3))
+        m = self._near_mass[hits]
+        vs = v_pred[hits]
         if motion.dynamic:
             predicted = wall_velocity
-            tied = np.full(len(h), self.slide == "tied")
+            tied = np.full(len(hits), self.slide == "tied")
             wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, tied)
         normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
         if motion.dynamic and self.slide == "friction":
@@ -203,7 +203,7 @@ class RigidWall:
             final = predicted - self.comm.allreduce(impulse.sum(axis=0)) / motion.mass
         before = motion.velocity
         motion.advance(final, dt)
-        w_old = v_old[h] - before
+        w_old = v_old[hits] - before
         self.normal_work += 0.5 * (normal * w_old).sum()
         if tangential is not None:
             self.friction_work += 0.5 * (tangential * w_old).sum()
@@ -213,7 +213,7 @@ class RigidWall:
             self.driving_work += 0.5 * impulse.sum(axis=0) @ before
             self._pending_driving = 0.5 * impulse.sum(axis=0) @ final
         self.normal_impulse -= normal.sum(axis=0)
-        if len(h):
+        if len(hits):
             self.first_contact = min(self.first_contact, state.t)
             self.last_contact = state.t
 

@@ -1,8 +1,8 @@
 """How a wall moves: fixed, carried by a main node of given mass, or prescribed.
 
-A moving wall translates and never rotates (spec section 2): its state is the
-translation ``offset`` (m) of its defining points at time t_n and its velocity
-(m/s) over the current step. Every rank holds the same wall state: whatever
+A moving wall translates and never rotates (``docs/theory.md``, "Fixed and moving
+walls"): its state is the translation ``offset`` (m) of its defining points at time
+t_n and its velocity (m/s) over the current step. Every rank holds the same wall state: whatever
 changes it (the contact impulse) is summed over ranks first.
 """
 
@@ -33,7 +33,16 @@ class FixedMotion:
         """Take ``velocity`` (m/s) as V^{n+1/2} and move by ``dt`` (s)."""
 
 
-class MainNodeMotion(FixedMotion):
+class _Translating(FixedMotion):
+    """A wall that moves: each step translates it by dt times its velocity over the step."""
+
+    def advance(self, velocity: np.ndarray, dt: float) -> None:
+        self.previous_velocity = self.velocity
+        self.velocity = np.asarray(velocity, dtype=float)
+        self.offset = self.offset + dt * self.velocity
+
+
+class MainNodeMotion(_Translating):
     """A wall carried by a main node of ``mass`` (kg) starting at ``velocity`` (m/s).
 
     Contact impulses act on the main node by momentum conservation.
@@ -47,13 +56,8 @@ class MainNodeMotion(FixedMotion):
         self.velocity = np.asarray(velocity, dtype=float).copy()
         self.previous_velocity = self.velocity.copy()
 
-    def advance(self, velocity: np.ndarray, dt: float) -> None:
-        self.previous_velocity = self.velocity
-        self.velocity = np.asarray(velocity, dtype=float)
-        self.offset = self.offset + dt * self.velocity
 
-
-class PrescribedMotion(FixedMotion):
+class PrescribedMotion(_Translating):
     """A wall that follows a velocity history, whatever hits it.
 
     ``table`` is a constant velocity [vx, vy, vz] (m/s) or rows [t, vx, vy, vz]
@@ -76,8 +80,3 @@ class PrescribedMotion(FixedMotion):
 
     def predict(self, t: float, dt: float) -> np.ndarray:
         return self._at(t + 0.5 * dt)
-
-    def advance(self, velocity: np.ndarray, dt: float) -> None:
-        self.previous_velocity = self.velocity
-        self.velocity = np.asarray(velocity, dtype=float)
-        self.offset = self.offset + dt * self.velocity

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "SHAPES",
     "CylinderWall",
     "ParallelogramWall",
     "PlaneWall",
@@ -41,7 +42,6 @@ class PlaneWall:
     """
 
     kind = "plane"
-    radial = False  # one normal for every node
 
     def __init__(self, point, normal_point):
         self.point = np.asarray(point, dtype=float)
@@ -111,9 +111,8 @@ class ParallelogramWall(PlaneWall):
 
 
 class _RoundWall:
-    """Shared by the cylinder and the sphere: distance and normal from a radial vector."""
-
-    radial = True  # the normal follows the node (taken at its current position)
+    """Shared by the cylinder and the sphere: distance and normal from a radial vector;
+    the normal follows the node (taken at its current position)."""
 
     def distance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         return np.linalg.norm(self._radial(x, offset), axis=1) - self.radius

@@ -27,7 +27,7 @@ class StaysInFront:
     is found behind it at the next (nodes beyond its edges may legitimately pass under it)."""
 
     def __init__(self, sim, wall=0):
-        self.wall, self.comm = sim.constraints[wall], sim.history.comm
+        self.wall, self.comm = sim.walls[wall], sim.comm
         self.facing, self.deepest = None, 0.0
         sim.recorders.append(self)
 
@@ -64,7 +64,7 @@ def check_stable(sim, probe, *, balance=1e-10, inside=1e-12, dissipative=True):
         f" {summary['wall_seconds']:.2f} s"
     )
     if dissipative:  # fixed or main-node walls only take energy out
-        scale = sim.history.reference_energy  # E0, or the largest energy if E0 = 0
+        scale = sim.history.balance.reference  # E0, or the largest energy if E0 = 0
         assert all(w["work"] <= 1e-12 * scale for w in summary["walls"])
     return summary
 
@@ -127,7 +127,7 @@ def test_cube_lands_on_the_corner_of_a_parallelogram(refine, shared_dir):
     assert front.deepest >= -1e-12
     probe.distances[:] = 0.0  # beyond the edges nodes pass under the wall: checked above
     summary = check_stable(sim, probe, dissipative=False)
-    # Nodes slipping under the wall's edges and pushed back onto it (spec 4) may add a
+    # Nodes slipping under the wall's edges and pushed back onto it (docs/theory.md) may add a
     # little energy: 0.4 % seen; bounded at 1 %.
     energy, initial = sim.history.energy, summary["energy"]["initial"]
     assert summary["walls"][0]["work"] <= 0.01 * initial
@@ -276,7 +276,7 @@ def test_sphere_hit_on_the_centre_line_of_a_node(refine, shared_dir):
 
 def test_chatter_at_small_courant_number(refine, shared_dir):
     """dt_scale 0.3: nodes re-contact for single steps; re-contacts may inject a little
-    energy (numerics notes) but the total stays bounded by the initial energy."""
+    energy (docs/theory.md, "Chatter") but the total stays bounded by the initial energy."""
     raw = bar_scene(elements=20 * refine, h=1e-3 / refine)
     raw["run"]["dt_scale"] = 0.3
     sim, probe = run_probed(raw, shared_dir)

@@ -1,13 +1,12 @@
-"""Off-screen pictures of a run: ``python -m rwall_fem.render DIR``.
+"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [COLOR]``.
 
-Reads the frame data that :class:`rwall_fem.frames.Frames` stored in
+Reads the frame data that :class:`rwall_fem.output.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
 ``DIR/animation.gif``, and ``DIR/animation.mp4`` when the ``imageio-ffmpeg``
 encoder is installed (``pip install rwall_fem[mp4]``). The body is drawn on
-its deformed geometry, coloured by the velocity component along the first
-wall's normal, with the walls.
+its deformed geometry, coloured by one of :data:`COLORS`, with the walls.
 The camera and the colour range are fixed once for all frames. This module
-must not import DOLFINx (see :mod:`rwall_fem.frames`).
+must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
 """
 
 from __future__ import annotations
@@ -21,18 +20,16 @@ import numpy as np
 
 from rwall_fem.walls.shapes import shape_from_parameters
 
-__all__ = ["render_frames"]
+__all__ = ["COLORS", "render_frames"]
+
+# What the body can be coloured by: the velocity along the first wall's normal (m/s),
+# the speed (m/s) or the magnitude of the displacement (m).
+COLORS = ("normal_velocity", "speed", "displacement")
 
 
-COLOURS = ("normal_velocity", "speed", "displacement")
-
-
-def render_frames(directory: str | Path, colour: str = "normal_velocity") -> list[Path]:
-    """Render every stored frame of the run in ``directory``; returns the PNG paths.
-
-    ``colour``: "normal_velocity" (along the first wall's normal, m/s), "speed" (m/s) or
-    "displacement" (magnitude, m).
-    """
+def render_frames(directory: str | Path, color: str = "normal_velocity") -> list[Path]:
+    """Render every stored frame of the run in ``directory``, coloured by ``color`` (one of
+    :data:`COLORS`); returns the PNG paths."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import imageio.v2 as imageio
     import pyvista
@@ -43,12 +40,12 @@ def render_frames(directory: str | Path, colour: str = "normal_velocity") -> lis
     points, speed = mesh["points"], float(mesh["speed"])
     walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
     frames = [dict(np.load(path)) for path in sorted(data.glob("frame_*.npz"))]
-    values = [_colour(colour, f, walls, points) for f in frames]
-    label = _colour_label(colour, walls)
+    values = [_color_values(color, f, walls, points) for f in frames]
+    label = _color_label(color, walls)
     top = max(float(np.abs(v).max(initial=0.0)) for v in values) or 1.0
     clim = (
         (-1.2 * max(speed, top), 1.2 * max(speed, top))
-        if colour == "normal_velocity"
+        if color == "normal_velocity"
         else (0.0, top)
     )
     # One box for the whole run: it fixes the camera and the size of the walls drawn.
@@ -95,17 +92,17 @@ def _has_mp4_encoder() -> bool:
     return True
 
 
-def _colour_label(colour: str, walls) -> str:
-    if colour == "normal_velocity":
+def _color_label(color: str, walls) -> str:
+    if color == "normal_velocity":
         return "velocity along the wall normal (m/s)" if walls else "velocity z (m/s)"
-    return {"speed": "speed (m/s)", "displacement": "displacement (m)"}[colour]
+    return {"speed": "speed (m/s)", "displacement": "displacement (m)"}[color]
 
 
-def _colour(colour: str, frame: dict, walls, points: np.ndarray) -> np.ndarray:
-    if colour == "normal_velocity":
+def _color_values(color: str, frame: dict, walls, points: np.ndarray) -> np.ndarray:
+    if color == "normal_velocity":
         normal = walls[0].normals(points[:1]) if walls else np.array([0.0, 0.0, 1.0])
         return frame["v"] @ np.broadcast_to(normal, (1, 3))[0]
-    field = frame["v"] if colour == "speed" else frame["u"]
+    field = frame["v"] if color == "speed" else frame["u"]
     return np.linalg.norm(field, axis=1)
 
 
@@ -133,6 +130,6 @@ def _wall_surface(pyvista, shape, offset: np.ndarray, centre: np.ndarray, size: 
 
 
 if __name__ == "__main__":
-    if len(sys.argv) not in (2, 3) or sys.argv[2:] and sys.argv[2] not in COLOURS:
-        sys.exit(f"usage: python -m rwall_fem.render RESULTS_DIR [{'|'.join(COLOURS)}]")
+    if len(sys.argv) not in (2, 3) or sys.argv[2:] and sys.argv[2] not in COLORS:
+        sys.exit(f"usage: python -m rwall_fem.output.render RESULTS_DIR [{'|'.join(COLORS)}]")
     render_frames(*sys.argv[1:])

@@ -13,7 +13,7 @@ from mpi4py import MPI
 
 from rwall_fem.cli import main
 
-SCENES = sorted((Path(__file__).parent / "bad_scenes").glob("*.toml"))
+SCENES = sorted((Path(__file__).resolve().parents[1] / "bad_scenes").glob("*.toml"))
 
 
 def test_there_are_at_least_thirty():

@@ -15,11 +15,7 @@ from conftest import SCENE, bar_scene, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
-from rwall_fem.history import WALL_COLUMNS
-
-serial_only = pytest.mark.skipif(
-    MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
-)
+from rwall_fem.output.wall_table import WALL_COLUMNS
 
 
 def complete_rows(path: Path, columns: int) -> list[list[float]]:
@@ -51,7 +47,7 @@ def test_energy_error_guard(shared_dir):
     assert "energy balance error" in sim.status and "exceeds run.max_energy_error" in sim.status
     assert "fastest node" in sim.status and "|v| = " in sim.status
     assert sim.history.summary["status"] == "stopped"
-    assert len(sim.history.energy_rows) < sim.num_steps + 1
+    assert len(sim.history.energy) < sim.num_steps + 1
 
 
 def test_min_dt_guard(shared_dir):
@@ -85,7 +81,7 @@ def _start_long_run(tmp_path):
     return process
 
 
-@serial_only
+@pytest.mark.serial
 def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     process = _start_long_run(tmp_path)
     process.send_signal(signal.SIGTERM)
@@ -100,7 +96,7 @@ def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
 
 
-@serial_only
+@pytest.mark.serial
 def test_sigkill_leaves_complete_csv_lines(tmp_path):
     process = _start_long_run(tmp_path)
     process.kill()
@@ -108,3 +104,46 @@ def test_sigkill_leaves_complete_csv_lines(tmp_path):
     rows = complete_rows(tmp_path / "out" / "energy.csv", 6)
     assert len(rows) > 100
     assert not (tmp_path / "out" / "summary.json").exists()
+
+
+def test_an_error_before_the_first_sample_is_raised_as_itself(shared_dir):
+    """The run fails at step 0: the error itself reaches the caller, and the summary of
+    the outputs (no sample yet) says how the run ended."""
+    sim = build_simulation(
+        parse_scene(bar_scene(elements=4), source="test"), MPI.COMM_WORLD, shared_dir
+    )
+
+    def broken(state):
+        raise ArithmeticError("the force broke")
+
+    sim.internal.accelerate = broken
+    with pytest.raises(ArithmeticError, match="the force broke"):
+        sim.run()
+    summary = sim.history.summary
+    assert summary["status"] == "failed" and "the force broke" in summary["reason"]
+    assert summary["energy"]["kinetic"] is None
+
+
+def test_pictures_that_fail_to_render_leave_the_other_outputs(shared_dir, monkeypatch, capsys):
+    """The renderer fails: the command line says so in one line and exits 4; the summary
+    and the CSV files are written all the same."""
+    import rwall_fem.output.frames
+    from rwall_fem.cli import main
+
+    def failed_render(args, **kwargs):
+        return subprocess.CompletedProcess(args, 1, "", "Traceback\nRuntimeError: no display")
+
+    monkeypatch.setattr(rwall_fem.output.frames.subprocess, "run", failed_render)
+    out = Path(shared_dir)
+    if MPI.COMM_WORLD.rank == 0:
+        (out / "scene.toml").write_text(SCENE)
+    MPI.COMM_WORLD.Barrier()
+    code = main(["run", str(out / "scene.toml"), "--out", str(out / "run"), "--quiet"])
+    if MPI.COMM_WORLD.rank == 0:  # rank 0 renders
+        assert code == 4
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == ["rwall-fem: error: outputs: rendering the frames failed: RuntimeError: "
+                       "no display"]  # fmt: skip
+        summary = json.loads((out / "run" / "summary.json").read_text())
+        assert summary["status"] == "done"
+        complete_rows(out / "run" / "energy.csv", 6)

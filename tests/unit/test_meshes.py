@@ -321,7 +321,7 @@ def test_bad_mesh_keys_name_the_key(mesh, change, message):
         parse_scene(_scene(mesh), source="bad.toml")
 
 
-@pytest.mark.skipif(comm.size > 1, reason="starts the command line in a subprocess")
+@pytest.mark.serial
 def test_command_line_refuses_a_key_of_another_shape_in_one_line(tmp_path):
     (tmp_path / "scene.toml").write_text(
         '[run]\nend_time = 1e-6\n[mesh]\nshape = "plate"\nsize = [0.1, 0.1, 0.002]\n'

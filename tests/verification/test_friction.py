@@ -1,4 +1,4 @@
-"""Tangential behaviour: Coulomb friction by impulses, tied contact (spec section 3).
+"""Tangential behaviour: Coulomb friction by impulses, tied contact (docs/theory.md).
 
 References are rigid-body closed forms: on an incline of angle theta a block
 slides at g (sin theta - mu cos theta) when tan theta > mu and does not creep
@@ -6,7 +6,8 @@ when tan theta <= mu; a belt moving at V drags a block at mu g until it
 reaches V; a belt accelerating as k t holds the block until k t = mu g, then
 the block slips with acceleration mu g. The soft block rings elastically
 under the sudden load; friction capped node by node must still give the
-right mean force (numerics notes), so velocities are compared within 2 %.
+right mean force (docs/theory.md, "Tangential behaviour"), so velocities are compared
+within 2 %.
 """
 
 import math

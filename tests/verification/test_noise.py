@@ -1,4 +1,4 @@
-"""Random noise on the initial coordinates (spec 6.4 and 6.5).
+"""Random noise on the initial coordinates (docs/theory.md, "Coordinate noise").
 
 The noise of a node depends only on the seed and the node's input (gmsh)
 index, so a seeded run is reproducible and independent of the partitioning.
@@ -23,7 +23,7 @@ def noisy_bar(seed=7):
 
 def test_same_seed_same_run_other_seed_other_run(shared_dir, tmp_path):
     first = run(noisy_bar(), shared_dir).history
-    scale = first.initial_energy
+    scale = first.summary["energy"]["initial"]
     again = run(noisy_bar(), shared_dir).history.energy[:, 1:5]
     other = run(noisy_bar(seed=8), shared_dir).history.energy[:, 1:5]
     # Bitwise in serial; in parallel the order of sums may change the last bits.
@@ -36,11 +36,12 @@ def test_noise_does_not_depend_on_the_partition(shared_dir, tmp_path):
     parallel = run(noisy_bar(), shared_dir)
     serial = run(noisy_bar(), tmp_path, comm=MPI.COMM_SELF)
     e_par, e_ser = parallel.history.energy, serial.history.energy
-    assert np.abs(e_par[:, 1:5] - e_ser[:, 1:5]).max() <= 1e-10 * serial.history.initial_energy
+    scale = serial.history.summary["energy"]["initial"]
+    assert np.abs(e_par[:, 1:5] - e_ser[:, 1:5]).max() <= 1e-10 * scale
 
 
 def test_nodes_at_zero_distance_selected_by_distance(shared_dir):
-    """6.4: with noise, lower-face nodes at d = 0 land on both sides; those inside are not
+    """With noise, lower-face nodes at d = 0 land on both sides; those inside are not
     secondary when the selection is by distance."""
     wall = {
         "kind": "plane",
@@ -59,7 +60,7 @@ def test_nodes_at_zero_distance_selected_by_distance(shared_dir):
 
 @pytest.mark.parametrize("arm, tilted", [(1e-4, True), (1.0, False)])
 def test_noise_moves_a_moving_walls_main_node(arm, tilted, shared_dir):
-    """6.5: the main node moves with the noise; the normal from it to M1 turns, the more
+    """The main node moves with the noise; the normal from it to M1 turns, the more
     the closer M1 is."""
     wall = {
         "kind": "plane",

@@ -1,7 +1,7 @@
 """``rwall-fem study --quick``: output structure, and errors that shrink with refinement.
 
 Timings are never checked (another job may share the machine); the errors are, against
-the independent references of :mod:`rwall_fem.study` (1-D wave theory, the exponential
+the independent references of :mod:`rwall_fem.study.cases` (1-D wave theory, the exponential
 decay of a heavy wall on a free bar).
 """
 
@@ -11,14 +11,12 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rwall_fem.study import CASES, cost_at, run_study
+from rwall_fem.study import CASES, run_study
 
 # The study measures wall time against accuracy on one rank; its runs are the same scenes
 # that the rest of the suite runs on 2 ranks. Running it twice would double the suite's
 # longest test for nothing new.
-pytestmark = pytest.mark.skipif(
-    MPI.COMM_WORLD.size > 1, reason="the accuracy study is a one-rank measurement"
-)
+pytestmark = pytest.mark.serial
 
 
 @pytest.fixture(scope="module")
@@ -79,16 +77,3 @@ def test_errors_shrink_with_refinement(quick, case, quantities):
             for r in series:
                 assert r["balance_error"] < 1e-9
                 assert 0.0 < r["wall_share"] < 0.2
-
-
-def test_cost_interpolates_in_log_log():
-    # error = t^-1/4: 1 % at t = 1e8 / 1e0 ... exact power law, so interpolation is exact.
-    t = np.array([1.0, 16.0, 256.0])
-    e = 0.04 * t**-0.25
-    seconds, cells, how = cost_at(e, t, 100 * t, 0.01)
-    assert how == "interpolated"
-    assert seconds == pytest.approx(256.0)
-    assert cells == pytest.approx(25600.0)
-    seconds, _, how = cost_at(e, t, 100 * t, 0.005)
-    assert how == "extrapolated"
-    assert seconds == pytest.approx(4096.0)

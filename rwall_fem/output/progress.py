@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from rwall_fem.output.schedule import Every
+
 __all__ = ["Progress"]
 
 
@@ -13,8 +15,7 @@ class Progress:
     def __init__(self, num_steps: int, updates: int = 500):
         from tqdm import tqdm
 
-        self.every = max(1, num_steps // updates)
-        self.num_steps = num_steps
+        self.steps = Every(max(1, num_steps // updates), num_steps)
         self._bar = tqdm(
             total=num_steps + 1,
             unit="step",
@@ -26,11 +27,11 @@ class Progress:
         self._shown = 0
 
     def due(self, step: int) -> bool:
-        return step % self.every == 0 or step == self.num_steps
+        return step in self.steps
 
     def record(self, sim, s) -> None:
-        rows = sim.history.energy_rows
-        error = f"{rows[-1][5]:.1e}" if rows else "-"
+        latest = sim.history.balance.error
+        error = "-" if latest is None else f"{latest:.1e}"
         self._bar.set_postfix_str(f"t = {s.t:.4g} s, energy error {error}", refresh=False)
         self._bar.update(s.step + 1 - self._shown)
         self._shown = s.step + 1

@@ -1,10 +1,10 @@
-"""Frame data of a run, gathered on rank 0 and rendered by :mod:`rwall_fem.render`.
+"""Frame data of a run, gathered on rank 0 and rendered by :mod:`rwall_fem.output.render`.
 
 Each rank sends its cells, points and nodal values to rank 0 (connectivity
 offset by the points already received); rank 0 stores them in
 ``frames/data``: ``mesh.npz`` once, then ``frame_NNNN.npz`` per frame.
 Pictures are drawn at the end of the run (or of a stopped run) by a separate
-process, ``python -m rwall_fem.render DIR``, which never loads DOLFINx:
+process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
 VTK's wheels crash when they render in a process that holds DOLFINx's C++
 libraries (a libstdc++ ABI clash, seen with vtk 9.7 and DOLFINx 0.5).
 """
@@ -21,16 +21,24 @@ import numpy as np
 from dolfinx import fem
 
 from rwall_fem import _compat
+from rwall_fem.output import OutputError
+from rwall_fem.output.schedule import spread
 
 __all__ = ["Frames"]
 
 
 class Frames:
-    """Recorder that stores ``count`` frames evenly over the run in ``directory/frames``."""
+    """Recorder that stores ``count`` frames of the body (space ``V``) and its ``walls``,
+    spread evenly over the ``num_steps`` steps of the run, in ``directory/frames``.
+
+    ``speed`` (m/s) sets the colour range of the velocity colourings; ``color`` is one of
+    :data:`rwall_fem.output.render.COLORS`.
+    """
 
     def __init__(
         self,
         directory: Path,
+        *,
         count: int,
         num_steps: int,
         V,
@@ -38,7 +46,7 @@ class Frames:
         speed: float,
         color: str = "normal_velocity",
     ):
-        self.steps = {round(k * num_steps / max(count - 1, 1)) for k in range(count)}
+        self.steps = spread(count, num_steps)
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
@@ -106,10 +114,13 @@ class Frames:
         env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
         env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         result = subprocess.run(
-            [sys.executable, "-m", "rwall_fem.render", str(self.directory), self.color],
+            [sys.executable, "-m", "rwall_fem.output.render", str(self.directory), self.color],
             env=env,
             capture_output=True,
             text=True,
         )
         if result.returncode != 0:
-            raise RuntimeError(f"rendering the frames failed:\n{result.stderr[-2000:]}")
+            lines = result.stderr.strip().splitlines() or ["no message"]
+            error = OutputError(f"rendering the frames failed: {lines[-1]}")
+            error.add_note(result.stderr[-2000:])  # the renderer's traceback
+            raise error

@@ -6,7 +6,7 @@ the wall at v0: contact lasts 2L/c, the wall force is rho c A v0, the total
 impulse 2 m v0 and the bar leaves at v0. The kinematic wall stops the first
 layer of nodes plastically, which destroys 1/2 m_face v0^2 with m_face the
 lumped mass of the contact face, M / (2N) for N layers; the discrete answers
-converge at O(1/N) (see ../shared/notes/numerics.md for the 1-D figures).
+converge at O(1/N) (docs/theory.md, "Bar on a fixed plane", gives the 1-D figures).
 """
 
 import math

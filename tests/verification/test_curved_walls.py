@@ -2,7 +2,7 @@
 
 A point mass starting at the top of a frictionless convex cylinder or sphere
 of radius R with speed v0 leaves the surface at cos(theta) = 2/3 + v0^2/(3 g R)
-(numerics notes). The block (2 mm, one soft hexahedron) is small against
+(docs/theory.md, "Curved walls"). The block (2 mm, one soft hexahedron) is small against
 R = 0.1 m; its centre runs at R + a/2. Its flat face touching a curved wall
 and its elastic ringing shift the angle by well under 0.02 in cos(theta).
 """

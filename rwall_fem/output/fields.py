@@ -14,15 +14,17 @@ from dolfinx import fem, io
 
 from rwall_fem import _compat
 from rwall_fem.mechanics import stress
+from rwall_fem.output.schedule import spread
 
 __all__ = ["Fields"]
 
 
 class Fields:
-    """Recorder that writes ``count`` field snapshots evenly over the run."""
+    """Recorder that writes ``count`` field snapshots of the displacement ``u`` in the space
+    ``V`` spread evenly over the ``num_steps`` steps of the run, into ``directory``."""
 
-    def __init__(self, directory: Path, count: int, num_steps: int, V, material):
-        self.steps = {round(k * num_steps / max(count - 1, 1)) for k in range(count)}
+    def __init__(self, directory: Path, *, count: int, num_steps: int, V, material):
+        self.steps = spread(count, num_steps)
         self.path = Path(directory) / "fields.xdmf"
         msh = V.mesh
         self.u, self.v = fem.Function(V), fem.Function(V)

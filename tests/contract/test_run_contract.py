@@ -13,11 +13,7 @@ from conftest import SCENE, bar_scene, run
 from mpi4py import MPI
 
 from rwall_fem import SceneError, parse_scene
-from rwall_fem.history import WALL_COLUMNS
-
-serial_only = pytest.mark.skipif(
-    MPI.COMM_WORLD.size > 1, reason="starts the command line in a subprocess"
-)
+from rwall_fem.output.wall_table import WALL_COLUMNS
 
 
 def test_outputs_of_a_run(shared_dir):
@@ -188,7 +184,7 @@ def _cli(*args, cwd):
     )
 
 
-@serial_only
+@pytest.mark.serial
 def test_command_line_run_with_override(tmp_path):
     (tmp_path / "scene.toml").write_text(SCENE)
     result = _cli(
@@ -208,7 +204,7 @@ def test_command_line_run_with_override(tmp_path):
     assert "done:" in result.stdout
 
 
-@serial_only
+@pytest.mark.serial
 @pytest.mark.parametrize(
     "args, message",
     [
@@ -227,7 +223,7 @@ def test_command_line_bad_input_is_one_line(tmp_path, args, message):
     assert "Traceback" not in result.stderr
 
 
-@serial_only
+@pytest.mark.serial
 def test_check_prints_what_would_run_and_writes_nothing(tmp_path):
     (tmp_path / "scene.toml").write_text(SCENE)
     result = _cli("check", "scene.toml", "--set", "mesh.cell='tetrahedron'", cwd=tmp_path)
@@ -238,7 +234,7 @@ def test_check_prints_what_would_run_and_writes_nothing(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]
 
 
-@serial_only
+@pytest.mark.serial
 def test_render_draws_a_results_folder_again(tmp_path):
     (tmp_path / "scene.toml").write_text(SCENE)
     assert _cli("run", "scene.toml", "--out", "out", "--quiet", cwd=tmp_path).returncode == 0
@@ -251,7 +247,7 @@ def test_render_draws_a_results_folder_again(tmp_path):
     assert missing.returncode == 2 and "no frame data" in missing.stderr
 
 
-@serial_only
+@pytest.mark.serial
 def test_a_surface_mesh_is_refused(tmp_path):
     import gmsh
 
@@ -313,7 +309,7 @@ def test_the_reference_scene_uses_every_key(monkeypatch):
         opened(self, raw, path, source, allowed)
 
     monkeypatch.setattr(scene._Table, "__init__", recording)
-    path = Path(__file__).resolve().parent.parent / "demos" / "every_key.toml"
+    path = Path(__file__).resolve().parents[2] / "demos" / "every_key.toml"
     load_scene(path)
     text = path.read_text()
     keys = set(re.findall(r"(?:^#?\s*|[{,]\s*)(\w+)\s*=", text, re.MULTILINE))

@@ -1,5 +1,5 @@
-"""Secondary nodes (spec sections 5 and 6): boundary default, search distance, named sets,
-and nodes that start inside a wall.
+"""Secondary nodes (docs/theory.md, "Secondary nodes"): boundary default, search distance,
+named sets, and nodes that start inside a wall.
 
 The block is 10 mm with 2 hexahedra a side: 27 nodes in layers of 9, 26 on the
 boundary, 9 on each face, 1 inside the lower face's edges.

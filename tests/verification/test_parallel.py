@@ -16,7 +16,7 @@ def test_partitioned_run_equals_serial_run(cell, shared_dir, tmp_path):
     assert parallel.state.dt == serial.state.dt
     e_par, e_ser = parallel.history.energy, serial.history.energy
     assert e_par.shape == e_ser.shape
-    scale = serial.history.initial_energy
+    scale = serial.history.summary["energy"]["initial"]
     assert np.abs(e_par[:, 1:5] - e_ser[:, 1:5]).max() <= 1e-10 * scale
     w_par, w_ser = parallel.history.wall(0), serial.history.wall(0)
     contacts = COLUMN["contacts"]

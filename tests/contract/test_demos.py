@@ -9,7 +9,7 @@ from mpi4py import MPI
 
 from rwall_fem import build_simulation, load_scene
 
-DEMOS = Path(__file__).resolve().parent.parent / "demos"
+DEMOS = Path(__file__).resolve().parents[2] / "demos"
 COARSE = {  # scene -> overrides that keep it to a few seconds
     "bar_impact": ["mesh.element_size=0.005", "run.end_time=3e-5"],
     "moving_wall_crush": ["mesh.element_size=0.005", "run.end_time=1e-4"],

@@ -1,4 +1,5 @@
-"""A heavy wall carried by a main node hits a free bar (spec section 2; numerics notes).
+"""A heavy wall carried by a main node hits a free bar (docs/theory.md, "Heavy wall on a
+free bar").
 
 Exact 1-D answer for a nu = 0 bar of mass m_b hit at V0 by a wall of mass M_w:
 while in contact M_w dV/dt = -Z V with Z = rho c A, so V(t) = V0 exp(-Z t / M_w);

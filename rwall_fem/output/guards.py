@@ -1,0 +1,60 @@
+"""When a run must stop (the Radioss /STOP and LS-DYNA ENDENG kind of checks).
+
+The guards act at every history sample, on values already summed over ranks, so every
+rank takes the same decision at the same step: a NaN or Inf in a nodal array (seen as a
+non-finite sum), an energy balance error above ``max_energy_error``, a time step below
+``min_dt``, or a SIGTERM received by any rank stop the run with one
+:class:`~rwall_fem.solver.RunStopped` message naming the step, the time, the quantity
+and the worst node.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rwall_fem.solver import RunStopped
+
+__all__ = ["Guards"]
+
+
+class Guards:
+    """The checks of a sample. ``node_ids`` are the global indices of the rank's owned
+    nodes (for the messages); ``max_energy_error`` bounds |balance error|, ``min_dt`` (s)
+    the time step."""
+
+    def __init__(
+        self, comm, node_ids: np.ndarray, *, max_energy_error: float = 0.05, min_dt: float = 0.0
+    ):
+        self.comm, self.node_ids = comm, node_ids
+        self.max_energy_error, self.min_dt = max_energy_error, min_dt
+
+    def check(self, s, error: float, *, finite: bool, terminate: bool) -> None:
+        """Raise :class:`RunStopped` (on every rank alike) if a guard trips at the sample of
+        the state ``s``: ``error`` is its balance error, ``finite`` whether every sum of
+        the sample is finite, ``terminate`` whether any rank received SIGTERM."""
+        where = f"step {s.step}, t = {s.t:.6g} s"
+        if not finite:
+            bad = ~(np.isfinite(s.u).all(axis=1) & np.isfinite(s.v).all(axis=1))
+            node = self._worst(bad.astype(float), s)
+            raise RunStopped(f"{where}: NaN or Inf in the nodal state; first bad node {node}")
+        if abs(error) > self.max_energy_error:
+            node = self._worst(np.linalg.norm(s.v, axis=1), s, "|v| = {:.4g} m/s")
+            raise RunStopped(
+                f"{where}: energy balance error {error:.3g} exceeds run.max_energy_error = "
+                f"{self.max_energy_error:g}; fastest node {node}"
+            )
+        if s.dt < self.min_dt:
+            raise RunStopped(
+                f"{where}: time step {s.dt:.4g} s is below run.min_dt = {self.min_dt:g} s"
+            )
+        if terminate:
+            raise RunStopped(f"{where}: terminated by SIGTERM")
+
+    def _worst(self, score: np.ndarray, s, detail: str = "") -> str:
+        """'<global id> at (x, y, z) m' of the node with the largest ``score`` on any rank."""
+        score = np.where(np.isnan(score), np.inf, score)
+        i = int(np.argmax(score)) if len(score) else -1
+        mine = (score[i], self.node_ids[i], *(s.X[i] + s.u[i])) if i >= 0 else (-np.inf,)
+        best = max(self.comm.allgather(mine), key=lambda c: c[0])
+        text = f"{best[1]} at ({best[2]:.6g}, {best[3]:.6g}, {best[4]:.6g}) m"
+        return f"{text}, {detail.format(best[0])}" if detail else text

@@ -1,0 +1,95 @@
+"""``summary.json``: what ran, how it ended, and the totals of every effect (SI units).
+
+Every value is summed (or reduced) over ranks, so the summary is the same on every
+rank; rank 0 writes it.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+__all__ = ["momentum", "run_summary", "write_summary"]
+
+
+def momentum(state, walls, comm) -> np.ndarray:
+    """Momentum (kg m/s) of the body plus that of the walls carried by a main node."""
+    total = comm.allreduce(np.sum(state.mass[:, None] * state.v, axis=0))
+    for w in walls:
+        if w.motion.dynamic:
+            total = total + w.motion.mass * w.motion.velocity
+    return total
+
+
+def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> dict:
+    """The summary of the run ``sim`` with the energy ``balance`` (an
+    :class:`~rwall_fem.output.energy.EnergyBalance`), the most nodes each wall treated in
+    one step and the momentum at the start (kg m/s)."""
+    s, comm = sim.state, sim.comm
+    outcome, _, reason = sim.status.partition(": ")
+    latest = balance.latest or {}
+    energy = {"initial": balance.initial}
+    energy |= {name: latest.get(name) for name in balance.columns[1:-1]}
+    energy["max_balance_error"] = balance.max_error
+    return sim.info | {
+        "status": outcome,
+        "reason": reason or None,
+        "ranks": comm.size,
+        "steps": sim.num_steps,
+        "dt": s.dt,
+        "end_time": sim.num_steps * s.dt,
+        "wall_seconds": comm.allreduce(sim.wall_seconds, MPI.MAX),
+        "effects": sim.effects,
+        "initial_momentum": initial_momentum.tolist(),
+        "final_momentum": momentum(s, sim.walls, comm).tolist(),
+        "energy": energy,
+        "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
+        "boundaries": [
+            {
+                "name": b.name,
+                "nodes": comm.allreduce(len(b.nodes)),
+                "reaction_impulse": comm.allreduce(b.impulse).tolist(),
+                "work": comm.allreduce(b.work),
+            }
+            for b in sim.boundaries
+        ],
+    }
+
+
+def _wall(w, peak_contacts: int, comm) -> dict:
+    entry = {
+        "name": w.name,
+        "kind": w.shape.kind,
+        "slide": w.slide,
+        "secondary_nodes": comm.allreduce(len(w.nodes)),
+        "impulse": comm.allreduce(w.impulse).tolist(),
+        "normal_impulse": comm.allreduce(w.normal_impulse).tolist(),
+        "tangential_impulse": comm.allreduce(w.tangential_impulse).tolist(),
+        "work": comm.allreduce(w.work),
+        "normal_work": comm.allreduce(w.normal_work),
+        "friction_work": comm.allreduce(w.friction_work),
+        "first_contact": _finite_or_none(comm.allreduce(w.first_contact, MPI.MIN)),
+        "last_contact": _finite_or_none(comm.allreduce(w.last_contact, MPI.MAX)),
+        "peak_contacts": int(peak_contacts),
+    }
+    if w.motion.dynamic or w.motion.prescribed:
+        entry["motion"] = "main node" if w.motion.dynamic else "prescribed"
+        entry["position"] = w.position.tolist()
+        entry["velocity"] = w.motion.velocity.tolist()
+        entry["driving_work"] = comm.allreduce(w.driving_work)
+    if w.motion.dynamic:
+        entry["mass"] = w.motion.mass
+    return entry
+
+
+def write_summary(directory: Path, summary: dict) -> None:
+    """Write ``summary`` to ``directory/summary.json``."""
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    (Path(directory) / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+
+
+def _finite_or_none(x: float):
+    return float(x) if np.isfinite(x) else None

@@ -1,0 +1,66 @@
+"""The rows of ``walls.csv``: per wall and sample, the push of the structure on the wall.
+
+Forces are the change of the cumulative impulses since the previous sample over the
+time between the two (N); impulses are cumulative (N s). Both are the push of the
+structure on the wall: negative along the normal of a wall hit from its allowed side.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["WALL_COLUMNS", "WallTable"]
+
+WALL_COLUMNS = (
+    ["time", "wall"]
+    + [f"force_{c}" for c in "xyz"]
+    + [f"impulse_{c}" for c in "xyz"]
+    + [f"normal_force_{c}" for c in "xyz"]
+    + [f"tangential_force_{c}" for c in "xyz"]
+    + [f"normal_impulse_{c}" for c in "xyz"]
+    + [f"tangential_impulse_{c}" for c in "xyz"]
+    + ["contacts"]
+    + [f"position_{c}" for c in "xyz"]
+    + [f"velocity_{c}" for c in "xyz"]
+)
+
+
+class WallTable:
+    """Turns the per-wall sums of a sample into rows with the columns of ``walls.csv``.
+
+    :attr:`sums` gives the shape of each per-rank quantity it needs summed over ranks
+    (the history reduces them with everything else of the sample in one call).
+    """
+
+    def __init__(self, walls):
+        self.walls = walls
+        n = len(walls)
+        self.sums = {"normal_impulse": (n, 3), "tangential_impulse": (n, 3), "contacts": (n,)}
+        self.peak_contacts = np.zeros(n, dtype=int)  # most nodes treated in one step
+        self._last_impulses = np.zeros((n, 6))  # normal and tangential, N s
+        self._last_step = -1
+
+    def fill(self, local: dict) -> None:
+        """Write this rank's impulses (N s) and contact counts into the ``local`` sums."""
+        for i, w in enumerate(self.walls):
+            local["normal_impulse"][i] = w.normal_impulse
+            local["tangential_impulse"][i] = w.tangential_impulse
+            local["contacts"][i] = w.contacts
+
+    def rows(self, state, total: dict) -> list[tuple]:
+        """The rows of step ``state.step`` from the sums over ranks ``total``."""
+        interval = (state.step - self._last_step) * state.dt  # s since the previous sample
+        self._last_step = state.step
+        rows = []
+        for i, w in enumerate(self.walls):
+            impulses = np.concatenate([total["normal_impulse"][i], total["tangential_impulse"][i]])
+            contacts = int(total["contacts"][i])
+            self.peak_contacts[i] = max(self.peak_contacts[i], contacts)
+            forces = (impulses - self._last_impulses[i]) / interval
+            self._last_impulses[i] = impulses
+            force, impulse = forces[:3] + forces[3:], impulses[:3] + impulses[3:]
+            rows.append(
+                (state.t, i, *force, *impulse, *forces, *impulses, contacts,
+                 *w.position, *w.motion.velocity)
+            )  # fmt: skip
+        return rows

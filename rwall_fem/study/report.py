@@ -1,0 +1,235 @@
+"""The study's report: what an accuracy target costs, tables and plots.
+
+The cost of an accuracy target is read from the data by linear interpolation of
+log(error) against log(time) (and log(cells)) between the two runs that bracket it; beyond
+the data the slope of the two nearest runs extrapolates, and the summary says so. Rank 0
+writes ``study.csv``, ``study.md`` (summary and tables), ``summary.md`` and
+``study_<case>.png`` (error against wall time, log-log, one line per cell type x dt_scale,
+slope guides).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from rwall_fem.study.cases import Case
+
+__all__ = ["cost_at", "plot", "summarise", "write_outputs"]
+
+
+def cost_at(errors, seconds, cells, target: float):
+    """(seconds, cells, how) at which |error| reaches ``target``, by log-log interpolation
+    between the two runs that bracket it (``how`` = "interpolated"), else along the slope
+    of the two runs nearest to it ("extrapolated"); None if the errors do not fall."""
+    e = np.abs(np.asarray(errors, float))
+    t, n = np.asarray(seconds, float), np.asarray(cells, float)
+    keep = np.isfinite(e) & (e > 0)
+    e, t, n = e[keep], t[keep], n[keep]
+    if len(e) < 2:
+        return None
+    order = np.argsort(t)
+    e, t, n = np.log(e[order]), np.log(t[order]), np.log(n[order])
+    goal = math.log(target)
+    pair, how = None, "extrapolated"
+    for i in range(len(e) - 1):
+        if (e[i] - goal) * (e[i + 1] - goal) <= 0 and e[i] != e[i + 1]:
+            pair, how = (i, i + 1), "interpolated"
+            break
+    if pair is None:
+        pair = (len(e) - 2, len(e) - 1) if e[-1] > goal else (0, 1)
+    i, j = pair
+    if e[j] >= e[i]:
+        return None  # no decrease to follow
+    w = (goal - e[i]) / (e[j] - e[i])
+    return (
+        math.exp(t[i] + w * (t[j] - t[i])),
+        math.exp(n[i] + w * (n[j] - n[i])),
+        how,
+    )
+
+
+def _slope(errors, seconds) -> float:
+    """Least-squares slope of log|error| against log(time) over the runs (nan if < 2)."""
+    e, t = np.abs(np.asarray(errors, float)), np.asarray(seconds, float)
+    keep = np.isfinite(e) & (e > 0)
+    if keep.sum() < 2:
+        return math.nan
+    return float(np.polyfit(np.log(t[keep]), np.log(e[keep]), 1)[0])
+
+
+def _technologies(rows):
+    return sorted({(r["cell"], r["dt_scale"]) for r in rows})
+
+
+def _series(rows, case, cell, dt_scale):
+    chosen = [r for r in rows if (r["case"], r["cell"], r["dt_scale"]) == (case, cell, dt_scale)]
+    return sorted(chosen, key=lambda r: -r["element_size"])
+
+
+def _label(cell: str, dt_scale: float) -> str:
+    return f"{'P1 tet' if cell == 'tetrahedron' else 'Q1 hex'}, dt_scale {dt_scale:g}"
+
+
+def summarise(rows, cases, target: float = 0.01) -> str:
+    """Plain-words markdown: what ``target`` relative error costs, for each headline quantity."""
+    lines = ["# What accuracy costs in time", ""]
+    ranks = rows[0]["ranks"] if rows else 1
+    lines.append(
+        f"Computed from {len(rows)} runs on {ranks} MPI rank(s); time is the wall time of the "
+        "time loop (median of repeats for short runs), set-up (meshing, assembly, stable step) "
+        "excluded. Costs are interpolated in log-log between the two runs that bracket the "
+        "target (or extrapolated along the nearest two, as marked)."
+    )
+    lines.append("")
+    for case in cases:
+        label = case.quantities[case.headline]
+        lines.append(f"**{case.title}**, {label}:")
+        lines.append("")
+        best = None
+        for cell, dt_scale in _technologies([r for r in rows if r["case"] == case.name]):
+            series = _series(rows, case.name, cell, dt_scale)
+            errors = [r[f"error_{case.headline}"] for r in series]
+            seconds = [r["wall_seconds"] for r in series]
+            cells = [r["cells"] for r in series]
+            one = cost_at(errors, seconds, cells, target)
+            half = cost_at(errors, seconds, cells, target / 2)
+            slope = _slope(errors, seconds)
+            name = _label(cell, dt_scale)
+            if one is None:
+                lines.append(
+                    f"- {name}: the error does not fall with refinement here "
+                    f"({', '.join(f'{100 * e:+.2f} %' for e in errors)})."
+                )
+                continue
+            text = (
+                f"- {name}: {100 * target:g} % {label} error takes about {one[1]:,.0f} cells and "
+                f"{one[0]:.3g} s ({one[2]})"
+            )
+            if half is not None:
+                text += f"; halving it costs {half[0] / one[0]:.3g}x the time ({half[2]})"
+            text += f" (error ~ time^{slope:.2f} over the runs)."
+            lines.append(text)
+            if best is None or one[0] < best[1]:
+                best = (name, one[0], one[1])
+        if best is not None:
+            lines.append("")
+            where = case.name.replace("_", " ")
+            lines.append(
+                f"In one line: {100 * target:g} % {label} error on the {where}"
+                f" costs {best[2]:,.0f} cells and {best[1]:.3g} s with the cheapest technology "
+                f"({best[0]})."
+            )
+        if case.note:
+            lines += ["", case.note]
+        lines.append("")
+    lines.append(
+        "Guides: an O(h) error at a cost growing like h^-4 (h^-3 cells times h^-1 steps) "
+        "falls like time^-1/4, so halving it costs 16x; O(h^2) falls like time^-1/2 (4x)."
+    )
+    return "\n".join(lines) + "\n"
+
+
+def _table(rows, case: Case) -> str:
+    keys = list(case.quantities)
+    head = (
+        ["cell", "dt_scale", "h (mm)", "cells", "steps", "dt (s)", "loop (s)", "ns/cell-step"]
+        + [f"{case.quantities[k]} err" for k in keys]
+        + ["wall share", "balance err"]
+    )
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for cell, dt_scale in _technologies([r for r in rows if r["case"] == case.name]):
+        for r in _series(rows, case.name, cell, dt_scale):
+            cells = [
+                cell[:3],
+                f"{dt_scale:g}",
+                f"{1e3 * r['element_size']:g}",
+                f"{r['cells']:,}",
+                f"{r['steps']}",
+                f"{r['dt']:.3g}",
+                f"{r['wall_seconds']:.3g}",
+                f"{r['ns_per_cell_step']:.0f}",
+                *(f"{100 * r[f'error_{k}']:+.3f} %" for k in keys),
+                f"{100 * r['wall_share']:.3f} %",
+                f"{r['balance_error']:.1e}",
+            ]
+            out.append("| " + " | ".join(cells) + " |")
+    return "\n".join(out) + "\n"
+
+
+def plot(rows, case: Case, path: Path) -> None:
+    """Error against wall time, log-log, one panel per quantity, one line per technology."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = list(case.quantities)
+    fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.8), squeeze=False)
+    mine = [r for r in rows if r["case"] == case.name]
+    for ax, key in zip(axes[0], keys, strict=True):
+        every_t, every_e = [], []
+        for (cell, dt_scale), marker in zip(_technologies(mine), "osD^v", strict=False):
+            series = _series(rows, case.name, cell, dt_scale)
+            t = np.array([r["wall_seconds"] for r in series])
+            e = 100 * np.abs([r[f"error_{key}"] for r in series])
+            good = e > 0
+            ax.loglog(t[good], e[good], marker=marker, label=_label(cell, dt_scale))
+            every_t += list(t[good])
+            every_e += list(e[good])
+        if every_t:
+            # Slope guides through the middle of the data.
+            t0 = math.exp(np.mean(np.log(every_t)))
+            e0 = math.exp(np.mean(np.log(every_e)))
+            span = np.array([min(every_t), max(every_t)])
+            for power, style in ((-0.25, ":"), (-0.5, "--")):
+                ax.loglog(span, e0 * (span / t0) ** power, "k" + style, lw=0.8,
+                          label=f"slope {power:g}")  # fmt: skip
+        ax.axhline(1.0, color="grey", lw=0.6)
+        ax.set_xlabel("wall time of the time loop (s)")
+        ax.set_ylabel("|relative error| (%)")
+        ax.set_title(case.quantities[key], fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(case.title, fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_outputs(rows, cases, out: Path, seconds: float, load=None) -> None:
+    """study.csv, study.md (summary + tables), summary.md, study_<case>.png (rank 0 only)."""
+    out.mkdir(parents=True, exist_ok=True)
+    columns = list(dict.fromkeys(k for r in rows for k in r))
+    with open(out / "study.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, columns, restval="")
+        writer.writeheader()
+        writer.writerows(rows)
+    summary = summarise(rows, cases)
+    (out / "summary.md").write_text(summary)
+    took = f"The whole study took {seconds:.0f} s (set-up included) on {os.cpu_count()} cores"
+    if load is not None:
+        # Timings are only as good as the machine was quiet: say how busy it was.
+        took += f"; 1-minute load average {load[0]:.2f} before, {load[1]:.2f} after"
+    parts = [summary, took + ".", ""]
+    for case in cases:
+        plot(rows, case, out / f"study_{case.name}.png")
+        parts += [
+            f"## {case.title}",
+            "",
+            f"![{case.name}](study_{case.name}.png)",
+            "",
+            _table(rows, case),
+        ]
+    parts += [
+        "Columns: relative errors are signed (computed - exact) / exact; *wall share* is the "
+        "energy the wall dissipated over the energy put in (initial plus external work); "
+        "*balance err* the largest energy balance error of the run; *loop* the wall time "
+        "of the time loop. Every run and its reference: `rwall_fem/study/cases.py`.",
+        "",
+    ]
+    (out / "study.md").write_text("\n".join(parts))
