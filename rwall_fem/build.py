@@ -1,7 +1,7 @@
 """From a validated scene to a ready-to-run :class:`~rwall_fem.solver.Simulation`.
 
-Data flows one way: scene -> body (mesh, space, lumped mass, stiffness) -> stable time
-step -> pipeline (internal force, body forces, walls, boundary conditions: only what
+Data flows one way: scene -> body (mesh, space, lumped mass, element technology) -> stable
+time step -> pipeline (internal force, body forces, walls, boundary conditions: only what
 the scene asks for) -> recorders (history, stable-step monitor, fields, frames).
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -18,13 +18,8 @@ from mpi4py import MPI
 from rwall_fem import _compat
 from rwall_fem.boundary import VelocityBoundary
 from rwall_fem.effects import Gravity
-from rwall_fem.mechanics import (
-    LinearElasticForce,
-    critical_time_step,
-    element_time_step,
-    lumped_mass,
-    stiffness_matrix,
-)
+from rwall_fem.elements import ElementForce, GhostedField, Technology
+from rwall_fem.mechanics import critical_time_step, element_time_step, lumped_mass
 from rwall_fem.meshing import (
     BodyMesh,
     body_mesh,
@@ -67,7 +62,7 @@ def build_simulation(
     *,
     body: BodyMesh | None = None,
 ) -> Simulation:
-    """Mesh the body, assemble mass and stiffness, choose dt and assemble the pipeline.
+    """Mesh the body, lump its mass, choose dt and assemble the pipeline.
 
     ``body`` is a mesh of your own (``BodyMesh(msh, facet_tags, groups)``, any
     distributed DOLFINx mesh of tetrahedra or hexahedra); it replaces the
@@ -90,15 +85,20 @@ def build_simulation(
 @dataclass
 class _Solid:
     """The discretised body: its communicator and mesh, the P1/Q1 vector space, the owned
-    nodes' reference coordinates (m) and lumped masses (kg), the small-strain stiffness K
-    (N/m) and the stable steps (s) from the largest eigenvalue and from the shortest edge."""
+    nodes' reference coordinates (m) and lumped masses (kg), its displacement and velocity
+    fields, its element technology with the linear elastic force of that technology (the
+    tangent at rest of every material), and the stable steps (s) from the largest
+    eigenvalue and from the shortest edge."""
 
     comm: MPI.Comm
     body: BodyMesh
     V: object
     X: np.ndarray
     mass: np.ndarray
-    K: object
+    u: GhostedField
+    v: GhostedField
+    technology: Technology
+    elastic: ElementForce
     dt_stable: float
     dt_element: float
 
@@ -108,7 +108,8 @@ class _Solid:
 
 
 def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
-    """The body of the scene's ``[mesh]`` (or ``body``), with its mass and stiffness."""
+    """The body of the scene's ``[mesh]`` (or ``body``), with its mass, its element
+    technology and stable step."""
     spec = scene.mesh
     if body is None and spec is None:
         raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
@@ -126,16 +127,24 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
         raise SceneError(
             f"{scene.source}: mesh: {cell} cells; allowed: tetrahedra or hexahedra (a volume)"
         )
+    element = scene.element
+    try:
+        technology = Technology.choose(
+            cell, element.integration, element.hourglass, element.hourglass_coefficient
+        )
+    except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
+        raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
     V = _compat.vector_space(body.msh)
     X = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local].copy()
     try:
         mass = lumped_mass(V, scene.material.density)
     except ValueError as err:
         raise SceneError(f"{scene.source}: mesh: {err}") from None
-    K = stiffness_matrix(V, scene.material)  # small strain: also the tangent at u = 0
-    dt_stable = critical_time_step(K, mass, X)
+    u, v = GhostedField(V), GhostedField(V)
+    elastic = ElementForce(V, replace(scene.material, model="linear_elastic"), technology, u, v)
+    dt_stable = critical_time_step(elastic, mass, X, comm)
     dt_element = element_time_step(V, scene.material)
-    return _Solid(comm, body, V, X, mass, K, dt_stable, dt_element)
+    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, dt_element)
 
 
 def _time_step(scene: Scene, solid: _Solid) -> float:
@@ -151,11 +160,12 @@ def _time_step(scene: Scene, solid: _Solid) -> float:
     else:
         dt = _round_down(scene.run.dt_scale * solid.dt_stable)
     log.info(
-        "mesh: %d %s cells, %d nodes; stable dt %.4g s (eigenvalue), %.4g s (shortest edge / c_p);"
-        " dt = %.4g s",
+        "mesh: %d %s cells, %d nodes; %s; stable dt %.4g s (eigenvalue), %.4g s (shortest edge /"
+        " c_p); dt = %.4g s",
         solid.body.num_cells,
         solid.body.msh.topology.cell_type.name,
         solid.V.dofmap.index_map.size_global,
+        solid.technology.describe(),
         solid.dt_stable,
         solid.dt_element,
         dt,
@@ -165,16 +175,12 @@ def _time_step(scene: Scene, solid: _Solid) -> float:
 
 def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
     """The state at t = 0 and the effects the scene asks for, in the order they act."""
-    state = State(X=solid.X, mass=solid.mass, dt=dt)
+    state = State(X=solid.X, mass=solid.mass, dt=dt, u=solid.u.owned, v=solid.v.owned)
     state.v[:] = scene.initial.velocity
     comm = solid.comm
-    if scene.material.model == "linear_elastic":
-        internal = LinearElasticForce(solid.K, state)
-    else:
-        from rwall_fem.hyperelasticity import HyperelasticForce
-
-        solid.K.destroy()  # only the initial stable step needed it
-        internal = HyperelasticForce(solid.V, scene.material, state)
+    internal = solid.elastic
+    if scene.material.model != "linear_elastic":
+        internal = ElementForce(solid.V, scene.material, solid.technology, solid.u, solid.v)
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
@@ -187,6 +193,7 @@ def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
             "scene": scene.source,
             "dolfinx_version": _compat.DOLFINX_VERSION,
             "cell": solid.body.msh.topology.cell_type.name,
+            "element": solid.technology.describe(),
             "cells": solid.body.num_cells,
             "nodes": solid.V.dofmap.index_map.size_global,
             "mass": comm.allreduce(float(solid.mass.sum())),
@@ -213,11 +220,11 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
         guards=guards,
         plot=scene.output.plot,
     )
-    sim.recorders.append(sim.history)
     if scene.material.model != "linear_elastic":
         from rwall_fem.hyperelasticity import StableStepMonitor
 
-        sim.recorders.append(StableStepMonitor(sim.internal, sim.state, solid.dt_stable))
+        monitor = StableStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
+        sim.recorders.append(monitor)
     if scene.output.fields:
         from rwall_fem.output.fields import Fields
 

@@ -49,8 +49,12 @@ class Technology:
     hourglass_coefficient: float = 0.0  # scales the hourglass forces
 
     @classmethod
-    def choose(cls, cell: str, integration=None, hourglass=None, coefficient=None) -> Technology:
-        """The technology for ``cell`` from the scene's choices (None: the default).
+    def choose(
+        cls, cell: str, integration=None, hourglass: str = "physical", coefficient=None
+    ) -> Technology:
+        """The technology for ``cell`` from a scene's ``[element]`` choices: ``integration``
+        None means the default of the cell type; ``hourglass`` and ``coefficient`` (None:
+        the form's default) only matter with reduced integration.
 
         Raises ValueError (one line, naming the key) for a combination that does not exist.
         """
@@ -64,14 +68,9 @@ class Technology:
                 "elements: use 'full' or drop the key"
             )
         if integration == "full":
-            if hourglass is not None or coefficient is not None:
-                raise ValueError("element.hourglass: only with integration = 'reduced'")
             return cls(cell, "full")
-        hourglass = "physical" if hourglass is None else hourglass
         if hourglass not in HOURGLASS:
             raise ValueError(f"element.hourglass: must be one of {HOURGLASS}, got {hourglass!r}")
-        if coefficient is not None and hourglass == "none":
-            raise ValueError("element.hourglass_coefficient: not with hourglass = 'none'")
         if coefficient is None:
             coefficient = DEFAULT_COEFFICIENT[hourglass]
         return cls(cell, "reduced", hourglass, float(coefficient))
@@ -134,6 +133,8 @@ class ElementForce:
         self.name = material.model
         self.technology = technology
         self.conservative = technology.conservative
+        hourglass = technology.integration == "reduced" and technology.hourglass != "none"
+        self.energy_names = ("internal", "hourglass") if hourglass else ("internal",)
         self.u, self.v = u, v
         self.f = GhostedField(V)
         self._space, self._probe = V, None  # the fields of forces(), made at its first call
@@ -152,6 +153,8 @@ class ElementForce:
         self.hourglass_energy = 0.0
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy)
         self._inv_mass = None
+        # Without a stored energy (viscous hourglass), the update books the work of f.
+        self.booked_force = None if self.conservative else self.f.owned
 
     def _bind(self, u: np.ndarray, v: np.ndarray, f: np.ndarray, energy: np.ndarray):
         """The kernel of the technology and material, with its arguments bound."""
@@ -172,6 +175,17 @@ class ElementForce:
     def stored_energy(self) -> float:
         """Elastic energy (J) of this rank's cells at the latest force computation."""
         return float(self._energy[0])
+
+    def energies(self, state) -> dict[str, float]:
+        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
+        without a stored energy, the internal work less the hourglass dissipation), and
+        ``"hourglass"`` when the elements have hourglass control."""
+        hourglass = self.hourglass_energy
+        internal = self.stored_energy if self.conservative else state.internal_work - hourglass
+        energies = {"internal": internal}
+        if "hourglass" in self.energy_names:
+            energies["hourglass"] = hourglass
+        return energies
 
     def accelerate(self, state) -> None:
         """Set ``state.a = -f_int(u^n) / m`` on the owned nodes."""

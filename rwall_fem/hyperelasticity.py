@@ -1,30 +1,25 @@
-"""Large deformation (total Lagrangian): hyperelastic internal forces as an effect.
+"""Large deformation (total Lagrangian): the hyperelastic laws and their stable step.
 
 Selected by ``material.model = "saint_venant_kirchhoff"`` or ``"neo_hookean"``
-(compressible). The internal force is the residual of the first Piola-Kirchhoff
-stress, f = int P(F) : grad(w) dX with F = I + grad(u), assembled every step
-from a form compiled once; the strain energy is int psi(F) dX. At u = 0 both
-models have the small-strain stiffness, so the initial stable step is that of
-the linear model; :class:`StableStepMonitor` re-estimates it in the current
-configuration.
+(compressible). The element kernels compute the internal force
+f = int P(F) : grad(w) dX, F = I + grad(u), and the strain energy int psi(F) dX;
+:func:`strain_energy_density` is the same law in UFL, the reference the tests
+compare the kernels against and the field output's stress. At u = 0 both models
+have the small-strain stiffness, so the initial stable step is that of the linear
+model; :class:`StableStepMonitor` re-estimates it in the current configuration.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import ufl
-from dolfinx import fem
 from mpi4py import MPI
-from petsc4py import PETSc
 
-from rwall_fem import _compat
 from rwall_fem.mechanics import coordinate_pattern
 from rwall_fem.scene import Material
 from rwall_fem.solver import RunStopped
 
-__all__ = ["HyperelasticForce", "StableStepMonitor", "strain_energy_density"]
-
-QUADRATURE_DEGREE = 2  # exact for the linearised P1 / Q1 stiffness
+__all__ = ["StableStepMonitor", "strain_energy_density"]
 
 
 def strain_energy_density(F, material: Material):
@@ -38,79 +33,6 @@ def strain_energy_density(F, material: Material):
         J = ufl.det(F)
         return 0.5 * mu * (ufl.tr(F.T * F) - d) - mu * ufl.ln(J) + 0.5 * lmbda * ufl.ln(J) ** 2
     raise ValueError(f"no hyperelastic model {material.model!r}")
-
-
-class HyperelasticForce:
-    """Internal force of a hyperelastic body; *sets* ``state.a`` like the linear force."""
-
-    energy_names = ("internal",)
-
-    def __init__(self, V, material: Material, state):
-        self.name = material.model
-        self.V = V
-        self.u = fem.Function(V)
-        gdim = V.mesh.geometry.dim
-        F = ufl.variable(ufl.Identity(gdim) + ufl.grad(self.u))
-        psi = strain_energy_density(F, material)
-        P = ufl.diff(psi, F)
-        w = ufl.TestFunction(V)
-        # One quadrature rule for both forms: the discrete force is then exactly the
-        # gradient of the discrete strain energy, which the energy balance relies on.
-        dx = ufl.dx(metadata={"quadrature_degree": QUADRATURE_DEGREE})
-        self._force = fem.form(ufl.inner(P, ufl.grad(w)) * dx)
-        self._energy = fem.form(psi * dx)
-        self._vector = _compat.create_vector(V, self._force)
-        self._owned = state.u.size
-        self._mode = None  # the latest eigenvector estimate of largest_eigenvalue
-
-    def forces(self, u: np.ndarray) -> np.ndarray:
-        """Internal forces (N) on the owned nodes for the displacement ``u`` (n, 3), a view."""
-        self.u.x.array[: self._owned] = u.ravel()
-        self.u.x.scatter_forward()
-        b = self._vector
-        with b.localForm() as local:
-            local.set(0.0)
-        fem.petsc.assemble_vector(b, self._force)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        return b.array.reshape(-1, 3)
-
-    def accelerate(self, state) -> None:
-        np.multiply(self.forces(state.u), state.inv_mass, out=state.a)
-        np.negative(state.a, out=state.a)
-
-    def energies(self, state) -> dict[str, float]:
-        """Strain energy (J) of this rank's cells at the displacement of the latest step,
-        as ``{"internal": ...}``."""
-        return {"internal": fem.assemble_scalar(self._energy)}
-
-    def largest_eigenvalue(self, state, iterations: int, tolerance: float = 1e-3) -> float:
-        """Rayleigh quotient (1/s^2) of a power iteration on M^-1/2 K_t M^-1/2, the tangent
-        stiffness K_t applied by finite differences of the internal forces; warm-started
-        from the previous call's vector. It stops after ``iterations`` force assemblies, or
-        earlier (after at least two) once the quotient changes by less than ``tolerance``
-        (relative) from one iteration to the next."""
-        comm = self.V.mesh.comm
-        scale = np.sqrt(state.inv_mass)
-        base = self.forces(state.u).copy()
-        x = self._mode
-        if x is None:
-            x = coordinate_pattern(state.X)[:, None] * [1, -1, 1]
-            x = x / np.sqrt(comm.allreduce(float(np.sum(x * x))))
-        size = comm.allreduce(float(np.ptp(state.X, axis=0).max(initial=0.0)), op=MPI.MAX)
-        rayleigh = previous = 0.0
-        for i in range(iterations):
-            dx = scale * x
-            # Perturb by 1e-7 of the body size: linear enough, far above round-off.
-            largest = comm.allreduce(float(np.abs(dx).max(initial=0.0)), op=MPI.MAX)
-            reach = 1e-7 * size / largest
-            y = (self.forces(state.u + reach * dx) - base) / reach * scale
-            previous, rayleigh = rayleigh, comm.allreduce(float(np.sum(x * y)))
-            x = y / np.sqrt(comm.allreduce(float(np.sum(y * y))))
-            if i >= 1 and abs(rayleigh - previous) <= tolerance * abs(rayleigh):
-                break
-        self._mode = x
-        self.forces(state.u)  # leave the Function at the current displacement
-        return rayleigh
 
 
 class StableStepMonitor:
@@ -132,11 +54,41 @@ class StableStepMonitor:
 
     SAFETY = 0.95
 
-    def __init__(self, force: HyperelasticForce, state, dt_stable: float, every: int = 50):
-        self.force, self.every, self.dt_stable = force, every, dt_stable
-        self.reference = force.largest_eigenvalue(state, iterations=60, tolerance=1e-6)
+    def __init__(self, force, state, dt_stable: float, comm: MPI.Comm, every: int = 50):
+        self.force, self.comm, self.every, self.dt_stable = force, comm, every, dt_stable
+        self._mode = None  # the latest eigenvector estimate
+        self.reference = self.largest_eigenvalue(state, iterations=60, tolerance=1e-6)
         self.estimates = []  # (t, estimated stable step in s) at every check
         self._next, self._interval, self._last = 0, 1, (0, dt_stable)
+
+    def largest_eigenvalue(self, state, iterations: int, tolerance: float = 1e-3) -> float:
+        """Rayleigh quotient (1/s^2) of a power iteration on M^-1/2 K_t M^-1/2, the tangent
+        stiffness K_t applied by finite differences of the internal forces (``forces`` of
+        the :class:`~rwall_fem.elements.ElementForce`); warm-started from the previous
+        call's vector. It stops after ``iterations`` force computations, or earlier (after
+        at least two) once the quotient changes by less than ``tolerance`` (relative) from
+        one iteration to the next."""
+        comm, forces = self.comm, self.force.forces
+        scale = np.sqrt(state.inv_mass)
+        base = forces(state.u)
+        x = self._mode
+        if x is None:
+            x = coordinate_pattern(state.X)[:, None] * [1, -1, 1]
+            x = x / np.sqrt(comm.allreduce(float(np.sum(x * x))))
+        size = comm.allreduce(float(np.ptp(state.X, axis=0).max(initial=0.0)), op=MPI.MAX)
+        rayleigh = previous = 0.0
+        for i in range(iterations):
+            dx = scale * x
+            # Perturb by 1e-7 of the body size: linear enough, far above round-off.
+            largest = comm.allreduce(float(np.abs(dx).max(initial=0.0)), op=MPI.MAX)
+            reach = 1e-7 * size / largest
+            y = (forces(state.u + reach * dx) - base) / reach * scale
+            previous, rayleigh = rayleigh, comm.allreduce(float(np.sum(x * y)))
+            x = y / np.sqrt(comm.allreduce(float(np.sum(y * y))))
+            if i >= 1 and abs(rayleigh - previous) <= tolerance * abs(rayleigh):
+                break
+        self._mode = x
+        return rayleigh
 
     def due(self, step: int) -> bool:
         return step >= self._next

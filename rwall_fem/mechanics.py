@@ -1,8 +1,9 @@
-"""The discretised solid: lumped mass, small-strain stiffness, stable step, internal force.
+"""The discretised solid: lumped mass, stable step, and the UFL forms of Hooke's law.
 
 All arrays returned here hold the rank's *owned* nodes only, shape (n, 3) for
-vectors, in the order of the function space's index map. PETSc vectors that
-wrap them share the row layout of the stiffness matrix.
+vectors, in the order of the function space's index map. The internal force is
+computed by the element kernels (:mod:`rwall_fem.elements`); the UFL stress and
+stiffness forms here are the references the tests and the field output use.
 """
 
 from __future__ import annotations
@@ -19,13 +20,11 @@ from rwall_fem import _compat
 from rwall_fem.scene import Material
 
 __all__ = [
-    "LinearElasticForce",
     "coordinate_pattern",
     "critical_time_step",
     "element_time_step",
     "lumped_mass",
     "stiffness_form",
-    "stiffness_matrix",
     "strain",
     "stress",
 ]
@@ -89,30 +88,37 @@ def stiffness_form(V, material: Material) -> fem.Form:
     return fem.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx)
 
 
-def stiffness_matrix(V, material: Material) -> PETSc.Mat:
-    """Assembled small-strain stiffness K (N/m), a block (BAIJ) PETSc matrix of 3 x 3 blocks.
+class _ScaledStiffness:
+    """The product y = M^-1/2 K M^-1/2 x of a PETSc shell matrix, K applied by the element
+    kernels of a linear elastic force."""
 
-    One column index per block instead of per entry moves about 30 % fewer bytes
-    per product K u than AIJ, the format DOLFINx assembles into (bench/results.md).
-    """
-    return _compat.assemble_matrix(stiffness_form(V, material), PETSc.Mat.Type.BAIJ)
+    def __init__(self, force, mass: np.ndarray):
+        self.force = force
+        self.scale = np.repeat(1.0 / np.sqrt(mass), 3)
+
+    def mult(self, mat, x, y):
+        u = (x.getArray(readonly=True) * self.scale).reshape(-1, 3)
+        y.setArray(self.force.forces(u).ravel() * self.scale)
 
 
-def critical_time_step(K: PETSc.Mat, mass: np.ndarray, coords: np.ndarray) -> float:
+def critical_time_step(force, mass: np.ndarray, coords: np.ndarray, comm: MPI.Comm) -> float:
     """Stable central-difference step 2/omega_max (s), omega_max^2 = lambda_max(M^-1 K).
 
-    The eigenvalue of the symmetric M^-1/2 K M^-1/2 comes from SLEPc, started
-    from :func:`coordinate_pattern` so that every partitioning finds the same value.
+    K is the small-strain stiffness that the linear elastic ``force`` (an
+    :class:`~rwall_fem.elements.ElementForce`) applies cell by cell: no matrix is stored.
+    The eigenvalue of the symmetric M^-1/2 K M^-1/2 comes from SLEPc on a shell
+    operator, started from :func:`coordinate_pattern` of the owned nodes' coordinates
+    ``coords`` (m) so that every partitioning finds the same value. ``mass``: lumped
+    masses (kg) of the owned nodes.
     """
     from slepc4py import SLEPc
 
-    scale = K.createVecRight()
-    scale.array[:] = np.repeat(1.0 / np.sqrt(mass), 3)
-    A = K.copy()
-    A.diagonalScale(scale, scale)
-    start = K.createVecRight()
+    size = (3 * len(mass), PETSc.DECIDE)
+    A = PETSc.Mat().createPython((size, size), _ScaledStiffness(force, mass), comm=comm)
+    A.setUp()
+    start = A.createVecRight()
     start.array[:] = coordinate_pattern(coords).repeat(3) + 1.5
-    eps = SLEPc.EPS().create(K.comm)
+    eps = SLEPc.EPS().create(comm)
     eps.setOperators(A)
     eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
@@ -120,11 +126,12 @@ def critical_time_step(K: PETSc.Mat, mass: np.ndarray, coords: np.ndarray) -> fl
     eps.setTolerances(1e-8, 2000)
     eps.setInitialSpace([start])
     eps.solve()
-    if eps.getConverged() < 1:
-        raise RuntimeError("the largest eigenvalue of M^-1 K did not converge")
-    lambda_max = eps.getEigenvalue(0).real
-    for obj in (eps, A, scale, start):
+    converged = eps.getConverged() >= 1
+    lambda_max = eps.getEigenvalue(0).real if converged else math.nan
+    for obj in (eps, A, start):
         obj.destroy()
+    if not lambda_max > 0.0:
+        raise RuntimeError("the largest eigenvalue of M^-1 K did not converge")
     return 2.0 / math.sqrt(lambda_max)
 
 
@@ -142,32 +149,3 @@ def element_time_step(V, material: Material) -> float:
     lengths = np.linalg.norm(x[nodes[:, pairs[:, 0]]] - x[nodes[:, pairs[:, 1]]], axis=-1)
     shortest = V.mesh.comm.allreduce(lengths.min(initial=np.inf), op=MPI.MIN)
     return shortest / material.p_wave_speed
-
-
-class LinearElasticForce:
-    """Internal force -K u of small-strain linear elasticity with a constant stiffness K.
-
-    It *sets* ``state.a`` (it is always first in the force list). The strain
-    energy 1/2 u.Ku comes for free from the product already computed.
-    """
-
-    name = "linear_elastic"
-    energy_names = ("internal",)
-
-    def __init__(self, K: PETSc.Mat, state):
-        self.K = K
-        self.ku = np.zeros_like(state.u)  # K u^n, N
-        comm, size = K.comm, (state.u.size, PETSc.DECIDE)
-        self._u = PETSc.Vec().createWithArray(state.u.reshape(-1), size=size, bsize=3, comm=comm)
-        self._ku = PETSc.Vec().createWithArray(self.ku.reshape(-1), size=size, bsize=3, comm=comm)
-        # -1/m per component: one pass per step, and a contiguous (n, 3) operand is several
-        # times faster than broadcasting an (n, 1) column over rows of 3.
-        self._minus_inv_mass = -np.repeat(state.inv_mass, 3, axis=1)
-
-    def accelerate(self, state) -> None:
-        self.K.mult(self._u, self._ku)
-        np.multiply(self.ku, self._minus_inv_mass, out=state.a)
-
-    def energies(self, state) -> dict[str, float]:
-        """Strain energy 1/2 u.Ku (J) on this rank's rows, as ``{"internal": ...}``."""
-        return {"internal": 0.5 * float(np.vdot(state.u, self.ku))}

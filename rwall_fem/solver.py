@@ -4,8 +4,10 @@ One step, in the order of ``docs/theory.md`` (section "The step"):
 
 1. forces -> acceleration ``a^n``: the internal force *sets* ``a``, body forces add to it;
 2. constraints edit ``a^n``: the rigid walls, then the velocity boundary conditions;
-3. recorders sample the steps they are due (energies need ``v^{n-1/2}`` and ``a^n``);
-4. ``v^{n+1/2} = v^{n-1/2} + dt a^n``; ``u^{n+1} = u^n + dt v^{n+1/2}``.
+3. recorders sample the steps they are due (fields, frames: ``u^n``, ``v^{n-1/2}``);
+4. the update ``v^{n+1/2} = v^{n-1/2} + dt a^n``, ``u^{n+1} = u^n + dt v^{n+1/2}``, in one
+   compiled pass that also books the step's kinetic energy (:class:`CentralDifference`);
+5. bookkeeping: the history samples the energies of step n.
 
 Each effect is an object with a small interface (:class:`Force`, :class:`Constraint`,
 :class:`Recorder`), and only the effects a scene asks for are in the lists, so nothing
@@ -15,6 +17,7 @@ else runs.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import signal
 import threading
@@ -26,6 +29,7 @@ import numpy as np
 
 __all__ = [
     "BodyForce",
+    "CentralDifference",
     "Constraint",
     "Force",
     "InternalForce",
@@ -52,6 +56,8 @@ class State:
     a: np.ndarray = None  # acceleration a^n, m/s^2
     t: float = 0.0  # s
     step: int = 0
+    kinetic: float = 0.0  # K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} of the latest update, J
+    internal_work: float = 0.0  # of an internal force without stored energy, up to step n, J
 
     def __post_init__(self):
         for name in ("u", "v", "a"):
@@ -71,11 +77,14 @@ class Force(Protocol):
 class InternalForce(Force, Protocol):
     """The body's internal force: first in the pipeline, it *sets* ``state.a``.
 
-    ``energy_names`` are the energies it stores (``("internal",)``); :meth:`energies`
-    gives them (J) on this rank's share of the body at the latest step.
+    ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``);
+    :meth:`energies` gives them (J) on this rank's share of the body at step n.
+    ``booked_force`` is None for a force with a stored energy; otherwise it is the nodal
+    force (N, owned nodes) whose work the update books in ``state.internal_work``.
     """
 
     energy_names: tuple[str, ...]
+    booked_force: np.ndarray | None
 
     def energies(self, state: State) -> dict[str, float]: ...
 
@@ -96,14 +105,50 @@ class Constraint(Protocol):
 
 
 class Recorder(Protocol):
-    """Samples the run at the steps it is :meth:`due` (before the update of that step) and
-    is closed once when the run ends, however it ends."""
+    """Samples the run at the steps it is :meth:`due` (before the update of that step; the
+    history samples after it) and is closed once when the run ends, however it ends."""
 
     def due(self, step: int) -> bool: ...
 
     def record(self, sim: Simulation, state: State) -> None: ...
 
     def close(self, sim: Simulation) -> None: ...
+
+
+class CentralDifference:
+    """The update of a step in one compiled pass (``kernels/update.c``):
+    v^{n+1/2} = v^{n-1/2} + dt a^n and u^{n+1} = u^n + dt v^{n+1/2}, booking on the way the
+    shadow kinetic energy K^n in ``state.kinetic`` and, when ``booked`` is given, the work
+    of that force at mid-step velocities in ``state.internal_work`` (J, this rank: both
+    halves of every step before n and the first half of step n, as every work is booked).
+    """
+
+    def __init__(self, state: State, booked: np.ndarray | None = None):
+        from rwall_fem.kernels import load
+
+        ffi, lib = load()
+        self._out = np.zeros(3)
+        self._done = 0.0  # work of the finished steps, J
+
+        def ptr(array):
+            return ffi.cast("double *", array.ctypes.data) if array is not None else ffi.NULL
+
+        for name in ("u", "v", "a"):
+            if not getattr(state, name).flags.c_contiguous:
+                raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
+        self._booked = booked is not None
+        self._pass = functools.partial(
+            lib.advance, len(state.mass), state.dt, ptr(state.mass), ptr(state.a),
+            ptr(state.v), ptr(state.u), ptr(booked), ptr(self._out),
+        )  # fmt: skip
+
+    def __call__(self, state: State) -> None:
+        self._pass()
+        kinetic, first, second = self._out
+        state.kinetic = kinetic
+        if self._booked:
+            state.internal_work = self._done + first
+            self._done += first + second
 
 
 @dataclass
@@ -120,10 +165,15 @@ class Simulation:
     recorders: list[Recorder] = field(default_factory=list)
     # What was built: scene, cells, nodes, mass (kg), dt_stable (s), ... (summary.json)
     info: dict = field(default_factory=dict)
-    history: Any = None  # the History among the recorders (rwall_fem.output.history)
+    history: Recorder | None = None  # the energy books, sampled after the update
+    update: CentralDifference | None = None  # built from the state when not given
     wall_seconds: float = 0.0  # of the time loop, on this rank
     status: str = "not run"  # "done", "stopped: <reason>" or "failed: <error>"
     terminate_requested: bool = False  # set by SIGTERM; acted on at the next history sample
+
+    def __post_init__(self):
+        if self.update is None:
+            self.update = CentralDifference(self.state, self.internal.booked_force)
 
     @property
     def num_steps(self) -> int:
@@ -148,11 +198,11 @@ class Simulation:
         was closed; a recorder that fails to close does not keep the others from
         closing, and never hides an error raised before it (it is noted on it).
         """
-        s, last = self.state, self.num_steps
+        s, last, update, history = self.state, self.num_steps, self.update, self.history
         forces, constraints = [self.internal, *self.forces], self.constraints
-        scratch = np.empty_like(s.u)
         with contextlib.ExitStack() as closing:
-            for recorder in reversed(self.recorders):  # closed in the order of the list
+            outputs = [history, *self.recorders] if history is not None else self.recorders
+            for recorder in reversed(outputs):  # closed in the order of the list
                 closing.push(_closer(recorder, self))
             closing.enter_context(_sigterm_requests(self))
             started = time.perf_counter()
@@ -166,10 +216,9 @@ class Simulation:
                     for recorder in self.recorders:
                         if recorder.due(step):
                             recorder.record(self, s)
-                    np.multiply(s.a, s.dt, out=scratch)
-                    s.v += scratch
-                    np.multiply(s.v, s.dt, out=scratch)
-                    s.u += scratch
+                    update(s)
+                    if history is not None and history.due(step):
+                        history.record(self, s)
                 self.status = "done"
             except RunStopped as stop:
                 self.status = f"stopped: {stop}"

@@ -2,10 +2,12 @@
 
 ``docs/theory.md`` (section "Energy balance") derives the booking:
 
-- the kinetic energy is the shadow value K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}, walls
-  carried by a main node included;
-- the stored energies come from the internal force (``"internal"``: 1/2 u.Ku for linear
-  elasticity, the integral of the energy density for the hyperelastic models);
+- the kinetic energy is the shadow value K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} (booked by
+  the update of step n), walls carried by a main node included;
+- the stored energies come from the internal force: ``"internal"`` (the strain energy of
+  the element kernels: 1/2 u.Ku for linear elasticity, the integral of the energy density
+  for the hyperelastic models; for a force without stored energy, its work at mid-step
+  velocities) and ``"hourglass"`` (one-point hexahedra with hourglass control);
 - the work of every other force (body forces, walls, boundary conditions) is booked at
   mid-step velocities, 1/2 g^n . (v^{n-1/2} + v^{n+1/2}) dt. The wall work is that of
   the contact impulses relative to the wall (normal stop and friction); the driving work
@@ -21,15 +23,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["EnergyBalance", "initial_kinetic_energy", "shadow_kinetic_energy"]
-
-
-def shadow_kinetic_energy(state, scratch: np.ndarray) -> float:
-    """K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} (J) of this rank's nodes, with v^{n+1/2}
-    predicted from ``a^n`` into ``scratch`` (an (n, 3) work array)."""
-    ahead = np.multiply(state.a, state.dt, out=scratch)
-    ahead += state.v  # v^{n+1/2}
-    return 0.5 * np.einsum("i,ij,ij->", state.mass, state.v, ahead)
+__all__ = ["EnergyBalance", "initial_kinetic_energy"]
 
 
 def initial_kinetic_energy(state, walls, comm) -> float:
