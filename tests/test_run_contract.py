@@ -97,7 +97,7 @@ def test_dt_above_stable_limit_is_refused(shared_dir):
         ("mesh.size", [1.0, 0.0, 1.0], r"mesh\.size: must be 3 positive lengths"),
         ("wall.0.normal_point", [0.0, 0.0, 0.0], r"wall\[0\]\.normal_point: must differ"),
         ("wall.0.kind", "cone", r"wall\[0\]\.kind: must be one of 'plane', 'cylinder'"),
-        ("wall.0.slide", "sticky", r"wall\[0\]\.slide: must be 'free', 'tied', 'friction'"),
+        ("wall.0.slide", "sticky", r"wall\[0\]\.slide: must be one of 'free', 'tied', 'friction'"),
         ("wall.0.friction", 0.3, r"wall\[0\]\.friction: needs slide = 'friction'"),
         ("wall.0.diameter", 1.0, r"wall\[0\]\.diameter: is not a key of a plane wall"),
         ("wall.0.point", [0.0, float("nan"), 0.0], r"wall\[0\]\.point: must be 3 finite"),
