@@ -72,9 +72,12 @@ def show(value: Any, depth: int = 0) -> str:
     if isinstance(value, int):
         if abs(value) < 10**20:
             return str(value)
-        return f"a {int(math.log10(abs(value))) + 1}-digit integer"
+        try:
+            return f"a {len(str(abs(value)))}-digit integer"
+        except ValueError:  # beyond Python's digit limit for str()
+            return "an integer of thousands of digits"
     if isinstance(value, float):
-        return f"{value:g}"
+        return repr(value)
     if isinstance(value, str):
         text = value if len(value) <= 40 else value[:37] + "..."
         return repr(text)
@@ -127,7 +130,8 @@ class Context:
         return Context(self.source, self.base, path, self.values if values is None else values)
 
     def fail(self, path: str, message: str) -> NoReturn:
-        raise SceneError(f"{self.source}: {path}: {message}" if path else f"{self.source}: {message}")
+        where = f"{path}: " if path else ""
+        raise SceneError(f"{self.source}: {where}{message}")
 
 
 def _is_number(value) -> bool:
@@ -138,7 +142,7 @@ def _float(value) -> float:
     try:
         return float(value)
     except OverflowError:  # an integer of hundreds of digits
-        return math.copysign(math.inf, value)
+        return math.inf if value > 0 else -math.inf
 
 
 class ValueType:
@@ -205,7 +209,7 @@ class Real(ValueType):
 
 @dataclass(frozen=True)
 class Integer(ValueType):
-    """An integer (not a float, not a boolean) in [low, high]; ``why`` says where high comes from."""
+    """An integer (not a float, not a boolean) in [low, high]; ``why``: where high comes from."""
 
     low: int = 0
     high: int | None = None
@@ -216,12 +220,13 @@ class Integer(ValueType):
         high = INT64_MAX if self.high is None else self.high
         if isinstance(value, int) and not isinstance(value, bool) and self.low <= value <= high:
             return value
-        raise Invalid(f"must be an integer {self.allowed_text()}, got {show(value)}")
+        span = f">= {self.low}" if self.high is None else f"in {self.allowed_text()}"
+        raise Invalid(f"must be an integer {span}, got {show(value)}")
 
     def allowed_text(self):
         if self.high is None:
             return f">= {self.low}"
-        return f"in [{self.low}, {self.high}]" + (f" ({self.why})" if self.why else "")
+        return f"[{self.low}, {self.high}]" + (f" ({self.why})" if self.why else "")
 
     def json(self):
         return {"type": "integer", "minimum": self.low, "maximum": self.high or INT64_MAX}
@@ -456,7 +461,9 @@ class Each(ValueType):
         if not isinstance(value, (list, tuple)):
             name = ctx.path.rpartition(".")[2]
             raise Invalid(f"must be an array of tables: write [[{name}]]")
-        return tuple(read_table(self.cls, v, ctx.at(f"{ctx.path}[{i}]")) for i, v in enumerate(value))
+        return tuple(
+            read_table(self.cls, v, ctx.at(f"{ctx.path}[{i}]")) for i, v in enumerate(value)
+        )
 
 
 # --- keys and tables ------------------------------------------------------------
@@ -547,12 +554,14 @@ def table(doc: str, *, variants: Variants | None = None, one_of: bool = False):
     return mark
 
 
-def rule(cls):
+def rule(cls, json: list[dict] = ()):
     """Decorator: ``fn(values, raw, fail)`` checks the keys of ``cls``'s table together (its
     docstring is the rule's line on the reference page). ``values`` maps field names to the
-    values read (defaults filled in) and may be completed; ``fail(key, message)`` refuses."""
+    values read (defaults filled in) and may be completed; ``fail(key, message)`` refuses.
+    ``json``: what the JSON Schema can say of the rule (subschemas of the table's allOf)."""
 
     def register(fn):
+        fn.json = list(json)
         cls.__table__.rules.append(fn)
         return fn
 

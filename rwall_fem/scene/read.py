@@ -45,7 +45,8 @@ def read_toml(path: Path) -> dict:
     except tomllib.TOMLDecodeError as err:
         raise SceneError(f"{path}: not valid TOML: {' '.join(str(err).split())}") from None
     except ValueError as err:  # an integer beyond Python's digit limit
-        raise SceneError(f"{path}: not valid TOML: {' '.join(str(err).split())}") from None
+        reason = str(err).partition(";")[0]
+        raise SceneError(f"{path}: not valid TOML: a number too long to read ({reason})") from None
     except RecursionError:
         raise SceneError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
 
@@ -58,7 +59,8 @@ def parse_scene(raw: dict, source: str = "<scene>", base: Path = Path(".")) -> S
     """
     ctx = Context(source, Path(base))
     if isinstance(raw, dict) and isinstance(raw.get("wall"), (list, tuple)):
-        raw = raw | {"wall": [_shape_table(w, f"wall[{i}]", ctx) for i, w in enumerate(raw["wall"])]}
+        walls = [_shape_table(w, f"wall[{i}]", ctx) for i, w in enumerate(raw["wall"])]
+        raw = raw | {"wall": walls}
     return read_table(Scene, raw, ctx, extra={"source": source})
 
 

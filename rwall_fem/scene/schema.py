@@ -225,7 +225,18 @@ def _hole_fits(v, raw, fail):
         )
 
 
-@rule(MeshSpec)
+@rule(
+    MeshSpec,
+    json=[
+        {
+            "dependentRequired": {
+                "refine_point": ["refine_size"],
+                "refine_size": ["refine_point"],
+                "refine_radius": ["refine_point", "refine_size"],
+            }
+        }
+    ],
+)
 def _refinement_comes_whole(v, raw, fail):
     """refine_point and refine_size come together; refine_radius needs them."""
     given = [name for name in _REFINE_KEYS if name in raw]
@@ -439,7 +450,10 @@ class Motion:
         return self.mass is None
 
 
-@rule(Motion)
+@rule(
+    Motion,
+    json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
+)
 def _table_without_mass(v, raw, fail):
     """A velocity history prescribes the motion: no mass with it."""
     if v["mass"] is not None and isinstance(v["velocity"][0], tuple):
@@ -573,7 +587,10 @@ class Scene:
     source: str  # the file name used in messages
     run: RunSettings = key(Sub(RunSettings), doc="time span and step")
     mesh: MeshSpec | None = key(
-        Sub(MeshSpec, empty_is_none=True), None, doc="the body", default_doc="a body given to the API"
+        Sub(MeshSpec, empty_is_none=True),
+        None,
+        doc="the body",
+        default_doc="a body given to the API",
     )
     material: Material = key(Sub(Material), doc="the elastic law")
     element: Element = key(Sub(Element), factory=Element, doc="element technology")
@@ -581,8 +598,7 @@ class Scene:
     gravity: tuple[float, float, float] | None = key(
         Sub(Gravity, then=lambda g: g.acceleration),
         None,
-        unit="m/s^2",
-        doc="the acceleration of gravity",
+        doc="the acceleration of gravity (m/s^2)",
         default_doc="none",
     )
     boundaries: tuple[BoundarySpec, ...] = key(
@@ -592,7 +608,22 @@ class Scene:
     output: Output = key(Sub(Output), factory=Output, doc="pictures, fields, histories")
 
 
-@rule(Scene)
+_TETRAHEDRA = {
+    "properties": {
+        "mesh": {"properties": {"cell": {"const": "tetrahedron"}}, "required": ["cell"]}
+    },
+    "required": ["mesh"],
+}
+_FULL_ONLY = {
+    "properties": {
+        "integration": {"not": {"const": "reduced"}},
+        "hourglass": False,
+        "hourglass_coefficient": False,
+    }
+}
+
+
+@rule(Scene, json=[{"if": _TETRAHEDRA, "then": {"properties": {"element": _FULL_ONLY}}}])
 def _element_fits_the_cells(v, raw, fail):
     """Tetrahedra (mesh.cell) are P1, integrated exactly at one point: "full" only, and no
     hourglass keys. (For a mesh file the cell type is checked when the body is built.)"""
