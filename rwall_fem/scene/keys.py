@@ -585,9 +585,10 @@ def _default(f: dataclasses.Field) -> Any:
 
 
 def _hint(name: str, allowed) -> str:
-    close = difflib.get_close_matches(name, allowed, n=1) or [
-        a for a in allowed if a.startswith(name) or name.startswith(a)
-    ][:1]
+    close = (
+        difflib.get_close_matches(name, allowed, n=1)
+        or [a for a in allowed if a.startswith(name) or name.startswith(a)][:1]
+    )
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 

@@ -46,8 +46,11 @@ def apply_override(raw: dict, item: str, source: str = "--set") -> None:
             where = f"{where}[{part}]"
         else:
             if isinstance(node, list):
-                fail(f"{where} is an array: write {where}[{part}]" if part.isdigit() else
-                     f"{where} is an array of tables: index it, as in {where}[0].{part}")
+                fail(
+                    f"{where} is an array: write {where}[{part}]"
+                    if part.isdigit()
+                    else f"{where} is an array of tables: index it, as in {where}[0].{part}"
+                )
             if not isinstance(node, dict):
                 fail(f"{where} is {_kind(node)}, not a table")
             if after is not None and part not in node:
@@ -76,4 +79,6 @@ def _kind(value: Any) -> str:
         return "a string"
     if isinstance(value, list):
         return "an array"
+    if isinstance(value, dict):
+        return "a table"
     return "a date or time"

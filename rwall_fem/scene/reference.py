@@ -82,8 +82,9 @@ def _table_schema(cls) -> dict:
                     "then": {
                         "properties": {n: False for n in keys if n not in allowed},
                         "required": [
-                            n for n in keys if n in allowed and keys[n][1].required
-                            and not keys[n][1].when
+                            n
+                            for n in keys
+                            if n in allowed and keys[n][1].required and not keys[n][1].when
                         ],
                     },
                 }
@@ -103,7 +104,7 @@ def _table_schema(cls) -> dict:
                     "then": {"anyOf": [{"required": [v.on]}, {"required": [other]}]},
                 }
             )
-    for name, (f, k) in keys.items():
+    for name, (_, k) in keys.items():
         for sibling, allowed in k.when.items():
             sf, sk = keys[names[sibling]]
             values = sk.type.json_values(allowed) if isinstance(sk.type, Choice) else allowed
@@ -118,9 +119,7 @@ def _table_schema(cls) -> dict:
                 rules.append({"if": met, "then": {"required": [name]}})
     for check in spec.rules:
         rules.extend(getattr(check, "json", []))
-    required = [
-        n for n, (f, k) in keys.items() if k.required and not k.when and n not in variable
-    ]
+    required = [n for n, (f, k) in keys.items() if k.required and not k.when and n not in variable]
     if required:
         out["required"] = required
     if spec.one_of:
@@ -246,9 +245,10 @@ def reference_page() -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-def write(root: Path = Path(__file__).resolve().parents[2]) -> None:
-    """Write the reference page and the JSON Schema into the repository at ``root``."""
-    page = root / PAGE
+def write(root: Path | None = None) -> None:
+    """Write the reference page and the JSON Schema into the repository at ``root`` (by
+    default the one this package is in)."""
+    page = (root or Path(__file__).resolve().parents[2]) / PAGE
     page.parent.mkdir(parents=True, exist_ok=True)
     page.write_text(reference_page())
     SCHEMA_FILE.write_text(json.dumps(json_schema(), indent=2) + "\n")

@@ -340,9 +340,7 @@ class Material:
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 
 
-@table(
-    "Element technology (LS-DYNA *SECTION_SOLID + *HOURGLASS, Radioss /PROP/SOLID); optional."
-)
+@table("Element technology (LS-DYNA *SECTION_SOLID + *HOURGLASS, Radioss /PROP/SOLID); optional.")
 @dataclass(frozen=True)
 class Element:
     integration: str | None = key(
