@@ -587,7 +587,7 @@ def _default(f: dataclasses.Field) -> Any:
 def _hint(name: str, allowed) -> str:
     close = (
         difflib.get_close_matches(name, allowed, n=1)
-        or [a for a in allowed if a.startswith(name) or name.startswith(a)][:1]
+        or [a for a in allowed if name and (a.startswith(name) or name.startswith(a))][:1]
     )
     return f" (did you mean '{close[0]}'?)" if close else ""
 
@@ -611,6 +611,7 @@ def read_table(cls, raw: Any, ctx: Context, extra: dict | None = None) -> Any:
     keys = keys_of(cls)
     for name in raw:
         if name not in keys:
+            name = str(name)  # a dict from Python may have other keys than strings
             ctx.fail(
                 join(path, name), f"unknown key{_hint(name, keys)}; allowed: {', '.join(keys)}"
             )
@@ -647,14 +648,18 @@ def read_table(cls, raw: Any, ctx: Context, extra: dict | None = None) -> Any:
                 allowed = ", ".join(n for n in keys if n in present and n != v.on)
                 ctx.fail(join(path, name), f"is not a key of {noun}{belongs}; allowed: {allowed}")
 
+    # Declaration order: a key's conditions and bounds refer to keys declared before it.
     for name, (f, k) in keys.items():
-        unmet = _unmet(k, values) if name in present else "absent"
-        if unmet is None and name in raw:
-            values[f.name] = read(name)
-        elif unmet is None and k.required:
-            ctx.fail(join(path, name), "missing")
+        if name not in present:  # a key of another variant, not given
+            values[f.name] = _default(f)
+        elif unmet := _unmet(k, values):
+            if name in raw:
+                ctx.fail(join(path, name), unmet)
+            values[f.name] = _default(f)
         elif name in raw:
-            ctx.fail(join(path, name), unmet)
+            values[f.name] = read(name)
+        elif k.required:
+            ctx.fail(join(path, name), "missing")
         else:
             values[f.name] = _default(f)
 
