@@ -1,0 +1,642 @@
+"""The scene format, written once: every table a dataclass, every key a ``key(...)``.
+
+Each key carries its type, unit, range, default and a one-line doc; rules that
+tie keys together are functions next to their table, their docstring the line
+the reference page prints. The validation (:func:`~rwall_fem.scene.keys.read_table`),
+``docs/reference/scene.md`` and ``scene.schema.json``
+(:mod:`rwall_fem.scene.reference`) all come from here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from rwall_fem.scene.keys import (
+    Choice,
+    Each,
+    Flag,
+    Integer,
+    Letters,
+    MeshFile,
+    Names,
+    Real,
+    Sub,
+    Text,
+    Variants,
+    Vector,
+    Velocity,
+    key,
+    rule,
+    table,
+)
+
+__all__ = [
+    "MATERIAL_MODELS",
+    "MESH_SHAPES",
+    "SHAPE_KEYS",
+    "BoundarySpec",
+    "Element",
+    "Initial",
+    "Material",
+    "MeshSpec",
+    "Motion",
+    "Output",
+    "RunSettings",
+    "Scene",
+    "Secondary",
+    "WallSpec",
+]
+
+# Small strain (constant stiffness), and the large-deformation (hyperelastic) models.
+MATERIAL_MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
+
+# The keys of each mesh shape besides "shape", "noise" and the refinement keys.
+MESH_SHAPES = {
+    "bar": ("origin", "size", "axis", "element_size", "cell"),
+    "round_bar": ("origin", "radius", "length", "axis", "element_size", "cell"),
+    "plate": ("origin", "size", "layers", "axis", "element_size", "cell"),
+    "plate_with_hole": (
+        "origin",
+        "size",
+        "hole_radius",
+        "hole_offset",
+        "layers",
+        "axis",
+        "element_size",
+        "cell",
+    ),
+}
+_REFINE_KEYS = ("refine_point", "refine_size", "refine_radius")
+
+# The keys that define each wall shape besides ``point`` (M).
+SHAPE_KEYS = {
+    "plane": ("normal_point",),
+    "cylinder": ("axis_point", "diameter"),
+    "sphere": ("diameter",),
+    "parallelogram": ("corner1", "corner2"),
+}
+_WALL_KEYS = ("point", "slide", "friction", "friction_filter", "secondary", "motion")
+
+
+# --- [run] -------------------------------------------------------------------------
+
+
+@table("How long, and with which time step.")
+@dataclass(frozen=True)
+class RunSettings:
+    end_time: float = key(Real(low=0.0), unit="s", doc="simulated time")
+    dt_scale: float = key(
+        Real(low=0.0, high=1.0), 0.9, doc="the step as a fraction of the stable step 2/omega_max"
+    )
+    dt: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="s",
+        doc="a fixed step instead; refused above the stable limit (checked with the body)",
+        default_doc="from dt_scale",
+    )
+    max_energy_error: float = key(
+        Real(low=0.0),
+        0.05,
+        doc="guard: the run stops (exit 3) when the energy balance error exceeds it",
+    )
+    min_dt: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="s",
+        doc="guard: the run stops when the step falls below it",
+    )
+
+
+# --- [mesh] ------------------------------------------------------------------------
+
+
+@table("The noise: a reproducible random shift of every initial node coordinate.")
+@dataclass(frozen=True)
+class Noise:
+    amplitude: float = key(
+        Real(low=0.0), unit="m", doc="each coordinate moves by at most this, uniformly"
+    )
+    seed: int = key(
+        Integer(0, 2**64 - 1, why="the seed of a 64-bit generator"),
+        0,
+        doc="the same seed gives the same shift on any number of ranks",
+    )
+
+
+@table(
+    "The body: a built-in shape (`meshes/<shape>.geo`) or a gmsh file; no [mesh]: a body "
+    "given to `build_simulation`.",
+    variants=Variants(
+        "shape",
+        MESH_SHAPES,
+        common=(*_REFINE_KEYS, "noise"),
+        instead=("file", "a mesh file", ("noise",)),
+    ),
+)
+@dataclass(frozen=True)
+class MeshSpec:
+    shape: str | None = key(
+        Choice(tuple(MESH_SHAPES)),
+        None,
+        required=True,
+        doc="the built-in body",
+        default_doc="required, or file",
+    )
+    file: Path | None = key(
+        MeshFile(), None, doc="a gmsh .msh or .geo file instead of a shape and its keys"
+    )
+    origin: tuple[float, float, float] = key(
+        Vector(),
+        (0.0, 0.0, 0.0),
+        unit="m",
+        doc="lowest corner (bar, plates) or centre of the bottom face (round bar); "
+        "the body turns about it",
+    )
+    size: tuple[float, float, float] | None = key(
+        Vector(kind="positive"),
+        None,
+        required=True,
+        unit="m",
+        doc="lengths along the body's own x, y, z (plates: lx, ly, thickness)",
+    )
+    radius: float | None = key(Real(low=0.0), None, required=True, unit="m", doc="of the bar")
+    length: float | None = key(
+        Real(low=0.0), None, required=True, unit="m", doc="of the bar, along its own z"
+    )
+    hole_radius: float | None = key(
+        Real(low=0.0), None, required=True, unit="m", doc="of the through-hole"
+    )
+    hole_offset: tuple[float, float] = key(
+        Vector(2), (0.0, 0.0), unit="m", doc="hole centre - plate centre, along its own x, y"
+    )
+    layers: int = key(
+        Integer(low=1),
+        0,
+        doc="elements through the thickness",
+        default_doc="the fewest at most element_size thick",
+    )
+    axis: tuple[float, float, float] = key(
+        Vector(kind="direction"),
+        (0.0, 0.0, 1.0),
+        doc="where the body's own z points (it turns about origin)",
+    )
+    element_size: float | None = key(
+        Real(low=0.0), None, required=True, unit="m", doc="target edge length"
+    )
+    cell: str = key(Choice(("hexahedron", "tetrahedron")), "hexahedron", doc="the cell type")
+    refine_point: tuple[float, float, float] | None = key(
+        Vector(), None, unit="m", doc="centre of a zone of smaller cells, in scene coordinates"
+    )
+    refine_size: float | None = key(
+        Real(low=0.0, high="element_size", high_open=True),
+        None,
+        unit="m",
+        doc="element size at refine_point",
+    )
+    refine_radius: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="distance over which the size grows back to element_size",
+        default_doc="4 x element_size",
+    )
+    noise: tuple[float, int] | None = key(
+        Sub(Noise, then=lambda n: (n.amplitude, n.seed)),
+        None,
+        doc="(amplitude, seed): random shift of the initial coordinates",
+    )
+
+
+@rule(MeshSpec)
+def _hole_fits(v, raw, fail):
+    """A plate's hole lies inside the plate: |dx| + r < lx/2 and |dy| + r < ly/2."""
+    if v["shape"] != "plate_with_hole":
+        return
+    r, (dx, dy), (lx, ly, _) = v["hole_radius"], v["hole_offset"], v["size"]
+    if abs(dx) + r >= lx / 2 or abs(dy) + r >= ly / 2:
+        fail(
+            "hole_radius",
+            f"the hole (radius {r:g} m, centre {dx:g}, {dy:g} m from the plate's centre) "
+            f"does not fit in the plate ({lx:g} x {ly:g} m): "
+            "it needs |dx| + r < lx/2 and |dy| + r < ly/2",
+        )
+
+
+@rule(
+    MeshSpec,
+    json=[
+        {
+            "dependentRequired": {
+                "refine_point": ["refine_size"],
+                "refine_size": ["refine_point"],
+                "refine_radius": ["refine_point", "refine_size"],
+            }
+        }
+    ],
+)
+def _refinement_comes_whole(v, raw, fail):
+    """refine_point and refine_size come together; refine_radius needs them."""
+    given = [name for name in _REFINE_KEYS if name in raw]
+    if not given:
+        return
+    for name in ("refine_point", "refine_size"):
+        if name not in raw:
+            fail(name, f"missing ({' and '.join(given)} need it)")
+    if v["refine_radius"] is None:
+        v["refine_radius"] = 4 * v["element_size"]
+
+
+def _own_frame(axis) -> list[list[float]]:
+    """The rows of R^T, where R turns z onto ``axis``: meshing.rotation_to, without NumPy."""
+    n = math.hypot(*axis)
+    b = [a / n for a in axis]
+    c = b[2]
+    if c < -1 + 1e-12:
+        return [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]
+    k = (-b[1], b[0], 0.0)
+    K = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]]
+    KK = [[sum(K[i][m] * K[m][j] for m in range(3)) for j in range(3)] for i in range(3)]
+    R = [[(i == j) + K[i][j] + KK[i][j] / (1 + c) for j in range(3)] for i in range(3)]
+    return [[R[j][i] for j in range(3)] for i in range(3)]
+
+
+def body_box(v) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The body's box (lowest, highest corner) in its own frame, relative to ``origin``."""
+    if v["shape"] == "round_bar":
+        r = v["radius"]
+        return (-r, -r, 0.0), (r, r, v["length"])
+    return (0.0, 0.0, 0.0), v["size"]
+
+
+@rule(MeshSpec)
+def _refinement_reaches_the_body(v, raw, fail):
+    """A refine_point lies within refine_radius of the body's box (origin, size or radius
+    and length, turned onto axis): farther, nothing would be refined."""
+    if v["shape"] is None or v["refine_point"] is None:
+        return
+    low, high = body_box(v)
+    shifted = [p - o for p, o in zip(v["refine_point"], v["origin"], strict=True)]
+    own = [sum(r * s for r, s in zip(row, shifted, strict=True)) for row in _own_frame(v["axis"])]
+    gap = math.hypot(*(max(lo - q, 0.0, q - hi) for q, lo, hi in zip(own, low, high, strict=True)))
+    if gap > v["refine_radius"]:
+        box = " x ".join(f"[{lo:g}, {hi:g}]" for lo, hi in zip(low, high, strict=True))
+        fail(
+            "refine_point",
+            f"is {gap:.3g} m from the body, farther than refine_radius ({v['refine_radius']:g} m):"
+            f" nothing would be refined; the body is origin + {box} m in its own frame "
+            "(its z along axis)",
+        )
+
+
+@rule(MeshSpec)
+def _noise_is_small(v, raw, fail):
+    """The noise amplitude is at most 0.1 x the smallest element size (element_size,
+    refine_size): more distorts the elements and shrinks the stable step."""
+    if v["shape"] is None or v["noise"] is None:
+        return
+    h = min(v["element_size"], v["refine_size"] or math.inf)
+    amplitude = v["noise"][0]
+    if amplitude > 0.1 * h:
+        fail(
+            "noise.amplitude",
+            f"{amplitude:g} m is more than 0.1 x the smallest element size ({h:g} m): "
+            f"it would distort the elements and shrink the stable step; at most {0.1 * h:g} m",
+        )
+
+
+# --- [material], [element], [initial], [gravity] ------------------------------------
+
+
+@table(
+    "The body's material: one elastic law for the whole body.",
+    variants=Variants("model", {m: ("density", "young", "poisson") for m in MATERIAL_MODELS}),
+)
+@dataclass(frozen=True)
+class Material:
+    model: str = key(
+        Choice(MATERIAL_MODELS),
+        doc="linear_elastic: small strain; saint_venant_kirchhoff, neo_hookean: large deformation",
+    )
+    density: float = key(Real(low=0.0), unit="kg/m^3", doc="mass density")
+    young: float = key(Real(low=0.0), unit="Pa", doc="Young's modulus")
+    poisson: float = key(Real(low=-1.0, high=0.5, high_open=True), doc="Poisson's ratio")
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lamé parameters (lambda, mu) in Pa."""
+        E, nu = self.young, self.poisson
+        return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+
+    @property
+    def p_wave_speed(self) -> float:
+        """Dilatational wave speed sqrt((lambda + 2 mu)/rho) in m/s."""
+        lmbda, mu = self.lame
+        return math.sqrt((lmbda + 2 * mu) / self.density)
+
+
+_HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
+
+
+@table("Element technology (LS-DYNA *SECTION_SOLID + *HOURGLASS, Radioss /PROP/SOLID); optional.")
+@dataclass(frozen=True)
+class Element:
+    integration: str | None = key(
+        Choice(("reduced", "full")),
+        None,
+        doc="reduced: one point + hourglass control (hexahedra only); full: 2x2x2 Gauss on "
+        "hexahedra, one exact point on (P1) tetrahedra",
+        default_doc="reduced on hexahedra, full on tetrahedra (None: by cell type)",
+    )
+    hourglass: str = key(
+        Choice((*_HOURGLASS_FORMS, "none")),
+        "physical",
+        when={"integration": ("reduced",)},
+        doc="physical: assumed-strain stabilisation (Belytschko-Bindeman, Radioss HEPH); "
+        "stiffness, viscous: Flanagan-Belytschko forms; none",
+    )
+    hourglass_coefficient: float = key(
+        Real(low=0.0),
+        1.0,
+        when={"integration": ("reduced",), "hourglass": _HOURGLASS_FORMS},
+        doc="scales the hourglass forces",
+        default_doc="1.0 for physical, 0.1 for stiffness and viscous (LS-DYNA's QM)",
+    )
+
+
+@rule(Element)
+def _coefficient_by_form(v, raw, fail):
+    """hourglass_coefficient defaults by form: 1.0 (physical), 0.1 (stiffness, viscous);
+    with hourglass = "none" it is 0."""
+    if "hourglass_coefficient" not in raw:
+        v["hourglass_coefficient"] = {"physical": 1.0, "none": 0.0}.get(v["hourglass"], 0.1)
+
+
+@table("The initial state of the body.")
+@dataclass(frozen=True)
+class Initial:
+    velocity: tuple[float, float, float] = key(
+        Vector(), (0.0, 0.0, 0.0), unit="m/s", doc="uniform initial velocity"
+    )
+
+
+@table("A uniform body force; no [gravity]: none.")
+@dataclass(frozen=True)
+class Gravity:
+    acceleration: tuple[float, float, float] = key(
+        Vector(), unit="m/s^2", doc="on every node, e.g. [0, 0, -9.81]"
+    )
+
+
+# --- [[boundary]] ----------------------------------------------------------------
+
+
+@table("A prescribed velocity (zero: a clamp) of some components of a named node set.")
+@dataclass(frozen=True)
+class BoundarySpec:
+    group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
+    velocity: tuple = key(
+        Velocity(),
+        (0.0, 0.0, 0.0),
+        unit="m/s",
+        doc="constant, or a history (linear between rows, held after the last)",
+    )
+    components: str = key(
+        Letters(), "xyz", doc="the global components prescribed; the others stay free"
+    )
+
+
+# --- [[wall]] ------------------------------------------------------------------------
+
+
+@table("Which nodes a wall acts on; none given: every boundary node of the body.")
+@dataclass(frozen=True)
+class Secondary:
+    """Which nodes a wall acts on; the default is every boundary node of the body."""
+
+    search_distance: float | None = key(
+        Real(low=0.0, low_open=False),
+        None,
+        unit="m",
+        doc="only the nodes with 0 <= distance <= this at the start",
+        default_doc="no limit",
+    )
+    add: tuple[str, ...] = key(Names(), (), doc="named node sets (gmsh physical groups) to include")
+    exclude: tuple[str, ...] = key(Names(), (), doc="named node sets to leave out; exclusion wins")
+
+
+@table("A moving wall: a main node of some mass, or a prescribed velocity.")
+@dataclass(frozen=True, kw_only=True)
+class Motion:
+    """A main node of ``mass`` starting at ``velocity``, or a prescribed ``velocity`` history."""
+
+    mass: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="kg",
+        doc="the main node's mass (it moves under the contact forces)",
+        default_doc="none: the velocity is prescribed",
+    )
+    velocity: tuple = key(
+        Velocity(), unit="m/s", doc="initial (with mass) or prescribed, constant or a history"
+    )
+
+    @property
+    def prescribed(self) -> bool:
+        return self.mass is None
+
+
+@rule(
+    Motion,
+    json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
+)
+def _table_without_mass(v, raw, fail):
+    """A velocity history prescribes the motion: no mass with it."""
+    if v["mass"] is not None and isinstance(v["velocity"][0], tuple):
+        fail("mass", "a velocity table prescribes the motion: drop 'mass'")
+
+
+@table("The friction filter of Radioss: exactly one of its keys.", one_of=True)
+@dataclass(frozen=True)
+class FrictionFilter:
+    coefficient: float | None = key(
+        Real(low=0.0, high=1.0), None, doc="alpha, the weight of the new tangential force"
+    )
+    steps: float | None = key(
+        Real(low=2 * math.pi, low_open=False), None, doc="the filter's period in steps"
+    )
+    frequency: float | None = key(Real(low=0.0), None, unit="Hz", doc="the cut-off frequency")
+
+
+def _filter(f: FrictionFilter) -> tuple[str, float]:
+    return next((name, x) for name, x in vars(f).items() if x is not None)
+
+
+@table(
+    "A rigid wall (Radioss /RWALL): its kind, shape points, sliding, nodes, motion.",
+    variants=Variants("kind", SHAPE_KEYS, common=_WALL_KEYS, noun="a {} wall"),
+)
+@dataclass(frozen=True)
+class WallSpec:
+    kind: str = key(Choice(tuple(SHAPE_KEYS)), doc="the wall's shape")
+    point: tuple[float, float, float] = key(
+        Vector(), unit="m", doc="M: on the plane, on the axis, the centre, a corner"
+    )
+    normal_point: tuple[float, float, float] | None = key(
+        Vector(), None, required=True, unit="m", doc="M1: the normal M1 - M points to the free side"
+    )
+    axis_point: tuple[float, float, float] | None = key(
+        Vector(), None, required=True, unit="m", doc="M1: the axis M1 - M"
+    )
+    diameter: float | None = key(
+        Real(low=0.0), None, required=True, unit="m", doc="contact from outside only"
+    )
+    corner1: tuple[float, float, float] | None = key(
+        Vector(), None, required=True, unit="m", doc="M1: side L1 = M1 - M"
+    )
+    corner2: tuple[float, float, float] | None = key(
+        Vector(), None, required=True, unit="m", doc="M2: side L2 = M2 - M; normal along L1 x L2"
+    )
+    slide: str = key(
+        Choice(("free", "tied", "friction"), {0: "free", 1: "tied", 2: "friction"}),
+        "free",
+        doc="free: frictionless; tied: no sliding; friction: Coulomb",
+    )
+    friction: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        required=True,
+        when={"slide": ("friction",)},
+        doc="the Coulomb coefficient mu",
+    )
+    friction_filter: tuple[str, float] | None = key(
+        Sub(FrictionFilter, then=_filter),
+        None,
+        when={"slide": ("friction",)},
+        doc="(how, value): smooths the tangential force",
+        default_doc="none",
+    )
+    secondary: Secondary = key(Sub(Secondary), factory=Secondary, doc="the nodes it acts on")
+    motion: Motion | None = key(Sub(Motion), None, doc="how it moves", default_doc="fixed")
+
+
+def _distinct(v, name, fail):
+    point, other = v["point"], v[name]
+    scale = max(math.hypot(*point), math.hypot(*other))
+    if math.dist(point, other) <= 1e-10 * scale:
+        fail(name, f"must differ from 'point' ({name} = point leaves no direction)")
+
+
+@rule(WallSpec)
+def _points_span_the_shape(v, raw, fail):
+    """normal_point, axis_point, corner1 and corner2 differ from point, and the sides of a
+    parallelogram are not parallel."""
+    for name in SHAPE_KEYS[v["kind"]]:
+        if name != "diameter":
+            _distinct(v, name, fail)
+    if v["kind"] == "parallelogram":
+        l1 = [a - b for a, b in zip(v["corner1"], v["point"], strict=True)]
+        l2 = [a - b for a, b in zip(v["corner2"], v["point"], strict=True)]
+        cross = math.hypot(
+            l1[1] * l2[2] - l1[2] * l2[1],
+            l1[2] * l2[0] - l1[0] * l2[2],
+            l1[0] * l2[1] - l1[1] * l2[0],
+        )
+        if cross <= 1e-10 * math.hypot(*l1) * math.hypot(*l2):
+            fail("corner2", "sides corner1 - point and corner2 - point are parallel")
+
+
+# --- [output] -----------------------------------------------------------------------
+
+
+@table("What a run writes besides summary.json, energy.csv and walls.csv.")
+@dataclass(frozen=True)
+class Output:
+    directory: Path = key(
+        Text("a path string", path=True),
+        Path("results"),
+        doc="the results folder (--out overrides it)",
+    )
+    frames: int = key(
+        Integer(low=0), 0, doc="PNG frames over the run, and animation.gif; 0: no pictures"
+    )
+    fields: int = key(
+        Integer(low=0), 0, doc="snapshots of displacement, velocity, von Mises in fields.xdmf"
+    )
+    history_interval: int = key(
+        Integer(low=1), 1, doc="steps between rows of energy.csv and walls.csv"
+    )
+    color: str = key(
+        Choice(("normal_velocity", "speed", "displacement")),
+        "normal_velocity",
+        doc="what colours the frames",
+    )
+    plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
+
+
+# --- the scene -----------------------------------------------------------------------
+
+
+@table("A scene: one body, its material, walls and boundary conditions, and what to write.")
+@dataclass(frozen=True, kw_only=True)
+class Scene:
+    source: str  # the file name used in messages
+    run: RunSettings = key(Sub(RunSettings), doc="time span and step")
+    mesh: MeshSpec | None = key(
+        Sub(MeshSpec, empty_is_none=True),
+        None,
+        doc="the body",
+        default_doc="a body given to the API",
+    )
+    material: Material = key(Sub(Material), doc="the elastic law")
+    element: Element = key(Sub(Element), factory=Element, doc="element technology")
+    initial: Initial = key(Sub(Initial), factory=Initial, doc="the initial velocity")
+    gravity: tuple[float, float, float] | None = key(
+        Sub(Gravity, then=lambda g: g.acceleration),
+        None,
+        doc="the acceleration of gravity (m/s^2)",
+        default_doc="none",
+    )
+    boundaries: tuple[BoundarySpec, ...] = key(
+        Each(BoundarySpec), (), toml="boundary", doc="prescribed velocities of node sets"
+    )
+    walls: tuple[WallSpec, ...] = key(Each(WallSpec), (), toml="wall", doc="the rigid walls")
+    output: Output = key(Sub(Output), factory=Output, doc="pictures, fields, histories")
+
+
+_TETRAHEDRA = {
+    "properties": {
+        "mesh": {"properties": {"cell": {"const": "tetrahedron"}}, "required": ["cell"]}
+    },
+    "required": ["mesh"],
+}
+_FULL_ONLY = {
+    "properties": {
+        "integration": {"not": {"const": "reduced"}},
+        "hourglass": False,
+        "hourglass_coefficient": False,
+    }
+}
+
+
+@rule(Scene, json=[{"if": _TETRAHEDRA, "then": {"properties": {"element": _FULL_ONLY}}}])
+def _element_fits_the_cells(v, raw, fail):
+    """Tetrahedra (mesh.cell) are P1, integrated exactly at one point: "full" only, and no
+    hourglass keys. (For a mesh file the cell type is checked when the body is built.)"""
+    mesh, element = v["mesh"], v["element"]
+    if mesh is None or mesh.shape is None or mesh.cell != "tetrahedron":
+        return
+    if element.integration == "reduced":
+        fail(
+            "element.integration",
+            "'reduced' is for hexahedra, and mesh.cell is 'tetrahedron' (P1, one exact point): "
+            "use 'full' or leave it out",
+        )
+    for name in ("hourglass", "hourglass_coefficient"):
+        if element.integration is None and name in raw.get("element", {}):
+            fail(
+                f"element.{name}",
+                "needs integration = 'reduced', and tetrahedra (mesh.cell) are integrated 'full'",
+            )

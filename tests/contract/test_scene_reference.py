@@ -1,0 +1,122 @@
+"""The reference page and the JSON Schema come from the schema, are up to date, ship with
+the package, and agree with the validator on the demos, the test scenes and the bad scenes."""
+
+import importlib.resources
+import json
+import shutil
+import subprocess
+import sys
+import tomllib
+import zipfile
+from pathlib import Path
+
+import jsonschema
+import pytest
+from conftest import SCENE, bar_scene, block_scene
+from mpi4py import MPI
+
+from rwall_fem.scene.keys import Each, Real, Sub, Vector, keys_of
+from rwall_fem.scene.reference import PAGE, SCHEMA_FILE, json_schema, reference_page, tables
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMOS = sorted((ROOT / "demos").glob("*.toml"))
+BAD = sorted((ROOT / "tests" / "bad_scenes").glob("*.toml"))
+VALIDATOR = jsonschema.Draft202012Validator(json_schema())
+REGENERATE = "run `python -m rwall_fem.scene.reference`"
+
+
+def test_the_reference_page_is_up_to_date():
+    assert (ROOT / PAGE).read_text() == reference_page(), REGENERATE
+
+
+def test_the_json_schema_is_up_to_date_and_valid():
+    assert json.loads(SCHEMA_FILE.read_text()) == json_schema(), REGENERATE
+    jsonschema.Draft202012Validator.check_schema(json_schema())
+
+
+def test_the_package_holds_the_json_schema():
+    shipped = importlib.resources.files("rwall_fem.scene").joinpath("scene.schema.json")
+    assert json.loads(shipped.read_text()) == json_schema()
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert "scene.schema.json" in pyproject["tool"]["setuptools"]["package-data"]["rwall_fem.scene"]
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="builds a wheel in a subprocess")
+def test_the_wheel_ships_the_json_schema(tmp_path):
+    source = tmp_path / "source"  # a copy: setuptools builds in the source folder
+    for name in ("pyproject.toml", "README.md"):
+        (source / name).parent.mkdir(exist_ok=True)
+        shutil.copy(ROOT / name, source / name)
+    skip = shutil.ignore_patterns("__pycache__")
+    shutil.copytree(ROOT / "rwall_fem", source / "rwall_fem", ignore=skip)
+    build = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+         "-w", str(tmp_path), str(source)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert build.returncode == 0, build.stderr
+    (wheel,) = tmp_path.glob("rwall_fem-*.whl")
+    assert "rwall_fem/scene/scene.schema.json" in zipfile.ZipFile(wheel).namelist()
+
+
+def test_every_key_carries_a_doc_and_numbers_a_unit():
+    dimensionless = {
+        "dt_scale", "max_energy_error", "poisson", "hourglass_coefficient", "axis", "friction",
+        "coefficient", "steps",
+    }  # fmt: skip
+    for where, _, cls in tables():
+        assert cls.__table__.doc, where
+        for name, (_, k) in keys_of(cls).items():
+            assert k.doc and "\n" not in k.doc, f"{where}.{name}"
+            if isinstance(k.type, (Real, Vector)) and name not in dimensionless:
+                assert k.unit, f"{where}.{name} has no unit"
+            if not isinstance(k.type, (Sub, Each)):
+                assert k.type.type_text, f"{where}.{name}"
+
+
+@pytest.mark.parametrize("path", DEMOS, ids=[p.stem for p in DEMOS])
+def test_the_demos_validate_against_the_json_schema(path):
+    VALIDATOR.validate(tomllib.loads(path.read_text()))
+
+
+@pytest.mark.parametrize(
+    "raw",
+    [
+        tomllib.loads(SCENE),
+        bar_scene(),
+        bar_scene(cell="tetrahedron", axis=(1.0, -2.0, 2.0), wall=False),
+        block_scene(gravity=(0, 0, -9.81), wall=[{"kind": "sphere", "point": [0, 0, 0],
+                                                  "diameter": 1.0, "slide": 2, "friction": 0.1}]),
+    ],
+    ids=["SCENE", "bar", "tetrahedra", "block"],
+)  # fmt: skip
+def test_the_test_scenes_validate_against_the_json_schema(raw):
+    VALIDATOR.validate(json.loads(json.dumps(raw)))
+
+
+# The bad scenes whose mistake is beyond a JSON Schema: a number compared with the stable
+# step, a file or node set looked up, points compared across keys; and JSON's numbers, where
+# 1.0 is the integer 1 and a 400-digit integer is a number like any other.
+BEYOND = {
+    "09_dt_above_limit",
+    "40_wall_slide_float",
+    "42_end_time_400_digits",
+    "18_mesh_file_missing",
+    "26_wall_degenerate_normal",
+    "30_wall_unknown_group",
+    "32_boundary_unknown_group",
+    "44_refine_point_far_from_the_body",
+    "45_noise_amplitude_not_small",
+}
+
+
+def test_the_json_schema_refuses_the_bad_scenes_it_can_see():
+    refused, accepted = set(), set()
+    for path in BAD:
+        try:
+            raw = tomllib.loads(path.read_bytes().decode())
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError, RecursionError):
+            continue  # not TOML at all
+        (refused if any(VALIDATOR.iter_errors(raw)) else accepted).add(path.stem)
+    assert accepted == BEYOND
+    assert len(refused) >= 35
