@@ -25,12 +25,10 @@ class Gravity:
         state.a += self.g
 
     def work(self, state) -> float:
-        """Work of gravity on this rank's nodes up to step n (J), read after the update of
-        step n (``state.u`` is u^{n+1}, ``state.v`` is v^{n+1/2}).
+        """Work of gravity on this rank's nodes up to step n (J), after the update of step n.
 
         Mid-step booking of a constant force G = m g sums to
-        G . (u^n - u^0) + dt/2 G . v^{-1/2}: no per-step cost.
+        G . (u^n - u^0) + dt/2 G . v^{-1/2}, i.e. g . (sum m u^n + dt/2 sum m v^{-1/2}):
+        the update books sum m u^n (``state.mass_moment``) at no extra cost.
         """
-        m = state.mass[:, None]
-        pulled = np.sum(m * state.u, axis=0) - state.dt * np.sum(m * state.v, axis=0)  # m u^n
-        return float(self.g @ (pulled + 0.5 * state.dt * self._initial_momentum))
+        return float(self.g @ (state.mass_moment + 0.5 * state.dt * self._initial_momentum))

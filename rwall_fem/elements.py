@@ -137,7 +137,7 @@ class ElementForce:
         self.energy_names = ("internal", "hourglass") if hourglass else ("internal",)
         self.u, self.v = u, v
         self.f = GhostedField(V)
-        self._space, self._probe = V, None  # the fields of forces(), made at its first call
+        self.V, self._probe = V, None  # the fields of forces(), made at its first call
         self.ffi, self.lib = ffi, lib = load()
         tdim = V.mesh.topology.dim
         num_cells = V.mesh.topology.index_map(tdim).size_local
@@ -218,7 +218,7 @@ class ElementForce:
         The viscous hourglass form contributes nothing here (it acts on velocities).
         """
         if self._probe is None:
-            V = self._space
+            V = self.V
             fields, energy = (GhostedField(V), GhostedField(V), GhostedField(V)), np.zeros(2)
             self._probe = (*fields, self._bind(*(g.array for g in fields), energy), energy)
         u_probe, _, f_probe, kernel, energy = self._probe
@@ -236,4 +236,4 @@ class ElementForce:
         self.forces(u)
         energy = self._probe[4]
         stored = energy[0] + (energy[1] if self.conservative else 0.0)
-        return self._space.mesh.comm.allreduce(float(stored))
+        return self.V.mesh.comm.allreduce(float(stored))

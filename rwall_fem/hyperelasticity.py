@@ -94,7 +94,7 @@ class StableStepMonitor:
         return step >= self._next
 
     def record(self, sim, s) -> None:
-        ratio = self.force.largest_eigenvalue(s, iterations=8) / self.reference
+        ratio = self.largest_eigenvalue(s, iterations=8) / self.reference
         estimate = self.dt_stable / np.sqrt(max(ratio, 1e-300))
         self.estimates.append((s.t, estimate))
         limit = self.SAFETY * estimate

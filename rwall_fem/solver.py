@@ -58,11 +58,13 @@ class State:
     step: int = 0
     kinetic: float = 0.0  # K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} of the latest update, J
     internal_work: float = 0.0  # of an internal force without stored energy, up to step n, J
+    mass_moment: np.ndarray = None  # sum m u^n of the latest update, kg m
 
     def __post_init__(self):
         for name in ("u", "v", "a"):
             if getattr(self, name) is None:
                 setattr(self, name, np.zeros_like(self.X))
+        self.mass_moment = np.zeros(3)
         self.inv_mass = (1.0 / self.mass)[:, None]  # 1/kg, shape (n, 1)
 
 
@@ -118,16 +120,17 @@ class Recorder(Protocol):
 class CentralDifference:
     """The update of a step in one compiled pass (``kernels/update.c``):
     v^{n+1/2} = v^{n-1/2} + dt a^n and u^{n+1} = u^n + dt v^{n+1/2}, booking on the way the
-    shadow kinetic energy K^n in ``state.kinetic`` and, when ``booked`` is given, the work
-    of that force at mid-step velocities in ``state.internal_work`` (J, this rank: both
-    halves of every step before n and the first half of step n, as every work is booked).
+    shadow kinetic energy K^n in ``state.kinetic``, sum m u^n in ``state.mass_moment`` and,
+    when ``booked`` is given, the work of that force at mid-step velocities in
+    ``state.internal_work`` (J, this rank: both halves of every step before n and the
+    first half of step n, as every work is booked).
     """
 
     def __init__(self, state: State, booked: np.ndarray | None = None):
         from rwall_fem.kernels import load
 
         ffi, lib = load()
-        self._out = np.zeros(3)
+        self._out = np.zeros(6)
         self._done = 0.0  # work of the finished steps, J
 
         def ptr(array):
@@ -144,8 +147,9 @@ class CentralDifference:
 
     def __call__(self, state: State) -> None:
         self._pass()
-        kinetic, first, second = self._out
+        kinetic, first, second = self._out[:3]
         state.kinetic = kinetic
+        state.mass_moment[:] = self._out[3:]
         if self._booked:
             state.internal_work = self._done + first
             self._done += first + second

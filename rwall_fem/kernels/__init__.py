@@ -68,7 +68,7 @@ void hex8_plastic(int64_t n, const int32_t *cells, const double *X, const double
 ) + """
 void accelerate(int64_t n, const double *f, const double *inv_mass, double *a);
 void advance(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
-             const double *f, double out[3]);
+             const double *f, double out[6]);
 """ + "".join(
     f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"
     " const element_params *p, double *f, double *energy);\n"

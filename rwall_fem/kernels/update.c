@@ -8,10 +8,15 @@
  *   out[0] = K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}   (the shadow kinetic energy)
  *   out[1] = dt/2 sum f . v^{n-1/2}                  (first half of the work of f)
  *   out[2] = dt/2 sum f . v^{n+1/2}                  (second half)
+ *   out[3..5] = sum m u^n                            (the work of uniform gravity)
  * (out[1] and out[2] only when f is given; the mid-step booking of the internal
  * work for materials without a stored energy).
  */
 #include "batch.h"
+
+/* No fused multiply-add here: v + dt a must round like the separate operations, so that a
+ * prescribed velocity (a = (v_p - v)/dt) is met exactly. */
+#pragma GCC optimize("fp-contract=off")
 
 void accelerate(int64_t n, const double *restrict f, const double *restrict inv_mass,
                 double *restrict a)
@@ -22,39 +27,44 @@ void accelerate(int64_t n, const double *restrict f, const double *restrict inv_
       a[3 * i + c] = -f[3 * i + c] * inv_mass[i];
 }
 
-void advance(int64_t n, double dt, const double *restrict mass, const double *restrict a,
-             double *restrict v, double *restrict u, const double *restrict f, double out[3])
+/* One node of the update (f: NULL or the booked force); kept inline so that each loop
+ * below is compiled for its case. */
+INLINE void advance_node(int64_t i, double dt, const double *restrict mass,
+                         const double *restrict a, double *restrict v, double *restrict u,
+                         const double *restrict f, double *kinetic, double *first,
+                         double *second, double moment[3])
 {
-  double kinetic = 0.0, first = 0.0, second = 0.0;
+  const double m = mass[i];
+  for (int c = 0; c < 3; ++c)
+  {
+    const int64_t j = 3 * i + c;
+    const double old = v[j], next = old + dt * a[j];
+    *kinetic += m * old * next;
+    if (f)
+    {
+      *first += f[j] * old;
+      *second += f[j] * next;
+    }
+    moment[c] += m * u[j];
+    v[j] = next;
+    u[j] += dt * next;
+  }
+}
+
+void advance(int64_t n, double dt, const double *restrict mass, const double *restrict a,
+             double *restrict v, double *restrict u, const double *restrict f, double out[6])
+{
+  double kinetic = 0.0, first = 0.0, second = 0.0, moment[3] = {0.0, 0.0, 0.0};
   if (f)
-  {
-#pragma omp simd reduction(+ : kinetic, first, second)
     for (int64_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c)
-      {
-        const int64_t j = 3 * i + c;
-        const double old = v[j], next = old + dt * a[j];
-        kinetic += mass[i] * old * next;
-        first += f[j] * old;
-        second += f[j] * next;
-        v[j] = next;
-        u[j] += dt * next;
-      }
-  }
+      advance_node(i, dt, mass, a, v, u, f, &kinetic, &first, &second, moment);
   else
-  {
-#pragma omp simd reduction(+ : kinetic)
     for (int64_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c)
-      {
-        const int64_t j = 3 * i + c;
-        const double old = v[j], next = old + dt * a[j];
-        kinetic += mass[i] * old * next;
-        v[j] = next;
-        u[j] += dt * next;
-      }
-  }
+      advance_node(i, dt, mass, a, v, u, NULL, &kinetic, &first, &second, moment);
   out[0] = 0.5 * kinetic;
   out[1] = 0.5 * dt * first;
   out[2] = 0.5 * dt * second;
+  out[3] = moment[0];
+  out[4] = moment[1];
+  out[5] = moment[2];
 }

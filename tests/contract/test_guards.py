@@ -37,7 +37,7 @@ def test_nan_in_the_state_stops_the_run_and_names_the_node(shared_dir):
     if MPI.COMM_WORLD.rank == 0:
         summary = json.loads((Path(shared_dir) / "summary.json").read_text())
         assert summary["status"] == "stopped" and "NaN" in summary["reason"]
-        complete_rows(Path(shared_dir) / "energy.csv", 6)
+        complete_rows(Path(shared_dir) / "energy.csv", 7)
 
 
 def test_energy_error_guard(shared_dir):
@@ -91,7 +91,7 @@ def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     assert "terminated by SIGTERM" in stderr and len(stderr.strip().splitlines()) == 1
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "stopped" and "SIGTERM" in summary["reason"]
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 6)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
     assert summary["energy"]["kinetic"] == rows[-1][1]
     complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
 
@@ -101,7 +101,7 @@ def test_sigkill_leaves_complete_csv_lines(tmp_path):
     process = _start_long_run(tmp_path)
     process.kill()
     process.communicate(timeout=60)
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 6)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
     assert len(rows) > 100
     assert not (tmp_path / "out" / "summary.json").exists()
 
@@ -146,4 +146,4 @@ def test_pictures_that_fail_to_render_leave_the_other_outputs(shared_dir, monkey
                        "no display"]  # fmt: skip
         summary = json.loads((out / "run" / "summary.json").read_text())
         assert summary["status"] == "done"
-        complete_rows(out / "run" / "energy.csv", 6)
+        complete_rows(out / "run" / "energy.csv", 7)

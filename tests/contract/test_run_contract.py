@@ -25,6 +25,7 @@ def test_outputs_of_a_run(shared_dir):
         summary = json.loads((out / "summary.json").read_text())
         for key in (
             "dolfinx_version",
+            "element",
             "ranks",
             "cells",
             "nodes",

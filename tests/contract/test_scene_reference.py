@@ -3,17 +3,12 @@ the package, and agree with the validator on the demos, the test scenes and the 
 
 import importlib.resources
 import json
-import shutil
-import subprocess
-import sys
 import tomllib
-import zipfile
 from pathlib import Path
 
 import jsonschema
 import pytest
 from conftest import SCENE, bar_scene, block_scene
-from mpi4py import MPI
 
 from rwall_fem.scene.keys import Each, Real, Sub, Vector, keys_of
 from rwall_fem.scene.reference import PAGE, SCHEMA_FILE, json_schema, reference_page, tables
@@ -39,24 +34,6 @@ def test_the_package_holds_the_json_schema():
     assert json.loads(shipped.read_text()) == json_schema()
     pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert "scene.schema.json" in pyproject["tool"]["setuptools"]["package-data"]["rwall_fem.scene"]
-
-
-@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="builds a wheel in a subprocess")
-def test_the_wheel_ships_the_json_schema(tmp_path):
-    source = tmp_path / "source"  # a copy: setuptools builds in the source folder
-    for name in ("pyproject.toml", "README.md"):
-        (source / name).parent.mkdir(exist_ok=True)
-        shutil.copy(ROOT / name, source / name)
-    skip = shutil.ignore_patterns("__pycache__")
-    shutil.copytree(ROOT / "rwall_fem", source / "rwall_fem", ignore=skip)
-    build = subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
-         "-w", str(tmp_path), str(source)],
-        capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert build.returncode == 0, build.stderr
-    (wheel,) = tmp_path.glob("rwall_fem-*.whl")
-    assert "rwall_fem/scene/scene.schema.json" in zipfile.ZipFile(wheel).namelist()
 
 
 def test_every_key_carries_a_doc_and_numbers_a_unit():

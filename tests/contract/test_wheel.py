@@ -79,12 +79,17 @@ def wheel(tmp_path_factory) -> Path:
     return built
 
 
-def test_the_wheel_holds_every_module_and_the_geometry(wheel):
+def test_the_wheel_holds_every_module_the_geometry_the_kernels_and_the_schema(wheel):
     names = set(zipfile.ZipFile(wheel).namelist())
-    modules = {p.relative_to(REPOSITORY).as_posix() for p in REPOSITORY.glob("rwall_fem/**/*.py")}
+    package = REPOSITORY / "rwall_fem"
+    files = {
+        p.relative_to(REPOSITORY).as_posix()
+        for pattern in ("**/*.py", "kernels/*.c", "kernels/*.h", "scene/*.json")
+        for p in package.glob(pattern)
+    }
     geometry = {f"rwall_fem/meshes/{p.name}" for p in (REPOSITORY / "meshes").glob("*.geo")}
-    assert len(geometry) >= 5
-    assert modules | geometry <= names, sorted((modules | geometry) - names)
+    assert len(geometry) >= 5 and "rwall_fem/scene/scene.schema.json" in files
+    assert files | geometry <= names, sorted((files | geometry) - names)
 
 
 def test_an_installed_wheel_runs_a_built_in_shape_from_another_folder(wheel, tmp_path):

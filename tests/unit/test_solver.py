@@ -12,6 +12,7 @@ class Push:
 
     name = "push"
     energy_names = ("internal",)
+    booked_force = None
 
     def __init__(self, a=1.0, fail=None):
         self.a, self.fail = a, fail
