@@ -101,7 +101,8 @@ class GhostedField:
     """
 
     def __init__(self, V):
-        self._vector = fem.Function(V).x
+        self.function = fem.Function(V)  # owns the storage: keep it alive
+        self._vector = self.function.x
         self.array = self._vector.array.reshape(-1, 3)
         self.owned = self.array[: V.dofmap.index_map.size_local]
         self._parallel = V.mesh.comm.size > 1
@@ -203,7 +204,7 @@ class ElementForce:
         if self._inv_mass is None:
             self._inv_mass = np.ascontiguousarray(state.inv_mass[:, 0])
             self._accelerate = functools.partial(
-                self.lib.accelerate,
+                self.lib.internal_acceleration,
                 len(self._inv_mass),
                 self.ffi.cast("double *", self.f.array.ctypes.data),
                 self.ffi.cast("double *", self._inv_mass.ctypes.data),

@@ -141,7 +141,7 @@ class CentralDifference:
                 raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
         self._booked = booked is not None
         self._pass = functools.partial(
-            lib.advance, len(state.mass), state.dt, ptr(state.mass), ptr(state.a),
+            lib.central_difference, len(state.mass), state.dt, ptr(state.mass), ptr(state.a),
             ptr(state.v), ptr(state.u), ptr(booked), ptr(self._out),
         )  # fmt: skip
 

@@ -34,9 +34,11 @@ __all__ = ["KernelBuildError", "load"]
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "tetrahedron.c", "hexahedron.c",
            "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
+# Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
+# can take the place of a kernel.
 FLAG_SETS = (
-    ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno"],
-    ["-O3", "-fopenmp-simd", "-fno-math-errno"],
+    ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
+    ["-O3", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
 )
 MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
@@ -66,8 +68,8 @@ void hex8_plastic(int64_t n, const int32_t *cells, const double *X, const double
     " int64_t stride, double *f, double *energy);\n"
     for hourglass in HOURGLASS
 ) + """
-void accelerate(int64_t n, const double *f, const double *inv_mass, double *a);
-void advance(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
+void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
+void central_difference(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
              const double *f, double out[6]);
 """ + "".join(
     f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"

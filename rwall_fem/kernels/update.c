@@ -1,9 +1,9 @@
 /* The per-node parts of a central-difference step (docs/theory.md, "Time stepping").
  *
- * accelerate: a = -f / m, the acceleration from the internal force f, before
+ * internal_acceleration: a = -f / m, the acceleration from the internal force f, before
  * body forces and constraints add to it or edit it.
  *
- * advance: v^{n+1/2} = v^{n-1/2} + dt a^n, u^{n+1} = u^n + dt v^{n+1/2}, in one
+ * central_difference: v^{n+1/2} = v^{n-1/2} + dt a^n, u^{n+1} = u^n + dt v^{n+1/2}, in one
  * pass that also returns what the energy books need of this step:
  *   out[0] = K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}   (the shadow kinetic energy)
  *   out[1] = dt/2 sum f . v^{n-1/2}                  (first half of the work of f)
@@ -18,7 +18,7 @@
  * prescribed velocity (a = (v_p - v)/dt) is met exactly. */
 #pragma GCC optimize("fp-contract=off")
 
-void accelerate(int64_t n, const double *restrict f, const double *restrict inv_mass,
+void internal_acceleration(int64_t n, const double *restrict f, const double *restrict inv_mass,
                 double *restrict a)
 {
 #pragma omp simd
@@ -51,7 +51,7 @@ INLINE void advance_node(int64_t i, double dt, const double *restrict mass,
   }
 }
 
-void advance(int64_t n, double dt, const double *restrict mass, const double *restrict a,
+void central_difference(int64_t n, double dt, const double *restrict mass, const double *restrict a,
              double *restrict v, double *restrict u, const double *restrict f, double out[6])
 {
   double kinetic = 0.0, first = 0.0, second = 0.0, moment[3] = {0.0, 0.0, 0.0};
