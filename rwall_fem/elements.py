@@ -231,10 +231,11 @@ class ElementForce:
         f_probe.scatter_reverse_add()
         return f_probe.owned.copy()
 
-    def stored_energy_at(self, u: np.ndarray) -> float:
-        """Elastic plus stored hourglass energy (J) of the whole body at a displacement ``u``
-        (owned, (n, 3)), summed over ranks; the body's state is left as it is."""
+    def stored_energy_at(self, u: np.ndarray) -> tuple[float, float]:
+        """Elastic and stored hourglass energies (J) of the whole body at a displacement
+        ``u`` (owned, (n, 3)), summed over ranks; the body's state is left as it is."""
         self.forces(u)
-        energy = self._probe[4]
-        stored = energy[0] + (energy[1] if self.conservative else 0.0)
-        return self.V.mesh.comm.allreduce(float(stored))
+        elastic, hourglass = self._probe[4]
+        if not self.conservative:
+            hourglass = 0.0
+        return tuple(self.V.mesh.comm.allreduce(np.array([elastic, hourglass])))
