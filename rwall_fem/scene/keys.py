@@ -26,6 +26,7 @@ from typing import Any, NoReturn
 
 __all__ = [
     "Choice",
+    "Context",
     "Each",
     "Flag",
     "Integer",
@@ -374,7 +375,7 @@ class Vector(ValueType):
 @dataclass(frozen=True)
 class Velocity(ValueType):
     """A constant velocity [vx, vy, vz], or a history: rows [t, vx, vy, vz] with increasing t
-    (piecewise linear in between, held after the last row)."""
+    (piecewise linear in between, held outside them)."""
 
     type_text = "[x, y, z] or rows [t, vx, vy, vz]"
 

@@ -263,7 +263,7 @@ def _own_frame(axis) -> list[list[float]]:
     return [[R[j][i] for j in range(3)] for i in range(3)]
 
 
-def body_box(v) -> tuple[tuple[float, ...], tuple[float, ...]]:
+def _body_box(v) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """The body's box (lowest, highest corner) in its own frame, relative to ``origin``."""
     if v["shape"] == "round_bar":
         r = v["radius"]
@@ -277,7 +277,7 @@ def _refinement_reaches_the_body(v, raw, fail):
     and length, turned onto axis): farther, nothing would be refined."""
     if v["shape"] is None or v["refine_point"] is None:
         return
-    low, high = body_box(v)
+    low, high = _body_box(v)
     shifted = [p - o for p, o in zip(v["refine_point"], v["origin"], strict=True)]
     own = [sum(r * s for r, s in zip(row, shifted, strict=True)) for row in _own_frame(v["axis"])]
     gap = math.hypot(*(max(lo - q, 0.0, q - hi) for q, lo, hi in zip(own, low, high, strict=True)))
@@ -401,7 +401,7 @@ class BoundarySpec:
         Velocity(),
         (0.0, 0.0, 0.0),
         unit="m/s",
-        doc="constant, or a history (linear between rows, held after the last)",
+        doc="constant, or a history (linear between rows, held outside them)",
     )
     components: str = key(
         Letters(), "xyz", doc="the global components prescribed; the others stay free"
