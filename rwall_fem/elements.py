@@ -188,6 +188,12 @@ class ElementForce:
             energies["hourglass"] = hourglass
         return energies
 
+    def cell_fields(self, state) -> dict[str, np.ndarray]:
+        """Cell values at step n by name, each an array over this rank's owned cells (in
+        the order of ``cells``), in SI units: e.g. ``"plastic_strain"`` (equivalent plastic
+        strain, dimensionless) and ``"von_mises_stress"`` (Pa); empty for elastic bodies."""
+        return {}
+
     def accelerate(self, state) -> None:
         """Set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
         self.u.scatter_forward()
