@@ -237,8 +237,16 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
         )
         sim.recorders.append(fields)
     if scene.output.frames:
+        from rwall_fem.output.coloring import COLORS
         from rwall_fem.output.frames import Frames
 
+        color, fields = scene.output.color, sorted(sim.internal.cell_fields(sim.state))
+        if color not in COLORS and color not in fields:
+            raise SceneError(
+                f"{scene.source}: output.color: {color!r} is not a field of this body "
+                f"({', '.join(fields) or 'no cell fields'} for {scene.material.model}); "
+                f"use one of {', '.join(COLORS)}"
+            )
         frames = Frames(
             directory,
             count=scene.output.frames,
@@ -246,7 +254,8 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
             V=solid.V,
             walls=sim.walls,
             speed=float(np.linalg.norm(scene.initial.velocity)),
-            color=scene.output.color,
+            gravity=scene.gravity,
+            color=color,
         )
         sim.recorders.append(frames)
 

@@ -45,7 +45,11 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--quiet", action="store_true", help="print only errors")
     render = commands.add_parser("render", help="draw the frames of a results folder again")
     render.add_argument("directory", help="results folder of a run with output.frames > 0")
-    render.add_argument("--color", default=COLORS[0], choices=COLORS)
+    render.add_argument(
+        "--color",
+        default=COLORS[0],
+        help=f"{', '.join(COLORS)}, or a cell field of the body such as plastic_strain",
+    )
     study = commands.add_parser("study", help="accuracy against wall time, on exact references")
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
@@ -153,16 +157,6 @@ def _check(scene_file, overrides, comm) -> int:
 
 
 def _render(directory: str, color: str) -> int:
-    from pathlib import Path
+    from rwall_fem.output.render import main as render
 
-    from rwall_fem.output.render import render_frames
-
-    if not (Path(directory) / "frames" / "data" / "mesh.npz").is_file():
-        print(
-            f"rwall-fem: error: {directory}: no frame data (run with output.frames > 0)",
-            file=sys.stderr,
-        )
-        return 2
-    files = render_frames(directory, color)
-    print(f"rwall-fem: {len(files)} frames and animation.gif in {directory}")
-    return 0
+    return render([directory, "--color", color])

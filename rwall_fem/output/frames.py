@@ -1,8 +1,10 @@
 """Frame data of a run, gathered on rank 0 and rendered by :mod:`rwall_fem.output.render`.
 
-Each rank sends its cells, points and nodal values to rank 0 (connectivity
-offset by the points already received); rank 0 stores them in
-``frames/data``: ``mesh.npz`` once, then ``frame_NNNN.npz`` per frame.
+Each rank sends its cells, points, nodal values and the cell fields of the
+internal force to rank 0 (connectivity offset by the points already received);
+rank 0 stores them in ``frames/data``: ``mesh.npz`` once, then
+``frame_NNNN.npz`` per frame (``t``, ``u``, ``v``, the walls' ``offsets`` and
+``cell_<name>`` for each cell field).
 Pictures are drawn at the end of the run (or of a stopped run) by a separate
 process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
 VTK's wheels crash when they render in a process that holds DOLFINx's C++
@@ -31,8 +33,9 @@ class Frames:
     """Recorder that stores ``count`` frames of the body (space ``V``) and its ``walls``,
     spread evenly over the ``num_steps`` steps of the run, in ``directory/frames``.
 
-    ``speed`` (m/s) sets the colour range of the velocity colourings; ``color`` is one of
-    :data:`rwall_fem.output.render.COLORS`.
+    ``speed`` (m/s), the initial speed, is the least colour range of the velocity
+    colourings; ``gravity`` (m/s^2, or None) says where up is; ``color`` is one of
+    :data:`rwall_fem.output.coloring.COLORS` or a cell field of the internal force.
     """
 
     def __init__(
@@ -44,6 +47,7 @@ class Frames:
         V,
         walls,
         speed: float,
+        gravity=None,
         color: str = "normal_velocity",
     ):
         self.steps = spread(count, num_steps)
@@ -57,6 +61,7 @@ class Frames:
         mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
         self._mesh = mesh
         self._speed = speed
+        self._gravity = np.zeros(3) if gravity is None else np.asarray(gravity, float)
 
     def _gather(self, local):
         pieces = self.comm.gather(local, root=0)
@@ -80,6 +85,11 @@ class Frames:
         gathered = self.comm.gather(f.x.array.reshape(-1, 3).copy(), root=0)
         return None if gathered is None else np.concatenate(gathered)
 
+    def _cells(self, values: np.ndarray) -> np.ndarray | None:
+        """Values on the owned cells of every rank, in the order of the gathered mesh."""
+        gathered = self.comm.gather(np.asarray(values, dtype=float), root=0)
+        return None if gathered is None else np.concatenate(gathered)
+
     def due(self, step: int) -> bool:
         return step in self.steps
 
@@ -95,16 +105,19 @@ class Frames:
             cell_types=cell_types,
             points=points,
             speed=self._speed,
+            gravity=self._gravity,
             walls=json.dumps(walls_info),
         )
 
     def record(self, sim, s) -> None:
         u, v = self._nodal(s.u), self._nodal(s.v)
+        cells = {f"cell_{k}": self._cells(a) for k, a in sim.internal.cell_fields(s).items()}
         if self.comm.rank == 0:
             if not self._count:
                 self._save_mesh()
             offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
-            np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v, offsets=offsets)
+            path = self.data / f"frame_{self._count:04d}.npz"
+            np.savez(path, t=s.t, u=u, v=v, offsets=offsets, **cells)
         self._count += 1
 
     def close(self, sim) -> None:
@@ -114,7 +127,8 @@ class Frames:
         env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
         env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         result = subprocess.run(
-            [sys.executable, "-m", "rwall_fem.output.render", str(self.directory), self.color],
+            [sys.executable, "-m", "rwall_fem.output.render", str(self.directory)]
+            + ["--color", self.color],
             env=env,
             capture_output=True,
             text=True,

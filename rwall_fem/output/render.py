@@ -1,16 +1,20 @@
-"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [COLOR]``.
+"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [--color COLOR]``.
 
 Reads the frame data that :class:`rwall_fem.output.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
 ``DIR/animation.gif``, and ``DIR/animation.mp4`` when the ``imageio-ffmpeg``
 encoder is installed (``pip install rwall_fem[mp4]``). The body is drawn on
-its deformed geometry, coloured by one of :data:`COLORS`, with the walls.
-The camera and the colour range are fixed once for all frames. This module
-must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
+its deformed geometry at true scale (no magnification), coloured as
+:mod:`rwall_fem.output.coloring` says, with the walls as
+:mod:`rwall_fem.output.view` draws them: flat walls opaque (the camera sees
+them from their allowed side, behind the body), curved walls translucent with
+their outline. The camera and the colour range are fixed once for all frames.
+This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import sys
@@ -18,60 +22,91 @@ from pathlib import Path
 
 import numpy as np
 
+from rwall_fem.output.coloring import COLORS, coloring
+from rwall_fem.output.view import choose_view, up_direction, wall_surface
 from rwall_fem.walls.shapes import shape_from_parameters
 
-__all__ = ["COLORS", "render_frames"]
+__all__ = ["COLORS", "RenderError", "body_grid", "main", "render_frames"]
 
-# What the body can be coloured by: the velocity along the first wall's normal (m/s),
-# the speed (m/s) or the magnitude of the displacement (m).
-COLORS = ("normal_velocity", "speed", "displacement")
+WINDOW = (800, 600)  # pixels
+BAR = (0.2, 0.06, 0.6, 0.04)  # the colour bar's box: x, y, width, height (of the window)
+WALL_COLOR = "#a9b4c2"  # a cool grey that no colour map uses
+TIME_UNITS = ((1e-6, "µs"), (1e-3, "ms"), (1.0, "s"))  # the largest below the end time
+
+
+class RenderError(ValueError):
+    """The pictures cannot be drawn from what the folder holds (one line)."""
 
 
 def render_frames(directory: str | Path, color: str = "normal_velocity") -> list[Path]:
     """Render every stored frame of the run in ``directory``, coloured by ``color`` (one of
-    :data:`COLORS`); returns the PNG paths."""
+    :data:`COLORS` or a cell field the run stored); returns the PNG paths.
+
+    Raises RenderError for a folder without frame data or an unknown colouring.
+    """
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    directory = Path(directory)
+    data = directory / "frames" / "data"
+    if not directory.is_dir():
+        raise RenderError(f"{directory}: no such folder")
+    if not (data / "mesh.npz").is_file():
+        raise RenderError(f"{directory}: no frame data (run with output.frames > 0)")
     import imageio.v2 as imageio
     import pyvista
 
-    directory = Path(directory)
-    data = directory / "frames" / "data"
-    mesh = np.load(data / "mesh.npz")
-    points, speed = mesh["points"], float(mesh["speed"])
+    mesh = dict(np.load(data / "mesh.npz"))
+    points = mesh["points"]
     walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
-    frames = [dict(np.load(path)) for path in sorted(data.glob("frame_*.npz"))]
-    values = [_color_values(color, f, walls, points) for f in frames]
-    label = _color_label(color, walls)
-    top = max(float(np.abs(v).max(initial=0.0)) for v in values) or 1.0
-    clim = (
-        (-1.2 * max(speed, top), 1.2 * max(speed, top))
-        if color == "normal_velocity"
-        else (0.0, top)
-    )
-    # One box for the whole run: it fixes the camera and the size of the walls drawn.
-    moved = np.concatenate([points + f["u"] for f in frames])
-    low, high = moved.min(axis=0), moved.max(axis=0)
-    centre, size = 0.5 * (low + high), float((high - low).max())
-    end = float(frames[-1]["t"]) if frames else 0.0
-    unit, scale = ("us", 1e6) if end < 1e-3 else ("ms", 1e3) if end < 1.0 else ("s", 1.0)
-    camera, files = None, []
-    for path, frame, value in zip(sorted(data.glob("frame_*.npz")), frames, values, strict=True):
-        grid = pyvista.UnstructuredGrid(mesh["topology"], mesh["cell_types"], points + frame["u"])
-        grid.point_data[label] = value
-        plotter = pyvista.Plotter(off_screen=True, window_size=(800, 600))
+    up = up_direction(mesh.get("gravity"), walls)
+    paths = sorted(data.glob("frame_*.npz"))
+    frames = [dict(np.load(path)) for path in paths]
+    try:
+        paint = coloring(color, frames, points, walls, up, float(mesh["speed"]))
+    except ValueError as err:
+        raise RenderError(str(err)) from None
+    body = np.concatenate([points + f["u"] for f in frames])
+    size = float(np.ptp(body, axis=0).max())
+    surfaces = [
+        [wall_surface(pyvista, w, offset, body, size) for w, offset in zip(walls, f["offsets"])]
+        for f in frames
+    ]
+    clouds = [body, *(s.points for drawn in surfaces for s in drawn)]
+    view = choose_view(points + frames[0]["u"], clouds, walls, up, WINDOW[0] / WINDOW[1])
+    behind = [
+        w.kind in ("plane", "parallelogram") and w.normal @ view.direction >= -1e-9 for w in walls
+    ]
+    scale, unit = _time_unit(float(frames[-1]["t"]) if frames else 0.0)
+    decimals = _time_decimals(frames, scale)
+    files = []
+    for path, frame, values, drawn in zip(paths, frames, paint.values, surfaces, strict=True):
+        plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW)
+        grid = body_grid(pyvista, mesh, frame)
+        (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
         plotter.add_mesh(
-            grid, show_edges=len(points) < 1000, edge_color="dimgray", clim=clim, cmap="coolwarm"
+            grid,
+            scalars=paint.title,
+            clim=paint.clim,
+            cmap=paint.cmap,
+            show_edges=len(points) < 2000,
+            edge_color="#404040",
+            line_width=0.5,
+            ambient=0.3,
+            diffuse=0.7,
+            show_scalar_bar=False,
         )
-        for wall, offset in zip(walls, frame["offsets"], strict=True):
-            surface = _wall_surface(pyvista, wall, offset, centre, size)
-            plotter.add_mesh(surface, color="lightgray", opacity=0.6)
-        plotter.add_text(f"t = {float(frame['t']) * scale:9.3f} {unit}", font_size=12)
-        if camera is None:
-            plotter.camera_position = "iso"
-            margin = 0.15 * size
-            plotter.reset_camera(bounds=np.ravel([low - margin, high + margin], order="F"))
-            camera = plotter.camera_position
-        plotter.camera_position = camera
+        _colour_bar(plotter, paint)
+        for surface, opaque in zip(drawn, behind, strict=True):
+            if opaque:
+                plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
+            else:
+                plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
+        plotter.add_text(
+            f"t = {float(frame['t']) / scale:.{decimals}f} {unit}",
+            position=(12, WINDOW[1] - 32),
+            font_size=12,
+            color="black",
+        )
+        view.apply(plotter)
         png = directory / "frames" / path.with_suffix(".png").name
         plotter.screenshot(str(png))
         plotter.close()
@@ -84,6 +119,55 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     return files
 
 
+def body_grid(pyvista, mesh: dict, frame: dict):
+    """The body of ``frame`` as a pyvista grid, on its deformed points X + u (m): true scale."""
+    return pyvista.UnstructuredGrid(
+        mesh["topology"], mesh["cell_types"], mesh["points"] + frame["u"]
+    )
+
+
+def _colour_bar(plotter, paint) -> None:
+    """The colour bar under the picture: the bar from VTK, its title above it and its labels
+    (in one format, at round values) under it, placed here: VTK's own placement lets them
+    overlap the bar and each other."""
+    plotter.add_scalar_bar(
+        title=" ",
+        n_labels=0,
+        position_x=BAR[0],
+        position_y=BAR[1],
+        width=BAR[2],
+        height=BAR[3],
+    )
+    plotter.scalar_bar.SetTitle("")
+    plotter.scalar_bar.SetDrawTickLabels(False)
+    plotter.scalar_bar.SetBarRatio(1.0)  # the bar fills its box
+    (left, bottom), width = np.multiply(BAR[:2], WINDOW), BAR[2] * WINDOW[0]
+    (low, high), n = paint.clim, paint.n_labels
+    for i in range(n):
+        value = low + (high - low) * i / (n - 1) + 0.0  # + 0.0: no "-0"
+        _centred_text(plotter, paint.fmt % value, left + width * i / (n - 1), bottom - 20, 10)
+    _centred_text(plotter, paint.title, WINDOW[0] / 2, bottom + BAR[3] * WINDOW[1] + 6, 11)
+
+
+def _centred_text(plotter, text: str, x: float, y: float, size: int) -> None:
+    """``text`` centred on ``x`` with its foot at ``y`` (pixels from the lower left)."""
+    actor = plotter.add_text(text, position=(x, y), font_size=size, color="black")
+    actor.GetTextProperty().SetJustificationToCentered()
+
+
+def _time_unit(end: float) -> tuple[float, str]:
+    """The unit of the time label: µs, ms or s, the largest that ``end`` (s) reaches."""
+    return next(((s, name) for s, name in reversed(TIME_UNITS) if end >= s), TIME_UNITS[0])
+
+
+def _time_decimals(frames: list[dict], scale: float) -> int:
+    """Decimals that tell the frames apart: one more than the spacing of the frames needs."""
+    if len(frames) < 2:
+        return 1
+    spacing = (float(frames[-1]["t"]) - float(frames[0]["t"])) / (len(frames) - 1) / scale
+    return max(0, 1 - int(np.floor(np.log10(spacing)))) if spacing > 0 else 1
+
+
 def _has_mp4_encoder() -> bool:
     try:
         import imageio_ffmpeg  # noqa: F401  (imageio's ffmpeg plugin runs its binary)
@@ -92,44 +176,28 @@ def _has_mp4_encoder() -> bool:
     return True
 
 
-def _color_label(color: str, walls) -> str:
-    if color == "normal_velocity":
-        return "velocity along the wall normal (m/s)" if walls else "velocity z (m/s)"
-    return {"speed": "speed (m/s)", "displacement": "displacement (m)"}[color]
-
-
-def _color_values(color: str, frame: dict, walls, points: np.ndarray) -> np.ndarray:
-    if color == "normal_velocity":
-        normal = walls[0].normals(points[:1]) if walls else np.array([0.0, 0.0, 1.0])
-        return frame["v"] @ np.broadcast_to(normal, (1, 3))[0]
-    field = frame["v"] if color == "speed" else frame["u"]
-    return np.linalg.norm(field, axis=1)
-
-
-def _wall_surface(pyvista, shape, offset: np.ndarray, centre: np.ndarray, size: float):
-    """A pyvista surface for ``shape`` translated by ``offset`` (m): an infinite plane as a
-    square of side 1.5 ``size`` under ``centre``, a cylinder 1.5 ``size`` long."""
-    point = shape.point + offset
-    if shape.kind == "plane":
-        foot = centre - shape.distance(centre[None, :], offset)[0] * shape.normal
-        return pyvista.Plane(
-            center=foot, direction=shape.normal, i_size=1.5 * size, j_size=1.5 * size
-        )
-    if shape.kind == "parallelogram":
-        corners = point + np.array(
-            [0 * shape.sides[0], shape.sides[0], shape.sides[0] + shape.sides[1], shape.sides[1]]
-        )
-        return pyvista.PolyData(corners, faces=[4, 0, 1, 2, 3])
-    if shape.kind == "cylinder":
-        foot = point + ((centre - point) @ shape.axis) * shape.axis
-        length = max(1.5 * size, 2.5 * shape.radius)
-        return pyvista.Cylinder(
-            center=foot, direction=shape.axis, radius=shape.radius, height=length, resolution=96
-        )
-    return pyvista.Sphere(radius=shape.radius, center=point, theta_resolution=64, phi_resolution=64)
+def main(argv: list[str] | None = None) -> int:
+    """The command line of this module (also what ``rwall-fem render`` runs)."""
+    parser = argparse.ArgumentParser(
+        prog="python -m rwall_fem.output.render",
+        description="Draw the stored frames of a run: frames/frame_NNNN.png, animation.gif.",
+    )
+    parser.add_argument("directory", help="results folder of a run with output.frames > 0")
+    parser.add_argument(
+        "--color",
+        default=COLORS[0],
+        help=f"{', '.join(COLORS)}, or a cell field of the body such as plastic_strain "
+        f"(default {COLORS[0]})",
+    )
+    args = parser.parse_args(argv)
+    try:
+        files = render_frames(args.directory, args.color)
+    except RenderError as err:
+        print(f"rwall-fem: error: {err}", file=sys.stderr)
+        return 2
+    print(f"rwall-fem: {len(files)} frames and animation.gif in {args.directory}")
+    return 0
 
 
 if __name__ == "__main__":
-    if len(sys.argv) not in (2, 3) or sys.argv[2:] and sys.argv[2] not in COLORS:
-        sys.exit(f"usage: python -m rwall_fem.output.render RESULTS_DIR [{'|'.join(COLORS)}]")
-    render_frames(*sys.argv[1:])
+    sys.exit(main())

@@ -569,9 +569,9 @@ class Output:
         Integer(low=1), 1, doc="steps between rows of energy.csv and walls.csv"
     )
     color: str = key(
-        Choice(("normal_velocity", "speed", "displacement")),
+        Choice(("normal_velocity", "speed", "displacement", "plastic_strain")),
         "normal_velocity",
-        doc="what colours the frames",
+        doc="what colours the frames (plastic_strain: elasto-plastic bodies)",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
 

@@ -1,0 +1,132 @@
+"""What colours the body in the frames: the values, their colour range, unit and labels.
+
+The body is coloured by a nodal quantity (:data:`COLORS`) or by a cell field
+the run stored (e.g. ``plastic_strain``). One range serves every frame and
+fits the scene: velocities span the 95th percentile of their magnitude over
+all nodes and frames, at least the initial speed (the spikes at a wave front
+saturate, the bulk of the motion spans the bar); other quantities span their
+maximum. The range is rounded up to a round number, in a unit with a prefix
+that keeps the labels short (``µm``, ``MPa``), and its labels fall on round
+values written with one format. This module needs neither DOLFINx nor VTK.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["COLORS", "Coloring", "coloring", "round_range"]
+
+# Nodal colourings: the velocity along the first wall's normal at each node (m/s, signed;
+# without walls, the upward velocity), the speed (m/s), the magnitude of the displacement (m).
+COLORS = ("normal_velocity", "speed", "displacement")
+
+# Names and units of the cell fields this module knows; others are shown by their name.
+CELL_FIELDS = {
+    "plastic_strain": ("equivalent plastic strain", ""),
+    "von_mises_stress": ("von Mises stress", "Pa"),
+}
+# Unit prefixes: (size of the unit in SI, name), largest first.
+PREFIXES = {
+    "m": ((1.0, "m"), (1e-3, "mm"), (1e-6, "µm")),
+    "m/s": ((1.0, "m/s"), (1e-3, "mm/s")),
+    "Pa": ((1e9, "GPa"), (1e6, "MPa"), (1e3, "kPa"), (1.0, "Pa")),
+}
+# Round tops of a range (times a power of ten) and the label intervals that give round
+# label values: over [0, top], and over each half of [-top, top].
+INTERVALS = {1.0: 5, 1.2: 4, 1.5: 3, 2.0: 4, 2.5: 5, 3.0: 3, 4.0: 4, 5.0: 5, 6.0: 3, 8.0: 4}
+HALF_INTERVALS = {1.0: 2, 1.2: 2, 1.5: 3, 2.0: 2, 3.0: 3, 4.0: 2, 5.0: 2, 6.0: 3, 8.0: 2}
+
+
+@dataclass(frozen=True)
+class Coloring:
+    """How the body is coloured: ``values`` per frame (in ``title``'s unit) on the points or
+    (``per_cell``) the cells, the colour range ``clim`` and map ``cmap``, and the colour
+    bar's ``n_labels`` labels written with ``fmt``."""
+
+    title: str
+    per_cell: bool
+    values: list[np.ndarray]
+    clim: tuple[float, float]
+    cmap: str
+    n_labels: int
+    fmt: str
+
+
+def coloring(color: str, frames: list[dict], points, walls, up, speed: float) -> Coloring:
+    """The colouring ``color`` (one of :data:`COLORS` or a stored cell field) of the
+    ``frames`` (dicts with ``u``, ``v`` (m, m/s), ``offsets`` and ``cell_<name>``) of a
+    body at ``points`` (m), with its ``walls`` (shapes), ``up`` and initial ``speed`` (m/s).
+
+    Raises ValueError (one line) for a colouring that the frames cannot give.
+    """
+    if color in COLORS:
+        values = [_nodal(color, f, points, walls, up) for f in frames]
+        if color == "normal_velocity":
+            name = "velocity along the wall normal" if walls else "upward velocity"
+        else:
+            name = color
+        unit = "m" if color == "displacement" else "m/s"
+    else:
+        stored = sorted(k.removeprefix("cell_") for k in frames[0] if k.startswith("cell_"))
+        if color not in stored:
+            fields = f"its cell fields: {', '.join(stored)}" if stored else "no cell fields"
+            raise ValueError(
+                f"color {color!r}: not a field of this body; choose one of {', '.join(COLORS)} "
+                f"({fields})"
+            )
+        values = [f[f"cell_{color}"] for f in frames]
+        name, unit = CELL_FIELDS.get(color, (color.replace("_", " "), ""))
+    everything = np.abs(np.concatenate(values))
+    if unit == "m/s":
+        top = max(speed, float(np.percentile(everything, 95)) if everything.size else 0.0)
+    else:
+        top = float(everything.max(initial=0.0))
+    signed = color == "normal_velocity" or min(v.min(initial=0.0) for v in values) < 0.0
+    scale, unit = _prefixed(unit, top)
+    low, high, n_labels, decimals = round_range(top / scale, signed)
+    return Coloring(
+        title=f"{name} ({unit})" if unit else name,
+        per_cell=color not in COLORS,
+        values=[v / scale for v in values],
+        clim=(low, high),
+        cmap="coolwarm" if signed else "viridis",
+        n_labels=n_labels,
+        fmt=f"%.{decimals}f",
+    )
+
+
+def round_range(top: float, signed: bool) -> tuple[float, float, int, int]:
+    """The round range that holds [0, ``top``] (or [-``top``, ``top``] when ``signed``):
+    ``(low, high, number of labels, decimals of the labels)``; a unit range for 0."""
+    intervals = HALF_INTERVALS if signed else INTERVALS
+    if not top > 0.0:
+        top = 1.0
+    power = 10.0 ** math.floor(math.log10(top))
+    mantissa = next((m for m in intervals if m * power >= top * (1 - 1e-9)), None)
+    if mantissa is None:  # above the largest round top of this power of ten
+        mantissa, power = 1.0, 10 * power
+    high = mantissa * power
+    step = high / intervals[mantissa]
+    decimals = next(d for d in range(12) if abs(round(step, d) - step) <= 1e-9 * step)
+    n_labels = 2 * intervals[mantissa] + 1 if signed else intervals[mantissa] + 1
+    return (-high if signed else 0.0), high, n_labels, decimals
+
+
+def _prefixed(unit: str, top: float) -> tuple[float, str]:
+    """The size (in SI) and name of the prefixed ``unit`` in which ``top`` is >= 1."""
+    choices = PREFIXES.get(unit, ((1.0, unit),))
+    return next(((s, name) for s, name in choices if top >= s), choices[-1])
+
+
+def _nodal(color: str, frame: dict, points: np.ndarray, walls, up: np.ndarray) -> np.ndarray:
+    """The nodal values of ``color`` in ``frame`` (SI units)."""
+    if color == "normal_velocity":
+        if not walls:
+            return frame["v"] @ up
+        normals = walls[0].normals(points + frame["u"], frame["offsets"][0])
+        return np.sum(frame["v"] * normals, axis=-1)
+    field = frame["v"] if color == "speed" else frame["u"]
+    return np.linalg.norm(field, axis=1)

@@ -1,0 +1,153 @@
+"""The geometry of the pictures: the walls as drawn, and the camera.
+
+Walls are drawn where the body is: a plane (or a parallelogram) as a thin slab
+on its forbidden side under the body's footprint, a cylinder as a tube without
+end caps along the body's extent on its axis (it is infinite), a sphere whole.
+
+The camera is parallel (orthographic, as in FE post-processors), the same for
+every frame, with ``up`` pointing up. It looks across the body's longer
+horizontal extent, 30 degrees round from square and from 20 degrees above
+the horizon (lower when a flat wall asks for it): always from the allowed
+side of the flat walls, so that they lie behind the body. It is fitted to
+everything drawn in every frame, between the time at the top and the colour
+bar at the bottom. The body is drawn at true scale by the renderer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["View", "choose_view", "up_direction", "wall_surface"]
+
+# (azimuth, elevation) of the camera (degrees): a flat body (a plate) is seen from higher
+# up, so that its face shows; beside a finite wall the camera looks square along the body
+# (and the wall's edge under it), so that what hangs over the edge shows; lower
+# elevations are tried after these.
+ANGLES = {"flat": (30.0, 30.0), "edge": (0.0, 20.0), "other": (30.0, 20.0)}
+LOWER = (10.0, 0.0, -10.0, -20.0)
+FLAT = 0.2  # a body is flat when its height is below this fraction of its width
+MARGIN = 0.15  # walls reach this fraction of the scene's size beyond the body (m / m)
+SLAB = 0.01  # thickness of a flat wall as a fraction of the scene's size
+# The band of the picture that the scene fills (fractions of the height from the bottom):
+# the time is written above it, the colour bar drawn below.
+BAND = (0.16, 0.90)
+
+
+@dataclass(frozen=True)
+class View:
+    """A parallel camera: it looks at ``focal`` (m) from ``direction`` (unit, from the focal
+    point to the camera) with ``up`` (unit) upward; ``scale`` (m) is half the picture's
+    height."""
+
+    focal: np.ndarray
+    direction: np.ndarray
+    up: np.ndarray
+    scale: float
+
+    def apply(self, plotter) -> None:
+        """Set ``plotter``'s camera to this view."""
+        camera = plotter.camera
+        camera.parallel_projection = True
+        distance = 10.0 * self.scale
+        camera.position = tuple(self.focal + distance * self.direction)
+        camera.focal_point = tuple(self.focal)
+        camera.up = tuple(self.up)
+        camera.parallel_scale = self.scale
+        plotter.renderer.ResetCameraClippingRange()
+
+
+def up_direction(gravity, walls) -> np.ndarray:
+    """Up: against ``gravity`` (m/s^2, or None), else the normal of the first flat wall,
+    else +z."""
+    if gravity is not None and np.linalg.norm(gravity) > 0:
+        return -np.asarray(gravity, float) / np.linalg.norm(gravity)
+    flat = [w for w in walls if w.kind in ("plane", "parallelogram")]
+    return flat[0].normal.copy() if flat else np.array([0.0, 0.0, 1.0])
+
+
+def choose_view(start: np.ndarray, clouds: list[np.ndarray], walls, up, aspect: float) -> View:
+    """The view of a run whose body starts at the points ``start`` ((n, 3), m) and whose
+    drawn points are ``clouds`` ((n, 3) arrays, m: the body and the walls as drawn in every
+    frame), for a picture ``aspect`` times wider than high; ``walls`` are the shapes, whose
+    flat ones the camera looks at from their allowed side."""
+    points = np.concatenate(clouds)
+    across, along = _horizontal_axes(points, up)
+    height = np.ptp(start @ up)
+    flat = height < FLAT * min(np.ptp(start @ across), np.ptp(start @ along))
+    edge = any(w.kind == "parallelogram" for w in walls)
+    azimuth, elevation = np.radians(ANGLES["flat" if flat else "edge" if edge else "other"])
+    normals = [w.normal for w in walls if w.kind in ("plane", "parallelogram")]
+    choices = [
+        np.cos(e) * (np.cos(azimuth) * a + np.sin(azimuth) * b) + np.sin(e) * up
+        for e in (elevation, *np.radians([x for x in LOWER if x < np.degrees(elevation)]))
+        for a in (-across, across)
+        for b in (-along, along)
+    ]
+    direction = next((d for d in choices if all(d @ n >= -1e-9 for n in normals)), choices[0])
+    view_up = up - (up @ direction) * direction
+    view_up /= np.linalg.norm(view_up)
+    right = np.cross(view_up, direction)
+    x, y = points @ right, points @ view_up
+    band = BAND[1] - BAND[0]
+    scale = 1.02 * max(np.ptp(y) / (2 * band), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
+    centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * view_up
+    centre += (points @ direction).mean() * direction
+    # The middle of the band is above the middle of the picture by this much (m).
+    lift = (0.5 * (BAND[0] + BAND[1]) - 0.5) * 2 * scale
+    return View(centre - lift * view_up, direction, view_up, scale)
+
+
+def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: float):
+    """A pyvista surface of ``shape`` translated by ``offset`` (m), drawn where the ``body``
+    ((n, 3) points, m: of every frame) is, in a scene of ``size`` (m)."""
+    margin = MARGIN * size
+    point = shape.point + offset
+    if shape.kind == "cylinder":
+        along = (body - point) @ shape.axis
+        low, high = along.min() - margin, along.max() + margin
+        return pyvista.Cylinder(
+            center=point + 0.5 * (low + high) * shape.axis,
+            direction=shape.axis,
+            radius=shape.radius,
+            height=high - low,
+            resolution=96,
+            capping=False,
+        )
+    if shape.kind == "sphere":
+        return pyvista.Sphere(
+            radius=shape.radius, center=point, theta_resolution=64, phi_resolution=64
+        )
+    if shape.kind == "parallelogram":
+        corners = point + np.array([[0, 0], [1, 0], [1, 1], [0, 1]]) @ shape.sides
+    else:  # an infinite plane: under the body's footprint, with a margin
+        e1 = np.cross(shape.normal, np.eye(3)[np.argmin(np.abs(shape.normal))])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(shape.normal, e1)
+        a, b = (body - point) @ e1, (body - point) @ e2
+        square = [[a.min(), b.min()], [a.max(), b.min()], [a.max(), b.max()], [a.min(), b.max()]]
+        corners = point + (
+            np.array(square) + margin * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
+        ) @ [e1, e2]
+    return _slab(pyvista, corners, -SLAB * size * shape.normal)
+
+
+def _slab(pyvista, corners: np.ndarray, depth: np.ndarray):
+    """The closed box whose top face is the quadrilateral ``corners`` (4, 3) and whose
+    bottom face is that face moved by ``depth`` (m)."""
+    points = np.vstack([corners, corners + depth])
+    faces = [[0, 1, 2, 3], [7, 6, 5, 4], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]]
+    return pyvista.PolyData(points, faces=np.hstack([[4, *f] for f in faces]))
+
+
+def _horizontal_axes(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors normal to ``up``: the one across which ``points`` extend less, then
+    the other (the camera looks along the first)."""
+    first = np.eye(3)[np.argmin(np.abs(up))]
+    first = first - (first @ up) * up
+    first /= np.linalg.norm(first)
+    second = np.cross(up, first)
+    if np.ptp(points @ first) < np.ptp(points @ second):
+        return first, second
+    return second, first
