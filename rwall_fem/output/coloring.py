@@ -2,12 +2,14 @@
 
 The body is coloured by a nodal quantity (:data:`COLORS`) or by a cell field
 the run stored (e.g. ``plastic_strain``). One range serves every frame and
-fits the scene: velocities span the 95th percentile of their magnitude over
-all nodes and frames, at least the initial speed (the spikes at a wave front
-saturate, the bulk of the motion spans the bar); other quantities span their
-maximum. The range is rounded up to a round number, in a unit with a prefix
-that keeps the labels short (``µm``, ``MPa``), and its labels fall on round
-values written with one format. This module needs neither DOLFINx nor VTK.
+fits the scene: a nodal quantity spans the 95th percentile of its magnitude
+over all nodes and frames (the spikes at a wave front or under a ball
+saturate, the bulk of the motion spans the range), velocities at least the
+initial speed; a cell field spans its maximum (plastic strain is often zero
+but in a few cells, which are the point). The range is rounded up to a round
+number, in a unit with a prefix that keeps the labels short (``µm``, ``MPa``),
+and its labels fall on round values written with one format. This module
+needs neither DOLFINx nor VTK.
 """
 
 from __future__ import annotations
@@ -80,10 +82,12 @@ def coloring(color: str, frames: list[dict], points, walls, up, speed: float) ->
         values = [f[f"cell_{color}"] for f in frames]
         name, unit = CELL_FIELDS.get(color, (color.replace("_", " "), ""))
     everything = np.abs(np.concatenate(values))
-    if unit == "m/s":
-        top = max(speed, float(np.percentile(everything, 95)) if everything.size else 0.0)
-    else:
+    if color not in COLORS:
         top = float(everything.max(initial=0.0))
+    else:
+        top = float(np.percentile(everything, 95)) if everything.size else 0.0
+        if unit == "m/s":
+            top = max(top, speed)
     signed = color == "normal_velocity" or min(v.min(initial=0.0) for v in values) < 0.0
     scale, unit = _prefixed(unit, top)
     low, high, n_labels, decimals = round_range(top / scale, signed)

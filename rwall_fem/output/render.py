@@ -30,6 +30,7 @@ __all__ = ["COLORS", "RenderError", "body_grid", "main", "render_frames"]
 
 WINDOW = (800, 600)  # pixels
 BAR = (0.2, 0.06, 0.6, 0.04)  # the colour bar's box: x, y, width, height (of the window)
+EDGES = 10  # pixels: the cell edges are drawn when cells are at least this large
 WALL_COLOR = "#a9b4c2"  # a cool grey that no colour map uses
 TIME_UNITS = ((1e-6, "µs"), (1e-3, "ms"), (1.0, "s"))  # the largest below the end time
 
@@ -45,21 +46,14 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     Raises RenderError for a folder without frame data or an unknown colouring.
     """
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    directory = Path(directory)
-    data = directory / "frames" / "data"
-    if not directory.is_dir():
-        raise RenderError(f"{directory}: no such folder")
-    if not (data / "mesh.npz").is_file():
-        raise RenderError(f"{directory}: no frame data (run with output.frames > 0)")
     import imageio.v2 as imageio
     import pyvista
 
-    mesh = dict(np.load(data / "mesh.npz"))
-    points = mesh["points"]
-    walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
-    up = up_direction(mesh.get("gravity"), walls)
-    paths = sorted(data.glob("frame_*.npz"))
+    directory = Path(directory)
+    mesh, walls, paths = _stored(directory)
     frames = [dict(np.load(path)) for path in paths]
+    points = mesh["points"]
+    up = up_direction(mesh.get("gravity"), walls)
     try:
         paint = coloring(color, frames, points, walls, up, float(mesh["speed"]))
     except ValueError as err:
@@ -67,15 +61,13 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     body = np.concatenate([points + f["u"] for f in frames])
     size = float(np.ptp(body, axis=0).max())
     surfaces = [
-        [wall_surface(pyvista, w, offset, body, size) for w, offset in zip(walls, f["offsets"])]
+        [wall_surface(pyvista, w, o, body, size) for w, o in zip(walls, f["offsets"], strict=True)]
         for f in frames
     ]
     clouds = [body, *(s.points for drawn in surfaces for s in drawn)]
     view = choose_view(points + frames[0]["u"], clouds, walls, up, WINDOW[0] / WINDOW[1])
-    behind = [
-        w.kind in ("plane", "parallelogram") and w.normal @ view.direction >= -1e-9 for w in walls
-    ]
-    scale, unit = _time_unit(float(frames[-1]["t"]) if frames else 0.0)
+    edges = bool(_cell_size(mesh) >= EDGES * 2 * view.scale / WINDOW[1])
+    scale, unit = _time_unit(float(frames[-1]["t"]))
     decimals = _time_decimals(frames, scale)
     files = []
     for path, frame, values, drawn in zip(paths, frames, paint.values, surfaces, strict=True):
@@ -87,7 +79,7 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
             scalars=paint.title,
             clim=paint.clim,
             cmap=paint.cmap,
-            show_edges=len(points) < 2000,
+            show_edges=edges,
             edge_color="#404040",
             line_width=0.5,
             ambient=0.3,
@@ -95,28 +87,37 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
             show_scalar_bar=False,
         )
         _colour_bar(plotter, paint)
-        for surface, opaque in zip(drawn, behind, strict=True):
-            if opaque:
+        for wall, surface in zip(walls, drawn, strict=True):
+            if view.behind(wall):
                 plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
             else:
                 plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
-        plotter.add_text(
-            f"t = {float(frame['t']) / scale:.{decimals}f} {unit}",
-            position=(12, WINDOW[1] - 32),
-            font_size=12,
-            color="black",
-        )
+        time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
+        plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
         view.apply(plotter)
         png = directory / "frames" / path.with_suffix(".png").name
         plotter.screenshot(str(png))
         plotter.close()
         files.append(png)
-    if files:
-        images = [imageio.imread(p) for p in files]
-        imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
-        if _has_mp4_encoder():
-            imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
+    images = [imageio.imread(p) for p in files]
+    imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
+    if _has_mp4_encoder():
+        imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
     return files
+
+
+def _stored(directory: Path):
+    """The body (``mesh.npz`` as a dict), the wall shapes and the frame files that
+    ``directory`` holds; RenderError when there are none."""
+    data = directory / "frames" / "data"
+    if not directory.is_dir():
+        raise RenderError(f"{directory}: no such folder")
+    paths = sorted(data.glob("frame_*.npz"))
+    if not (data / "mesh.npz").is_file() or not paths:
+        raise RenderError(f"{directory}: no frame data (run with output.frames > 0)")
+    mesh = dict(np.load(data / "mesh.npz"))
+    walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
+    return mesh, walls, paths
 
 
 def body_grid(pyvista, mesh: dict, frame: dict):
@@ -124,6 +125,13 @@ def body_grid(pyvista, mesh: dict, frame: dict):
     return pyvista.UnstructuredGrid(
         mesh["topology"], mesh["cell_types"], mesh["points"] + frame["u"]
     )
+
+
+def _cell_size(mesh: dict) -> float:
+    """The median length (m) of the first edge of the cells."""
+    topology = mesh["topology"].reshape(len(mesh["cell_types"]), -1)
+    first, second = mesh["points"][topology[:, 1]], mesh["points"][topology[:, 2]]
+    return float(np.median(np.linalg.norm(second - first, axis=1)))
 
 
 def _colour_bar(plotter, paint) -> None:

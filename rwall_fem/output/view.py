@@ -29,7 +29,7 @@ ANGLES = {"flat": (30.0, 30.0), "edge": (0.0, 20.0), "other": (30.0, 20.0)}
 LOWER = (10.0, 0.0, -10.0, -20.0)
 FLAT = 0.2  # a body is flat when its height is below this fraction of its width
 MARGIN = 0.15  # walls reach this fraction of the scene's size beyond the body (m / m)
-SLAB = 0.01  # thickness of a flat wall as a fraction of the scene's size
+SLAB = 0.02  # thickness of a flat wall as a fraction of the scene's size
 # The band of the picture that the scene fills (fractions of the height from the bottom):
 # the time is written above it, the colour bar drawn below.
 BAND = (0.16, 0.90)
@@ -45,6 +45,11 @@ class View:
     direction: np.ndarray
     up: np.ndarray
     scale: float
+
+    def behind(self, shape) -> bool:
+        """Whether the wall ``shape`` lies behind whatever is on its allowed side: a flat wall
+        seen from that side."""
+        return shape.kind in ("plane", "parallelogram") and shape.normal @ self.direction >= -1e-9
 
     def apply(self, plotter) -> None:
         """Set ``plotter``'s camera to this view."""

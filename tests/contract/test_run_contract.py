@@ -245,7 +245,10 @@ def test_render_draws_a_results_folder_again(tmp_path):
     assert result.returncode == 0, result.stderr
     assert len(list((tmp_path / "out" / "frames").glob("frame_*.png"))) == 3
     missing = _cli("render", "nowhere", cwd=tmp_path)
-    assert missing.returncode == 2 and "no frame data" in missing.stderr
+    assert missing.returncode == 2
+    assert missing.stderr.splitlines() == ["rwall-fem: error: nowhere: no such folder"]
+    empty = _cli("render", ".", cwd=tmp_path)
+    assert empty.returncode == 2 and "no frame data" in empty.stderr
 
 
 @pytest.mark.serial
