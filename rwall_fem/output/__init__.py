@@ -8,7 +8,8 @@
   :mod:`~rwall_fem.output.summary`;
 - :mod:`~rwall_fem.output.fields` (``fields.xdmf``), :mod:`~rwall_fem.output.frames`
   (frame data) and :mod:`~rwall_fem.output.render` (pictures, in a process without
-  DOLFINx); :mod:`~rwall_fem.output.plots` (``histories.png``);
+  DOLFINx, with :mod:`~rwall_fem.output.coloring` and :mod:`~rwall_fem.output.view`);
+  :mod:`~rwall_fem.output.plots` (``histories.png``);
   :mod:`~rwall_fem.output.progress` (the command line's progress bar);
 - :mod:`~rwall_fem.output.schedule`: the steps at which recorders sample.
 

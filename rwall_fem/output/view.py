@@ -5,12 +5,17 @@ on its forbidden side under the body's footprint, a cylinder as a tube without
 end caps along the body's extent on its axis (it is infinite), a sphere whole.
 
 The camera is parallel (orthographic, as in FE post-processors), the same for
-every frame, with ``up`` pointing up. It looks across the body's longer
-horizontal extent, 30 degrees round from square and from 20 degrees above
-the horizon (lower when a flat wall asks for it): always from the allowed
-side of the flat walls, so that they lie behind the body. It is fitted to
-everything drawn in every frame, between the time at the top and the colour
-bar at the bottom. The body is drawn at true scale by the renderer.
+every frame, with ``up`` pointing up (against gravity, else along the first
+flat wall's normal). It looks along the horizontal direction in which the scene
+is thinnest, so that the body's longer extent and its motion in that vertical
+plane lie across the picture: 30 degrees round and 20 degrees above the horizon
+as a rule; from 30 degrees up at a flat body (a plate), so that its face shows;
+square along the body beside a finite wall, so that what hangs over the wall's
+edge shows. Flat walls are always seen from their allowed side, so that they lie
+behind the body: lower elevations are tried until they are (a body between a
+floor and a press is seen level). The view is fitted to everything drawn in
+every frame, between the time at the top and the colour bar at the bottom. The
+body is drawn at true scale by the renderer.
 """
 
 from __future__ import annotations
@@ -21,10 +26,7 @@ import numpy as np
 
 __all__ = ["View", "choose_view", "up_direction", "wall_surface"]
 
-# (azimuth, elevation) of the camera (degrees): a flat body (a plate) is seen from higher
-# up, so that its face shows; beside a finite wall the camera looks square along the body
-# (and the wall's edge under it), so that what hangs over the edge shows; lower
-# elevations are tried after these.
+# (azimuth, elevation) of the camera (degrees), see above; then the elevations LOWER.
 ANGLES = {"flat": (30.0, 30.0), "edge": (0.0, 20.0), "other": (30.0, 20.0)}
 LOWER = (10.0, 0.0, -10.0, -20.0)
 FLAT = 0.2  # a body is flat when its height is below this fraction of its width
@@ -131,10 +133,9 @@ def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: flo
         e1 /= np.linalg.norm(e1)
         e2 = np.cross(shape.normal, e1)
         a, b = (body - point) @ e1, (body - point) @ e2
-        square = [[a.min(), b.min()], [a.max(), b.min()], [a.max(), b.max()], [a.min(), b.max()]]
-        corners = point + (
-            np.array(square) + margin * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
-        ) @ [e1, e2]
+        footprint = [[a.min(), b.min()], [a.max(), b.min()], [a.max(), b.max()], [a.min(), b.max()]]
+        outward = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
+        corners = point + (np.array(footprint) + margin * outward) @ [e1, e2]
     return _slab(pyvista, corners, -SLAB * size * shape.normal)
 
 
@@ -147,8 +148,8 @@ def _slab(pyvista, corners: np.ndarray, depth: np.ndarray):
 
 
 def _horizontal_axes(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors normal to ``up``: the one across which ``points`` extend less, then
-    the other (the camera looks along the first)."""
+    """Two unit vectors normal to ``up``: the one along which ``points`` extend less (the
+    camera looks along it), then the other."""
     first = np.eye(3)[np.argmin(np.abs(up))]
     first = first - (first @ up) * up
     first /= np.linalg.norm(first)
