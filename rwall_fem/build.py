@@ -130,7 +130,11 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
     element = scene.element
     try:
         technology = Technology.choose(
-            cell, element.integration, element.hourglass, element.hourglass_coefficient
+            cell,
+            element.integration,
+            element.hourglass,
+            element.hourglass_coefficient,
+            plastic=scene.material.plastic,
         )
     except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
         raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
@@ -220,10 +224,15 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
         guards=guards,
         plot=scene.output.plot,
     )
-    if scene.material.model != "linear_elastic":
-        from rwall_fem.hyperelasticity import StableStepMonitor
+    if scene.material.plastic:
+        from rwall_fem.stable_step import ElementStepMonitor
 
-        monitor = StableStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
+        monitor = ElementStepMonitor(solid.V, solid.u, sim.internal, solid.dt_stable, sim.comm)
+        sim.recorders.append(monitor)
+    elif scene.material.model != "linear_elastic":
+        from rwall_fem.stable_step import TangentStepMonitor
+
+        monitor = TangentStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
         sim.recorders.append(monitor)
     if scene.output.fields:
         from rwall_fem.output.fields import Fields

@@ -79,13 +79,15 @@ class Force(Protocol):
 class InternalForce(Force, Protocol):
     """The body's internal force: first in the pipeline, it *sets* ``state.a``.
 
-    ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``);
-    :meth:`energies` gives them (J) on this rank's share of the body at step n.
+    ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``),
+    ``energy_parts`` parts of them reported beside them (e.g. ``"plastic_work"``);
+    :meth:`energies` gives them all (J) on this rank's share of the body at step n.
     ``booked_force`` is None for a force with a stored energy; otherwise it is the nodal
     force (N, owned nodes) whose work the update books in ``state.internal_work``.
     """
 
     energy_names: tuple[str, ...]
+    energy_parts: tuple[str, ...]
     booked_force: np.ndarray | None
 
     def energies(self, state: State) -> dict[str, float]: ...

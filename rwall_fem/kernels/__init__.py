@@ -30,7 +30,7 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
-__all__ = ["KernelBuildError", "load"]
+__all__ = ["HOURGLASS", "MODELS", "POINT_SLOTS", "KernelBuildError", "load"]
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "tetrahedron.c", "hexahedron.c",
            "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
@@ -40,7 +40,8 @@ FLAG_SETS = (
     ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
     ["-O3", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
 )
-MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
+MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")  # the elastic laws
+POINT_SLOTS = 8  # state values per integration point of the plastic kernels (plasticity.h)
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
 
 _CDEF = """

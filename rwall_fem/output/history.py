@@ -48,6 +48,7 @@ class History:
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
+            parts=sim.internal.energy_parts,
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -57,7 +58,7 @@ class History:
         self._written_at = time.monotonic()
         self._sums = _Sums(
             comm,
-            {name: () for name in self.balance.stored}
+            {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "terminate": ()}
             | self.wall_table.sums,
         )
@@ -84,7 +85,7 @@ class History:
         self.wall_table.fill(local)
         total = self._sums.reduce()
 
-        energies = {name: float(total[name]) for name in self.balance.stored}
+        energies = {name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)}
         for w in sim.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic = 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity

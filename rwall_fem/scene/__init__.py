@@ -16,6 +16,7 @@ from rwall_fem.scene.overrides import apply_override
 from rwall_fem.scene.read import load_scene, parse_scene
 from rwall_fem.scene.schema import (
     MATERIAL_MODELS,
+    PLASTIC_MODELS,
     MESH_SHAPES,
     SHAPE_KEYS,
     BoundarySpec,
@@ -33,6 +34,7 @@ from rwall_fem.scene.schema import (
 
 __all__ = [
     "MATERIAL_MODELS",
+    "PLASTIC_MODELS",
     "MESH_SHAPES",
     "SHAPE_KEYS",
     "BoundarySpec",

@@ -137,7 +137,7 @@ def _one_line_or_scene(raw, source="fuzz.toml"):
 
 def test_full_scene_is_valid():
     scene = parse_scene(copy.deepcopy(FULL))
-    assert scene.walls[0].motion.mass == 1.0 and scene.element.hourglass_coefficient == 0.1
+    assert scene.walls[0].motion.mass == 1.0 and scene.element.hourglass_coefficient is None
 
 
 @pytest.mark.parametrize("where, name", list(_key_paths()), ids=".".join)
