@@ -89,7 +89,9 @@ class Technology:
             raise ValueError(f"element.hourglass: must be one of {HOURGLASS}, got {hourglass!r}")
         if coefficient is None:
             physical = hourglass == "physical"
-            coefficient = PLASTIC_COEFFICIENT if physical and plastic else DEFAULT_COEFFICIENT[hourglass]
+            coefficient = (
+                PLASTIC_COEFFICIENT if physical and plastic else DEFAULT_COEFFICIENT[hourglass]
+            )
         return cls(cell, "reduced", hourglass, float(coefficient))
 
     @property
@@ -176,7 +178,9 @@ class ElementForce:
         self.params.lmbda, self.params.mu = lmbda, mu
         self.params.density, self.params.wave_speed = material.density, material.p_wave_speed
         self.params.hourglass_coefficient = technology.hourglass_coefficient
-        self.points = 8 if technology.cell == "hexahedron" and technology.integration == "full" else 1
+        self.points = (
+            8 if technology.cell == "hexahedron" and technology.integration == "full" else 1
+        )
         self.history = None
         if self.plastic:
             self._set_plasticity(material)
@@ -229,7 +233,11 @@ class ElementForce:
         rest = (self.params, ptr(f), ptr(energy))
         family = "tet4" if t.cell == "tetrahedron" else "hex8"
         if self.plastic:
-            name = f"hex8r_plastic_{t.hourglass}" if t.integration == "reduced" else f"{family}_plastic"
+            name = (
+                f"hex8r_plastic_{t.hourglass}"
+                if t.integration == "reduced"
+                else f"{family}_plastic"
+            )
             state = (ptr(self.history), self.num_cells)
             return functools.partial(getattr(self.lib, name), *common, ptr(v), self.params, *state,
                                      ptr(f), ptr(energy))  # fmt: skip
@@ -360,9 +368,11 @@ def _oriented(cells: np.ndarray, X: np.ndarray) -> np.ndarray:
     elasto-plastic kernels then know a cell with a non-positive volume is inverted."""
     x = X[cells]
     if cells.shape[1] == 4:
-        det = np.einsum("ij,ij->i", x[:, 1] - x[:, 0], np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]))
+        det = np.einsum(
+            "ij,ij->i", x[:, 1] - x[:, 0], np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0])
+        )
     else:  # the Jacobian at the centre of the trilinear map
-        signs = np.array([[2 * (I >> k & 1) - 1 for I in range(8)] for k in range(3)])
+        signs = np.array([[2 * (node >> k & 1) - 1 for node in range(8)] for k in range(3)])
         e = np.einsum("kI,cIi->cki", signs, x)
         det = np.einsum("ci,ci->c", e[:, 0], np.cross(e[:, 1], e[:, 2]))
     mirrored = det < 0.0

@@ -85,7 +85,9 @@ class History:
         self.wall_table.fill(local)
         total = self._sums.reduce()
 
-        energies = {name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)}
+        energies = {
+            name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)
+        }
         for w in sim.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic = 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity

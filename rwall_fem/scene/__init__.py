@@ -16,8 +16,8 @@ from rwall_fem.scene.overrides import apply_override
 from rwall_fem.scene.read import load_scene, parse_scene
 from rwall_fem.scene.schema import (
     MATERIAL_MODELS,
-    PLASTIC_MODELS,
     MESH_SHAPES,
+    PLASTIC_MODELS,
     SHAPE_KEYS,
     BoundarySpec,
     Element,

@@ -442,7 +442,10 @@ class Material:
         doc="C in the rate factor 1 + C ln max(rate / reference_strain_rate, 1)",
     )
     reference_strain_rate: float = key(
-        Real(low=0.0), 1.0, unit="1/s", doc="the rate below which the flow stress is that of A + B eps_p^n"
+        Real(low=0.0),
+        1.0,
+        unit="1/s",
+        doc="the rate below which the flow stress is that of A + B eps_p^n",
     )
     heating: Heating | None = key(
         Sub(Heating),
