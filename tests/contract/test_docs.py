@@ -7,6 +7,7 @@ The site itself is built by ``make docs`` (warnings as errors), which ``make tes
 import importlib
 import importlib.util
 import pkgutil
+import re
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,23 @@ def test_every_demo_becomes_a_page(rwall_docs):
     for path in sorted((ROOT / "demos").glob("*.toml")):
         page, summary = rwall_docs.scene_markdown(path)
         assert page.startswith("# ") and summary and "{literalinclude}" in page, path.name
+
+
+def test_pointers_into_the_theory_name_its_sections():
+    """Code and tests point at ``docs/theory.md, "Section"``: each names a heading there
+    (or the start of one: "Chatter")."""
+    headings = [
+        line.lstrip("#").strip().lower()
+        for line in (ROOT / "docs/theory.md").read_text().splitlines()
+        if line.startswith("#")
+    ]
+    pointer = re.compile(r'theory\.md`{0,2},?\s*\(?(?:section\s+)?"([^"]+)"')
+    sources = [*(ROOT / "rwall_fem").rglob("*.py"), *(ROOT / "rwall_fem").rglob("*.[ch]")]
+    sources += [p for p in (ROOT / "tests").rglob("*.py") if p != Path(__file__).resolve()]
+    wrong = []
+    for path in sources:
+        for match in pointer.finditer(path.read_text()):
+            name = " ".join(re.sub(r"\n\s*[#*]?", " ", match.group(1)).split()).lower()
+            if not any(h.startswith(name) for h in headings):
+                wrong.append(f"{path.relative_to(ROOT)}: {match.group(1)!r}")
+    assert not wrong, f"no such section in docs/theory.md: {wrong}"
