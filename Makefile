@@ -8,7 +8,7 @@
 #   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
 #   make demos                 run every demo (scenes and Python scripts) into results/
 #   make docs                  the documentation site (Sphinx + MyST) into docs/_build/html,
-#                              warnings as errors; on the Debian leg, about 15 s, runs no demo
+#                              warnings as errors; on the Debian leg, a few seconds, runs no demo
 #   make study / make bench    accuracy vs wall time (results/study, copied to docs/); throughput
 #                              benchmark (bench/results.md); both on the Debian leg, long runs
 #   make clean                 remove both venvs, test logs, Python caches and the built docs
