@@ -115,5 +115,24 @@ class StableStepMonitor:
         self._last = (s.step, estimate)
         self._next = s.step + self._interval
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The reference eigenvalue (1/s^2), the power iteration's latest vector, the
+        estimates so far and the schedule of the checks."""
+        last_step, last_estimate = self._last
+        return {
+            "reference": np.array(self.reference),
+            "mode": self._mode,
+            "estimates": np.array(self.estimates).reshape(-1, 2),
+            "schedule": np.array([self._next, self._interval, last_step, last_estimate]),
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.reference = float(arrays["reference"])
+        self._mode = arrays["mode"].copy()
+        self.estimates = [tuple(row) for row in arrays["estimates"].tolist()]
+        following, interval, last_step, last_estimate = arrays["schedule"].tolist()
+        self._next, self._interval = int(following), int(interval)
+        self._last = (int(last_step), last_estimate)
+
     def close(self, sim) -> None:
         pass
