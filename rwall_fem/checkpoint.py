@@ -106,7 +106,7 @@ class Checkpoints:
         """Whether a checkpoint is due after ``step``; the same on every rank: rank 0
         reads its clock at steps it chooses (about 20 times per interval, at most twice
         as far apart as the previous time) and tells the others."""
-        if self.steps and step % self.steps == 0:
+        if self.steps and step and step % self.steps == 0:
             return True
         if not self.seconds or step < self._next_check:
             return False
