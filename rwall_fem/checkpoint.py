@@ -30,6 +30,7 @@ import logging
 import os
 import shutil
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -128,11 +129,11 @@ class Checkpoints:
             return
         finite = bool(np.isfinite(s.u).all() and np.isfinite(s.v).all())
         if not comm.allreduce(finite, op=MPI.LAND):
-            log.warning(
-                "no checkpoint at step %d: NaN or Inf in the state; the latest is step %d",
-                s.step,
-                self._saved,
-            )
+            if comm.rank == 0:
+                kept = f"step {self._saved}" if self._saved >= 0 else "none"
+                log.warning(
+                    "no checkpoint at step %d: NaN or Inf in the state (kept: %s)", s.step, kept
+                )
             return
         arrays = {
             f"{name}/{key}": np.asarray(value)
@@ -160,13 +161,13 @@ class Checkpoints:
                 "and every output.checkpoint_steps or _seconds)"
             )
         path = Path(latest) / f"rank_{comm.rank}.npz"
-        arrays, error = None, None
+        arrays, header, error = None, None, None
         try:
             with np.load(path, allow_pickle=False) as npz:
                 arrays = dict(npz)
-        except (OSError, ValueError) as err:
-            error = f"{path}: cannot be read ({err})"
-        header = json.loads(str(arrays.pop("header"))) if arrays else None
+            header = json.loads(str(arrays.pop("header")))
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:
+            error = f"{path}: cannot be read ({type(err).__name__}: {err})"
         ranks = comm.bcast(header["ranks"] if header else None, root=0)
         if ranks is not None and ranks != comm.size:
             raise CheckpointError(

@@ -52,11 +52,14 @@ class Stateful(Protocol):
 
     :meth:`checkpoint_state` gives that state after the update and the history of step n
     as named NumPy arrays (this rank's share; SI units; arrays may be views of the live
-    state: they are written at once). The names are the same at every step of a run.
+    state: they are written at once). The names are the same at every step of a run. An
+    object that writes outputs puts them on disk first (collectively, if it writes them
+    so): a checkpoint promises the outputs up to its step.
     :meth:`restore_state` takes those arrays back from a checkpoint of the same scene on
     as many ranks, so that step n + 1 runs exactly as it would have; it raises ValueError
-    (one line) when an output it continues does not fit the checkpoint. Whatever the
-    object derives again from the scene when it is built needs no place in it.
+    (one line) when an output it continues does not fit the checkpoint. What an object
+    derives from the scene alone when it is built (masses, node sets, histories of
+    prescribed velocities) needs no place in it.
 
     The pieces of a run are listed by :attr:`Simulation.stateful`; a recorder is
     stateful when it has these methods (a progress bar needs none).

@@ -257,3 +257,27 @@ def test_sigterm_writes_a_checkpoint_of_the_step_it_stopped_at(tmp_path):
         header = json.loads(str(npz["header"]))
         assert header["step"] == step and header["ranks"] == 1
         assert int(npz["state/clock"][0]) == step
+
+
+def test_checkpoints_every_so_many_seconds_look_at_the_clock_seldom(monkeypatch):
+    """On a clock that advances 1 ms per step, a checkpoint every second is due at step
+    1000 (within the last gap between looks at the clock, at most 1/20 of the interval),
+    after a few dozen looks, the same on every rank (rank 0's clock decides)."""
+    clock = {"now": 0.0, "looks": 0}
+
+    def monotonic():
+        clock["looks"] += 1
+        return clock["now"]
+
+    monkeypatch.setattr(rwall_fem.checkpoint.time, "monotonic", monotonic)
+    schedule = rwall_fem.checkpoint.Checkpoints(
+        Path("unused"), MPI.COMM_WORLD, {"scene": {}}, seconds=1.0
+    )
+    schedule.start(1)
+    clock["looks"] = 0
+    for step in range(1, 2000):
+        clock["now"] = 1e-3 * step
+        if schedule.due(step):
+            break
+    assert 1000 <= step <= 1050
+    assert clock["looks"] < 40 if MPI.COMM_WORLD.rank == 0 else clock["looks"] == 0
