@@ -91,6 +91,11 @@ class Fields:
                     f"checkpoint has {self._count} of each"
                 )
         self._present, error = comm.bcast((max(counts, default=0), error), root=0)
+        if not error and self._count:
+            try:  # a run killed while it wrote may leave the HDF5 file unreadable
+                io.XDMFFile(comm, str(self.path), "a").close()
+            except RuntimeError as err:
+                error = f"{self.path}: cannot be appended to ({err})"
         if error:
             raise ValueError(error)
 

@@ -74,9 +74,12 @@ def _read_rows(path: Path, columns: Sequence[str], count: int) -> list[tuple]:
         raise ValueError(f"{path}: its columns are not those of this run")
     if len(lines) < count + 2:  # the header, the rows, and what follows their last newline
         raise ValueError(f"{path}: holds {max(len(lines) - 2, 0)} rows; the checkpoint has {count}")
-    rows = [tuple(map(_number, line.split(","))) for line in lines[1 : count + 1]]
+    try:
+        rows = [tuple(map(_number, line.split(","))) for line in lines[1 : count + 1]]
+    except ValueError:
+        raise ValueError(f"{path}: a row of the first {count} is not numbers") from None
     if any(len(r) != len(columns) for r in rows):
-        raise ValueError(f"{path}: a row without {len(columns)} columns")
+        raise ValueError(f"{path}: a row of the first {count} has not {len(columns)} columns")
     return rows
 
 

@@ -180,7 +180,7 @@ def test_a_state_with_nan_keeps_the_last_good_checkpoint(shared_dir):
     assert checkpoints(Path(shared_dir)) == ["step_0000000004"]
 
 
-def test_a_resume_refuses_another_scene_or_none(shared_dir):
+def test_a_resume_refuses_another_scene_outputs_that_lack_rows_or_none(shared_dir):
     raw = bar_scene(elements=4)
     raw["run"]["end_time"] = 1e-6
     out = Path(shared_dir)
@@ -195,6 +195,14 @@ def test_a_resume_refuses_another_scene_or_none(shared_dir):
     other["output"]["checkpoint_steps"] = 3  # how often is free to change
     sim = build(other, out / "run")
     with pytest.raises(CheckpointError, match=r"another scene: wall\[0\]\.slide is 'tied', was "):
+        sim.checkpoints.resume(sim)
+
+    if MPI.COMM_WORLD.rank == 0:
+        energy = out / "run" / "energy.csv"
+        energy.write_text(energy.read_text().splitlines()[0] + "\n")
+    MPI.COMM_WORLD.Barrier()
+    sim = build(raw, out / "run")
+    with pytest.raises(CheckpointError, match=r"energy\.csv: holds 0 rows; the checkpoint has \d+"):
         sim.checkpoints.resume(sim)
 
 
