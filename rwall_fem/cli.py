@@ -7,8 +7,8 @@
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback; also a checkpoint
-that does not fit the scene), 3 run stopped by a
-guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept), 4 an output
+that does not fit the scene), 3 run stopped by a guard or by SIGTERM (one line on
+stderr; the outputs up to the stop are kept, and a checkpoint of the step), 4 an output
 could not be written at the end of the run (one line on stderr; the others are written).
 """
 

@@ -24,6 +24,7 @@ import rwall_fem.output.frames
 from rwall_fem import build_simulation, parse_scene
 from rwall_fem.checkpoint import CheckpointError
 from rwall_fem.cli import main
+from rwall_fem.output import OutputError
 
 # Every kind of state a step carries over: a hyperelastic body (stable-step monitor) with
 # viscous hourglass control (accumulated energy), gravity, a driven face, a wall carried
@@ -178,6 +179,18 @@ def test_a_state_with_nan_keeps_the_last_good_checkpoint(shared_dir):
     assert "NaN or Inf" in sim.run()
     MPI.COMM_WORLD.Barrier()
     assert checkpoints(Path(shared_dir)) == ["step_0000000004"]
+
+
+def test_a_checkpoint_that_cannot_be_written_fails_the_run_on_every_rank(shared_dir):
+    raw = bar_scene(elements=4)
+    raw["output"]["checkpoint_steps"] = 2
+    if MPI.COMM_WORLD.rank == 0:
+        (Path(shared_dir) / "checkpoint").write_text("a file where the directory goes")
+    MPI.COMM_WORLD.Barrier()
+    sim = build(raw, shared_dir)
+    with pytest.raises(OutputError, match=r"^checkpoint: .*checkpoint/partial: "):
+        sim.run()
+    assert sim.status.startswith("failed: OutputError") and sim.history.energy[-1][0] > 0
 
 
 def test_a_resume_refuses_another_scene_outputs_that_lack_rows_or_none(shared_dir):
