@@ -188,15 +188,6 @@ class ElementForce:
             energies["hourglass"] = hourglass
         return energies
 
-    def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The energies of the latest force computation (J): the viscous hourglass form
-        accumulates its dissipation in the second."""
-        return {"energy": self._energy}
-
-    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
-        self._energy[:] = arrays["energy"]
-        self.hourglass_energy = float(self._energy[1])
-
     def accelerate(self, state) -> None:
         """Set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
         self.u.scatter_forward()
@@ -248,3 +239,12 @@ class ElementForce:
         if not self.conservative:
             hourglass = 0.0
         return tuple(self.V.mesh.comm.allreduce(np.array([elastic, hourglass])))
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The energies of the latest force computation (J): the viscous hourglass form
+        accumulates its dissipation in the second."""
+        return {"energy": self._energy}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._energy[:] = arrays["energy"]
+        self.hourglass_energy = float(self._energy[1])
