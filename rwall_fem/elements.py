@@ -357,6 +357,20 @@ class ElementForce:
             hourglass = 0.0
         return tuple(self.V.mesh.comm.allreduce(np.array([elastic, hourglass])))
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The energies of the latest force computation (J: the viscous hourglass form and
+        the elasto-plastic kernels accumulate theirs), whether the first step is done, and
+        the elasto-plastic state per integration point."""
+        arrays = {"energy": self._energy, "started": np.array(self._started)}
+        if self.plastic:
+            arrays["history"] = self.history
+        return arrays
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._energy[:] = arrays["energy"]
+        self._started = bool(arrays["started"])
+        if self.plastic:
+            self.history[...] = arrays["history"]
 
 # Node permutations that turn a cell inside out: a mirror of its reference cell.
 _MIRROR = {4: [0, 2, 1, 3], 8: [1, 0, 3, 2, 5, 4, 7, 6]}

@@ -72,6 +72,20 @@ class _StepMonitor:
     def close(self, sim) -> None:
         pass
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The estimates so far and the schedule of the checks."""
+        last_step, last_estimate = self._last
+        return {
+            "estimates": np.array(self.estimates).reshape(-1, 2),
+            "schedule": np.array([self._next, self._interval, last_step, last_estimate]),
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.estimates = [tuple(row) for row in arrays["estimates"].tolist()]
+        following, interval, last_step, last_estimate = arrays["schedule"].tolist()
+        self._next, self._interval = int(following), int(interval)
+        self._last = (int(last_step), last_estimate)
+
 
 class TangentStepMonitor(_StepMonitor):
     """The stable step of a hyperelastic body: ``dt_stable`` (s) scaled by the change of the
@@ -90,6 +104,18 @@ class TangentStepMonitor(_StepMonitor):
     def estimate(self, s) -> float:
         ratio = self.largest_eigenvalue(s, iterations=8) / self.reference
         return self.dt_stable / np.sqrt(max(ratio, 1e-300))
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """Also the reference eigenvalue (1/s^2) and the power iteration's latest vector."""
+        return super().checkpoint_state() | {
+            "reference": np.array(self.reference),
+            "mode": self._mode,
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        super().restore_state(arrays)
+        self.reference = float(arrays["reference"])
+        self._mode = arrays["mode"].copy()
 
     def largest_eigenvalue(self, state, iterations: int, tolerance: float = 1e-3) -> float:
         """Rayleigh quotient (1/s^2) of a power iteration on M^-1/2 K_t M^-1/2, the tangent

@@ -62,6 +62,19 @@ class EnergyBalance:
         """Balance error of the latest sample (None before the first)."""
         return None if self.latest is None else self.latest["balance_error"]
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """E0, E_ref and the largest error so far, and the latest sample (empty: none)."""
+        latest = () if self.latest is None else tuple(self.latest.values())
+        return {
+            "books": np.array([self.initial, self.reference, self.max_error]),
+            "latest": np.array(latest, dtype=float),
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.initial, self.reference, self.max_error = arrays["books"].tolist()
+        latest = arrays["latest"].tolist()
+        self.latest = dict(zip(self.columns, latest, strict=True)) if latest else None
+
     def sample(self, t: float, energies: Mapping[str, float]) -> tuple:
         """Book the energies (J, summed over ranks) of time ``t`` (s); returns the row."""
         stored = sum(energies[name] for name in self.stored)

@@ -703,6 +703,17 @@ class Output:
         doc="what colours the frames",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
+    checkpoint_steps: int = key(
+        Integer(low=0),
+        0,
+        doc="steps between checkpoints (directory/checkpoint, for run --resume); 0: none",
+    )
+    checkpoint_seconds: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="s",
+        doc="wall time between checkpoints; 0: none (a stop by SIGTERM or a guard writes one)",
+    )
 
 
 # --- the scene -----------------------------------------------------------------------
