@@ -2,7 +2,8 @@
 
 Data flows one way: scene -> body (mesh, space, lumped mass, element technology) -> stable
 time step -> pipeline (internal force, body forces, walls, boundary conditions: only what
-the scene asks for) -> recorders (history, stable-step monitor, fields, frames).
+the scene asks for) -> recorders (history, stable-step monitor, fields, frames) and the
+checkpoints.
 """
 
 from __future__ import annotations
@@ -15,8 +16,9 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from rwall_fem import _compat
+from rwall_fem import __version__, _compat
 from rwall_fem.boundary import VelocityBoundary
+from rwall_fem.checkpoint import Checkpoints, body_digest, scene_keys
 from rwall_fem.effects import Gravity
 from rwall_fem.elements import ElementForce, GhostedField, Technology
 from rwall_fem.mechanics import critical_time_step, element_time_step, lumped_mass
@@ -46,11 +48,17 @@ def run_scene(
     out: str | Path | None = None,
     overrides=(),
     comm: MPI.Comm = MPI.COMM_WORLD,
+    *,
+    resume: bool = False,
 ) -> dict:
-    """Build and run a scene (object or TOML path); returns the summary written to ``out``."""
+    """Build and run a scene (object or TOML path); returns the summary written to ``out``.
+    With ``resume``, the run continues from the checkpoint in ``out``
+    (:mod:`rwall_fem.checkpoint`)."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene, list(overrides))
     sim = build_simulation(scene, comm, out)
+    if resume:
+        sim.checkpoints.resume(sim)
     sim.run()
     return sim.history.summary
 
@@ -72,7 +80,21 @@ def build_simulation(
     solid = _solid(scene, comm, body)
     dt = _time_step(scene, solid)
     sim = _pipeline(scene, solid, dt)
-    _add_recorders(sim, scene, solid, Path(out) if out is not None else scene.output.directory)
+    directory = Path(out) if out is not None else scene.output.directory
+    _add_recorders(sim, scene, solid, directory)
+    identity = {
+        "code": __version__,
+        "dolfinx": _compat.DOLFINX_VERSION,
+        "scene": scene_keys(scene),
+        "body": body_digest(sim.state),
+    }
+    sim.checkpoints = Checkpoints(
+        directory / "checkpoint",
+        sim.comm,
+        identity,
+        steps=scene.output.checkpoint_steps,
+        seconds=scene.output.checkpoint_seconds,
+    )
     log.info(
         "effects: %s; %d steps to t = %.4g s",
         ", ".join(sim.effects),
@@ -130,7 +152,11 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
     element = scene.element
     try:
         technology = Technology.choose(
-            cell, element.integration, element.hourglass, element.hourglass_coefficient
+            cell,
+            element.integration,
+            element.hourglass,
+            element.hourglass_coefficient,
+            plastic=scene.material.plastic,
         )
     except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
         raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
@@ -220,10 +246,15 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
         guards=guards,
         plot=scene.output.plot,
     )
-    if scene.material.model != "linear_elastic":
-        from rwall_fem.hyperelasticity import StableStepMonitor
+    if scene.material.plastic:
+        from rwall_fem.stable_step import ElementStepMonitor
 
-        monitor = StableStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
+        monitor = ElementStepMonitor(solid.V, solid.u, sim.internal, solid.dt_stable, sim.comm)
+        sim.recorders.append(monitor)
+    elif scene.material.model != "linear_elastic":
+        from rwall_fem.stable_step import TangentStepMonitor
+
+        monitor = TangentStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
         sim.recorders.append(monitor)
     if scene.output.fields:
         from rwall_fem.output.fields import Fields

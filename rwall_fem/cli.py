@@ -1,12 +1,14 @@
 """Command line.
 
-- ``rwall-fem run SCENE [--out DIR] [--set key=value ...] [--quiet]``: run a scene;
+- ``rwall-fem run SCENE [--out DIR] [--set key=value ...] [--quiet] [--resume]``: run a
+  scene, or with ``--resume`` continue the run whose checkpoint is in DIR;
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
 - ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
-Exit codes: 0 done, 2 bad input (one line on stderr, no traceback), 3 run stopped by a
-guard or by SIGTERM (one line on stderr; the outputs up to the stop are kept), 4 an output
+Exit codes: 0 done, 2 bad input (one line on stderr, no traceback; also a checkpoint
+that does not fit the scene), 3 run stopped by a guard or by SIGTERM (one line on
+stderr; the outputs up to the stop are kept, and a checkpoint of the step), 4 an output
 could not be written at the end of the run (one line on stderr; the others are written).
 """
 
@@ -43,6 +45,11 @@ def main(argv: list[str] | None = None) -> int:
         )
     run.add_argument("--out", help="results directory (default: the scene's output.directory)")
     run.add_argument("--quiet", action="store_true", help="print only errors")
+    run.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the run whose checkpoint is in the results directory (/RFILE)",
+    )
     render = commands.add_parser("render", help="draw the frames of a results folder again")
     render.add_argument("directory", help="results folder of a run with output.frames > 0")
     render.add_argument(
@@ -64,6 +71,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from mpi4py import MPI
 
+    from rwall_fem.checkpoint import CheckpointError
     from rwall_fem.output import OutputError
     from rwall_fem.scene import SceneError
 
@@ -81,8 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "check":
             return _check(args.scene, args.overrides, comm)
-        summary = _run(args.scene, args.out, args.overrides, comm, quiet)
-    except SceneError as err:
+        summary = _run(args.scene, args.out, args.overrides, comm, quiet, args.resume)
+    except (SceneError, CheckpointError) as err:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
@@ -103,11 +111,13 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _run(scene_file, out, overrides, comm, quiet: bool) -> dict:
+def _run(scene_file, out, overrides, comm, quiet: bool, resume: bool) -> dict:
     from rwall_fem.build import build_simulation
     from rwall_fem.scene import load_scene
 
     sim = build_simulation(load_scene(scene_file, overrides), comm, out)
+    if resume:
+        sim.checkpoints.resume(sim)
     if comm.rank == 0 and not quiet and sys.stderr.isatty():
         from rwall_fem.output.progress import Progress
 

@@ -10,10 +10,15 @@ sigma = P F^T / J for the hyperelastic models.
 DOLFINx writes the data collectively (XDMF with HDF5), so parallel runs give
 one file; its XML, though, holds one time series per function, and DOLFINx
 0.10+ declares the XInclude namespace with ``https://``, which the XDMF
-readers of VTK do not know (pyvista crashes on it). At the end of the run rank
-0 rewrites the XML into one temporal collection whose every step carries all
-fields, with the ``http://`` namespace (:func:`one_time_series`); the HDF5 file
-is left as DOLFINx wrote it.
+readers of VTK do not know (pyvista crashes on it). Whenever the file is
+closed, rank 0 rewrites the XML into one temporal collection whose every step
+carries all fields, with the ``http://`` namespace (:func:`one_time_series`);
+the HDF5 file is left as DOLFINx wrote it. Before DOLFINx appends to the file
+again, rank 0 gives the XML back its DOLFINx layout (:func:`series_per_field`).
+
+A checkpoint closes the file (HDF5 holds data in memory until then); the run appends
+to it afterwards, and a resumed run skips the snapshots already in it (those written
+after its checkpoint: the same ones, as the run is deterministic).
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import ufl
 from dolfinx import fem, io
 
@@ -28,11 +34,15 @@ from rwall_fem import _compat
 from rwall_fem.mechanics import stress
 from rwall_fem.output.schedule import spread
 
-__all__ = ["Fields", "one_time_series"]
+__all__ = ["Fields", "one_time_series", "series_per_field"]
 
 XINCLUDE = "http://www.w3.org/2001/XInclude"
 # The steps after the first take their topology and geometry from the first step.
 MESH_POINTER = "xpointer(/Xdmf/Domain/Grid/Grid[1]/*[self::Topology or self::Geometry])"
+# In DOLFINx's layout every step takes them from the mesh grid, the first uniform grid.
+DOLFINX_POINTER = (
+    "xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]/*[self::Topology or self::Geometry])"
+)
 
 
 class Fields:
@@ -51,15 +61,24 @@ class Fields:
         self._material, self._mises = material, None  # compiled at its first use
         self._cells: dict[str, fem.Function] = {}
         self._file = None
+        self._count = 0  # snapshots recorded
+        self._present = 0  # snapshots in the file when the run resumed
 
     def due(self, step: int) -> bool:
         return step in self.steps
 
     def record(self, sim, s) -> None:
+        index, self._count = self._count, self._count + 1
+        if index < self._present:
+            return  # written before a resume, after the checkpoint: the same snapshot
         if self._file is None:
+            msh = self.u.function_space.mesh
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._file = io.XDMFFile(self.u.function_space.mesh.comm, str(self.path), "w")
-            self._file.write_mesh(self.u.function_space.mesh)
+            if index:
+                self._per_field()
+            self._file = io.XDMFFile(msh.comm, str(self.path), "a" if index else "w")
+            if not index:
+                self._file.write_mesh(msh)
         for field, values in ((self.u, s.u), (self.v, s.v)):
             field.x.array[: values.size] = values.ravel()
             field.x.scatter_forward()
@@ -83,34 +102,70 @@ class Fields:
         return self._cells[name]
 
     def close(self, sim) -> None:
+        """Close the file (a checkpoint closes it too) and make it one time series."""
         if self._file is None:
             return
         self._file.close()
+        self._file = None
         if self.u.function_space.mesh.comm.rank == 0:
             one_time_series(self.path)
+
+    def _per_field(self) -> None:
+        """Give the file DOLFINx's layout back before DOLFINx appends to it (collective)."""
+        comm = self.u.function_space.mesh.comm
+        if comm.rank == 0:
+            series_per_field(self.path)
+        comm.barrier()
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """How many snapshots are written; the file is closed, so they are on disk."""
+        self.close(None)
+        return {"snapshots": np.array(self._count)}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Continue the file: it must hold the checkpoint's snapshots, whole."""
+        comm = self.u.function_space.mesh.comm
+        self._count, counts, error = int(arrays["snapshots"]), set(), None
+        if comm.rank == 0 and self._count:
+            try:
+                series_per_field(self.path)
+                domain = ET.parse(self.path).getroot().find("Domain")
+                collections = domain.findall("Grid[@CollectionType='Temporal']")
+                counts = {len(c.findall("Grid")) for c in collections}
+                if {self.u.name, self.v.name} - {c.get("Name") for c in collections}:
+                    counts.add(0)
+            except (OSError, ET.ParseError, AttributeError) as err:
+                error = f"{self.path}: cannot be read ({err})"
+            if not error and (len(counts) > 1 or min(counts) < self._count):
+                error = (
+                    f"{self.path}: holds snapshots {sorted(counts)} of its fields; the "
+                    f"checkpoint has {self._count} of each"
+                )
+        self._present, error = comm.bcast((max(counts, default=0), error), root=0)
+        if not error and self._count:
+            try:  # a run killed while it wrote may leave the HDF5 file unreadable
+                io.XDMFFile(comm, str(self.path), "a").close()
+            except RuntimeError as err:
+                error = f"{self.path}: cannot be appended to ({err})"
+        if error:
+            raise ValueError(error)
 
 
 def one_time_series(path: Path) -> None:
     """Rewrite the XDMF file ``path`` as DOLFINx wrote it (a mesh grid, then one temporal
     collection per function) into one temporal collection whose steps hold every
     attribute of their time, in the order the functions were written; the first step
-    holds the mesh, the others include it."""
+    holds the mesh, the others include it. A file in that form already is left as it is."""
     root = ET.parse(path).getroot()
     domain = root.find("Domain")
-    mesh, *collections = domain.findall("Grid")
+    mesh = domain.find("Grid[@GridType='Uniform']")
+    if mesh is None:
+        return
     steps: dict[str, list[ET.Element]] = {}  # time value (as written) -> attributes
-    for collection in collections:
+    for collection in domain.findall("Grid[@CollectionType='Temporal']"):
         for grid in collection.findall("Grid"):
             steps.setdefault(grid.find("Time").get("Value"), []).extend(grid.findall("Attribute"))
-    ET.register_namespace("xi", XINCLUDE)
-    out = ET.Element("Xdmf", Version="3.0")
-    series = ET.SubElement(
-        ET.SubElement(out, "Domain"),
-        "Grid",
-        Name="fields",
-        GridType="Collection",
-        CollectionType="Temporal",
-    )
+    series = ET.Element("Grid", Name="fields", GridType="Collection", CollectionType="Temporal")
     for k, time in enumerate(sorted(steps, key=float)):
         step = ET.SubElement(series, "Grid", Name="fields", GridType="Uniform")
         if k == 0:
@@ -119,12 +174,48 @@ def one_time_series(path: Path) -> None:
             ET.SubElement(step, f"{{{XINCLUDE}}}include", xpointer=MESH_POINTER)
         ET.SubElement(step, "Time", Value=time)
         step.extend(steps[time])
-    for item in out.iter("DataItem"):
+    for item in series.iter("DataItem"):
         # DOLFINx stores doubles and 64-bit integers but leaves the precision out, and
         # VTK's readers take 4 bytes by default (floats rounded to single precision).
         item.set("Precision", "8")
-    ET.indent(out)
-    Path(path).write_text('<?xml version="1.0"?>\n' + ET.tostring(out, encoding="unicode") + "\n")
+    _write(path, [series])
+
+
+def series_per_field(path: Path) -> None:
+    """Rewrite the XDMF file ``path`` made by :func:`one_time_series` into DOLFINx's layout
+    (a mesh grid, then one temporal collection per field), to which DOLFINx can append.
+    A file in that form already is left as it is."""
+    domain = ET.parse(path).getroot().find("Domain")
+    if domain.find("Grid[@GridType='Uniform']") is not None:
+        return
+    steps = domain.find("Grid").findall("Grid")
+    mesh = ET.Element("Grid", Name="mesh", GridType="Uniform")
+    mesh.extend(steps[0].findall("Topology") + steps[0].findall("Geometry"))
+    grids, series = [mesh], {}
+    for step in steps:
+        time = step.find("Time").get("Value")
+        for attribute in step.findall("Attribute"):
+            name = attribute.get("Name")
+            if name not in series:
+                series[name] = ET.Element(
+                    "Grid", Name=name, GridType="Collection", CollectionType="Temporal"
+                )
+                grids.append(series[name])
+            grid = ET.SubElement(series[name], "Grid", Name=name, GridType="Uniform")
+            ET.SubElement(grid, f"{{{XINCLUDE}}}include", xpointer=DOLFINX_POINTER)
+            ET.SubElement(grid, "Time", Value=time)
+            grid.append(attribute)
+    _write(path, grids)
+
+
+def _write(path: Path, grids: list[ET.Element]) -> None:
+    """Write an XDMF file whose domain holds ``grids``."""
+    ET.register_namespace("xi", XINCLUDE)
+    root = ET.Element("Xdmf", Version="3.0")
+    ET.SubElement(root, "Domain").extend(grids)
+    ET.indent(root)
+    text = ET.tostring(root, encoding="unicode")
+    Path(path).write_text('<?xml version="1.0"?>\n' + text + "\n")
 
 
 def _von_mises(u, material):

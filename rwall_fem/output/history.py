@@ -48,6 +48,7 @@ class History:
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
+            parts=sim.internal.energy_parts,
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -57,7 +58,7 @@ class History:
         self._written_at = time.monotonic()
         self._sums = _Sums(
             comm,
-            {name: () for name in self.balance.stored}
+            {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "terminate": ()}
             | self.wall_table.sums,
         )
@@ -84,7 +85,9 @@ class History:
         self.wall_table.fill(local)
         total = self._sums.reduce()
 
-        energies = {name: float(total[name]) for name in self.balance.stored}
+        energies = {
+            name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)
+        }
         for w in sim.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic = 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity
@@ -99,6 +102,37 @@ class History:
         self.guards.check(
             s, self.balance.error, finite=self._sums.finite(), terminate=bool(total["terminate"])
         )
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The energy balance, the wall table, the momentum of the start and how many rows
+        ``energy.csv`` and ``walls.csv`` have; both files are flushed first, so that they
+        hold those rows when the checkpoint exists."""
+        self._flush()
+        rows = [len(self._energy_csv.rows), len(self._walls_csv.rows)]
+        arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
+        arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
+        return arrays | {f"walls_{k}": v for k, v in self.wall_table.checkpoint_state().items()}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Also reads back the rows of ``energy.csv`` and ``walls.csv`` up to the checkpoint
+        and drops those after it; ValueError if the files do not hold them, or if the
+        energy row of the checkpoint's step is not the one in the file."""
+        self.initial_momentum = arrays["initial_momentum"].copy()
+        self.balance.restore_state(
+            {k.removeprefix("balance_"): v for k, v in arrays.items() if k.startswith("balance_")}
+        )
+        self.wall_table.restore_state(
+            {k.removeprefix("walls_"): v for k, v in arrays.items() if k.startswith("walls_")}
+        )
+        energy_rows, wall_rows = arrays["rows"].tolist()
+        self._energy_csv.resume(energy_rows)
+        self._walls_csv.resume(wall_rows)
+        latest = self._energy_csv.rows[-1] if energy_rows else ()
+        if list(latest) != arrays["balance_latest"].tolist():
+            raise ValueError(
+                f"{self._energy_csv.path}: row {energy_rows} is not the checkpoint's (the file "
+                "was changed, or is another run's)"
+            )
 
     def _flush(self) -> None:
         self._written_at = time.monotonic()

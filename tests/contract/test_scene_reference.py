@@ -39,7 +39,8 @@ def test_the_package_holds_the_json_schema():
 def test_every_key_carries_a_doc_and_numbers_a_unit():
     dimensionless = {
         "dt_scale", "max_energy_error", "poisson", "hourglass_coefficient", "axis", "friction",
-        "coefficient", "steps",
+        "coefficient", "steps", "hardening_exponent", "strain_rate_coefficient",
+        "softening_exponent", "taylor_quinney",
     }  # fmt: skip
     for where, _, cls in tables():
         assert cls.__table__.doc, where
