@@ -372,6 +372,7 @@ class ElementForce:
         if self.plastic:
             self.history[...] = arrays["history"]
 
+
 # Node permutations that turn a cell inside out: a mirror of its reference cell.
 _MIRROR = {4: [0, 2, 1, 3], 8: [1, 0, 3, 2, 5, 4, 7, 6]}
 
