@@ -68,6 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     from mpi4py import MPI
 
     from rwall_fem.checkpoint import CheckpointError
+    from rwall_fem.kernels import KernelBuildError
     from rwall_fem.output import OutputError
     from rwall_fem.scene import SceneError
 
@@ -86,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "check":
             return _check(args.scene, args.overrides, comm)
         summary = _run(args.scene, args.out, args.overrides, comm, quiet, args.resume)
-    except (SceneError, CheckpointError) as err:
+    except (SceneError, CheckpointError, KernelBuildError) as err:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
