@@ -86,8 +86,8 @@ BEYOND = {
     "32_boundary_unknown_group",
     "44_refine_point_far_from_the_body",
     "45_noise_amplitude_not_small",
-    "73_hardening_curve_decreasing_strain",
-    "77_melting_below_room",
+    "56_hardening_curve_decreasing_strain",
+    "60_melting_below_room",
 }
 
 
