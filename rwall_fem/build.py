@@ -118,8 +118,9 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
     else:  # keep the caller's comm: a DOLFINx 0.5 mesh's comm dies with the mesh
         try:
             body = body_mesh(comm, spec)
-        except ValueError as err:  # e.g. a file with mixed cell types
-            raise SceneError(f"{scene.source}: mesh: {err}") from None
+        except ValueError as err:  # a file gmsh cannot read, mixed cell types, ...
+            where = "mesh.file" if spec.file is not None else "mesh"
+            raise SceneError(f"{scene.source}: {where}: {err}") from None
     if spec is not None and spec.noise is not None:
         perturb(body, *spec.noise)
     cell = body.msh.topology.cell_type.name

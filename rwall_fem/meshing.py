@@ -203,7 +203,12 @@ def rotation_to(axis) -> np.ndarray:
 
 
 def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = None) -> BodyMesh:
-    """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``."""
+    """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``.
+
+    Rank 0 runs gmsh alone; whatever goes wrong there (a syntax error, a file that is not
+    a mesh, no cells, mixed cell types) reaches every rank as the same ``ValueError`` of
+    one line, before any collective call that the others would wait in for ever.
+    """
     import gmsh
 
     groups, error = None, None
@@ -211,30 +216,14 @@ def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = 
         argv = [""]
         for name, value in (parameters or {}).items():
             argv += ["-setnumber", name, repr(float(value))]
-        gmsh.initialize(argv)
-        gmsh.option.setNumber("General.Terminal", 0)
-        # ONELAB keeps DefineConstant values across sessions in a process: start afresh, so
-        # that a parameter not given takes its default in the .geo, not the last file's value.
-        gmsh.onelab.clear()
-        gmsh.open(str(path))
-        if len(gmsh.model.mesh.getElements(3)[0]) == 0:
-            gmsh.model.mesh.generate(3)
-        groups = {
-            gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
-            for dim, tag in gmsh.model.getPhysicalGroups()
-            if dim == 2
-        }
-        if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
-            # DOLFINx reads only cells that belong to a physical group.
-            gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
-        kinds = [
-            gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)
-        ]
-        if len(kinds) > 1:
-            error = (
-                f"{path.name}: mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
-                " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
-            )
+        gmsh.initialize(argv, readConfigFiles=False)
+        try:
+            groups = _gmsh_model(Path(path))
+        except _GmshError as err:
+            error = f"{Path(path).name}: {err}"
+        except Exception as err:  # gmsh raises plain Exceptions, naming the file
+            error = " ".join(str(err).replace(f"'{path}', ", "").split())
+            error = f"{Path(path).name}: gmsh cannot read it: {error}"
     groups, error = comm.bcast((groups, error), root=0)
     if error:
         if comm.rank == 0:
@@ -246,6 +235,44 @@ def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = 
         if comm.rank == 0:
             gmsh.finalize()
     return BodyMesh(msh, facet_tags, groups)
+
+
+class _GmshError(Exception):
+    """What is wrong with the model gmsh read, in one line."""
+
+
+def _gmsh_model(path: Path) -> dict[str, int]:
+    """Open ``path`` in the current gmsh session, mesh it in 3-D if it holds no volume
+    cells, and return its named surface groups; raises on anything DOLFINx cannot take."""
+    import gmsh
+
+    gmsh.option.setNumber("General.Terminal", 0)
+    # Never ask "Do you really want to continue?" on stdin (tiny sizes): the size guards
+    # of rwall_fem.estimate refuse such scenes before they get here.
+    gmsh.option.setNumber("General.ExpertMode", 1)
+    # ONELAB keeps DefineConstant values across sessions in a process: start afresh, so
+    # that a parameter not given takes its default in the .geo, not the last file's value.
+    gmsh.onelab.clear()
+    gmsh.open(str(path))
+    if len(gmsh.model.mesh.getElements(3)[0]) == 0:
+        gmsh.model.mesh.generate(3)
+    if not any(len(gmsh.model.mesh.getElements(dim)[0]) for dim in (2, 3)):
+        raise _GmshError("no cells: the file holds no mesh, and no geometry to mesh")
+    groups = {
+        gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
+        for dim, tag in gmsh.model.getPhysicalGroups()
+        if dim == 2
+    }
+    if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
+        # DOLFINx reads only cells that belong to a physical group.
+        gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
+    kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)]
+    if len(kinds) > 1:
+        raise _GmshError(
+            f"mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
+            " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
+        )
+    return groups
 
 
 def boundary_nodes(V) -> np.ndarray:
