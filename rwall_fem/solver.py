@@ -173,7 +173,8 @@ class Simulation:
     update: CentralDifference | None = None  # built from the state when not given
     wall_seconds: float = 0.0  # of the time loop, on this rank
     status: str = "not run"  # "done", "stopped: <reason>" or "failed: <error>"
-    terminate_requested: bool = False  # set by SIGTERM; acted on at the next history sample
+    # Names of the stop signals received ("SIGTERM", "SIGINT"); the history acts on them.
+    stop_requests: set[str] = field(default_factory=set)
 
     def __post_init__(self):
         if self.update is None:
@@ -197,18 +198,24 @@ class Simulation:
         """Advance from t = 0 to ``end_time`` (s), then close every recorder.
 
         Returns ``self.status``: "done", or "stopped: ..." when a guard (see
-        :mod:`rwall_fem.output.guards`) or SIGTERM stopped the run; the outputs up to
-        the last sample stay valid. Any other error propagates after every recorder
-        was closed; a recorder that fails to close does not keep the others from
-        closing, and never hides an error raised before it (it is noted on it).
+        :mod:`rwall_fem.output.guards`), SIGTERM or SIGINT (Ctrl-C) stopped the run; the
+        outputs up to the last sample stay valid. Any other error propagates after every
+        recorder was closed; a recorder that fails to close does not keep the others from
+        closing, and never hides an error raised before it (it is noted on it). A
+        simulation runs once: build another to run again.
         """
+        if self.status != "not run":
+            raise RuntimeError(
+                f"Simulation.run: this simulation has already run ({self.status.partition(':')[0]}"
+                "); build a new one (build_simulation) to run the scene again"
+            )
         s, last, update, history = self.state, self.num_steps, self.update, self.history
         forces, constraints = [self.internal, *self.forces], self.constraints
         with contextlib.ExitStack() as closing:
             outputs = [history, *self.recorders] if history is not None else self.recorders
             for recorder in reversed(outputs):  # closed in the order of the list
                 closing.push(_closer(recorder, self))
-            closing.enter_context(_sigterm_requests(self))
+            closing.enter_context(_stop_signals(self))
             started = time.perf_counter()
             try:
                 for step in range(last + 1):
@@ -252,19 +259,21 @@ def _closer(recorder: Recorder, sim: Simulation):
 
 
 @contextlib.contextmanager
-def _sigterm_requests(sim: Simulation):
-    """While the loop runs, SIGTERM only sets ``sim.terminate_requested``: the history's
-    guard stops the run at its next sample, on every rank at the same step. Signals can
-    be handled in the main thread only; elsewhere SIGTERM keeps its handler."""
+def _stop_signals(sim: Simulation):
+    """While the loop runs, SIGTERM and SIGINT (Ctrl-C) only add their name to
+    ``sim.stop_requests``: the history stops the run within a fraction of a second, on
+    every rank at the same step. Signals can be handled in the main thread only;
+    elsewhere they keep their handlers."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def request(signum, frame):
-        sim.terminate_requested = True
+        sim.stop_requests.add(signal.Signals(signum).name)
 
-    previous = signal.signal(signal.SIGTERM, request)
+    previous = {n: signal.signal(n, request) for n in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)

@@ -1,7 +1,10 @@
-"""CSV files that a killed run leaves readable: rows are written in whole lines.
+"""CSV files that stream to disk and that a killed run leaves readable.
 
-Every rank keeps the rows in memory (they are the same on every rank: sums over
-ranks); rank 0 appends the rows not yet written when the table is flushed.
+Rank 0 turns each row into its line as it comes and keeps at most ``PENDING_LINES``
+lines (or what :meth:`CsvTable.flush` has not yet written): memory stays flat
+however long the run. The pending lines go to the file in one write followed by a
+flush, so the file only ever holds whole lines. Other ranks keep nothing (the rows
+are sums over ranks, the same everywhere).
 """
 
 from __future__ import annotations
@@ -9,7 +12,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["CsvTable"]
+import numpy as np
+
+__all__ = ["PENDING_LINES", "CsvTable"]
+
+PENDING_LINES = 1000  # lines kept before they are written, whatever the time since the last
 
 
 class CsvTable:
@@ -17,28 +24,50 @@ class CsvTable:
 
     def __init__(self, path: Path, columns: Sequence[str], comm):
         self.path, self.columns, self.comm = Path(path), list(columns), comm
-        self.rows: list[tuple] = []
-        self._written = 0  # rows already in the file
+        self.count = 0  # rows so far
+        self._pending: list[str] = []
         self._file = None
+        self._closed = False
+
+    def append(self, row: Sequence) -> None:
+        """Add a row (numbers); it is written at the next :meth:`flush`, or now when
+        ``PENDING_LINES`` lines are waiting."""
+        self.count += 1
+        if self.comm.rank != 0:
+            return
+        self._pending.append(_line(row))
+        if len(self._pending) >= PENDING_LINES:
+            self.flush()
 
     def flush(self) -> None:
-        """Append the rows not yet written as whole lines and flush the file (rank 0); the
-        first flush creates the directory and the file with its header."""
-        if self.comm.rank != 0:
+        """Write the pending lines and flush the file (rank 0); the first flush creates the
+        directory and the file with its header."""
+        if self.comm.rank != 0 or self._closed:
             return
         if self._file is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._file = open(self.path, "w")
             self._file.write(",".join(self.columns) + "\n")
-        start, self._written = self._written, len(self.rows)
-        self._file.write("".join(_line(r) for r in self.rows[start:]))
+        self._file.write("".join(self._pending))
         self._file.flush()
+        self._pending.clear()
 
     def close(self) -> None:
         """Write what is left and close the file."""
         self.flush()
         if self._file is not None:
             self._file.close()
+        self._closed = True
+
+    def read(self) -> np.ndarray:
+        """Every row written so far, as an array (rows, columns), on every rank: rank 0
+        flushes and reads the file, the others receive it (collective)."""
+        rows = None
+        if self.comm.rank == 0:
+            self.flush()
+            rows = np.loadtxt(self.path, delimiter=",", skiprows=1, ndmin=2)
+            rows = rows.reshape(-1, len(self.columns))
+        return self.comm.bcast(rows, root=0)
 
 
 def _line(row) -> str:

@@ -17,6 +17,10 @@ from mpi4py import MPI
 from rwall_fem import build_simulation, parse_scene
 from rwall_fem.output.wall_table import WALL_COLUMNS
 
+# time, kinetic, internal, hourglass, external and wall work, balance error, total energy,
+# error in %, dt (the default element is a one-point hexahedron with hourglass control)
+ENERGY_COLUMNS = 10
+
 
 def complete_rows(path: Path, columns: int) -> list[list[float]]:
     """Every line of a CSV file, each checked to be complete and numeric."""
@@ -37,7 +41,7 @@ def test_nan_in_the_state_stops_the_run_and_names_the_node(shared_dir):
     if MPI.COMM_WORLD.rank == 0:
         summary = json.loads((Path(shared_dir) / "summary.json").read_text())
         assert summary["status"] == "stopped" and "NaN" in summary["reason"]
-        complete_rows(Path(shared_dir) / "energy.csv", 7)
+        complete_rows(Path(shared_dir) / "energy.csv", ENERGY_COLUMNS)
 
 
 def test_energy_error_guard(shared_dir):
@@ -91,7 +95,7 @@ def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     assert "terminated by SIGTERM" in stderr and len(stderr.strip().splitlines()) == 1
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "stopped" and "SIGTERM" in summary["reason"]
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", ENERGY_COLUMNS)
     assert summary["energy"]["kinetic"] == rows[-1][1]
     complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
 
@@ -101,7 +105,7 @@ def test_sigkill_leaves_complete_csv_lines(tmp_path):
     process = _start_long_run(tmp_path)
     process.kill()
     process.communicate(timeout=60)
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", ENERGY_COLUMNS)
     assert len(rows) > 100
     assert not (tmp_path / "out" / "summary.json").exists()
 
@@ -146,4 +150,4 @@ def test_pictures_that_fail_to_render_leave_the_other_outputs(shared_dir, monkey
                        "no display"]  # fmt: skip
         summary = json.loads((out / "run" / "summary.json").read_text())
         assert summary["status"] == "done"
-        complete_rows(out / "run" / "energy.csv", 7)
+        complete_rows(out / "run" / "energy.csv", ENERGY_COLUMNS)

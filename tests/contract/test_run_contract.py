@@ -37,9 +37,16 @@ def test_outputs_of_a_run(shared_dir):
             "mass",
             "initial_momentum",
             "final_momentum",
+            "version",
+            "git_hash",
+            "planned_steps",
+            "time",
+            "warnings",
         ):
             assert key in summary
         assert summary["ranks"] == MPI.COMM_WORLD.size
+        assert summary["steps"] == summary["planned_steps"] == sim.num_steps
+        assert summary["warnings"] == []
         assert set(summary["energy"]) == {
             "initial",
             "kinetic",
@@ -57,7 +64,14 @@ def test_outputs_of_a_run(shared_dir):
             "external_work",
             "wall_work",
             "balance_error",
+            "total_energy",
+            "energy_error_percent",
+            "dt",
         ]
+        for row in rows:  # GLSTAT's total energy, Radioss's energy error %, the step's dt
+            assert float(row["total_energy"]) == float(row["kinetic"]) + float(row["internal"])
+            assert float(row["energy_error_percent"]) == 100 * float(row["balance_error"])
+            assert float(row["dt"]) == sim.state.dt
         # every 5th step and the last one
         assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
         walls = list(csv.DictReader(open(out / "walls.csv")))
