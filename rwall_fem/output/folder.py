@@ -47,6 +47,7 @@ def check_folder(directory: Path, what: str, comm) -> None:
 
 def _unusable(directory: Path) -> str | None:
     """Why ``directory`` cannot hold results, or None."""
+    directory = directory.absolute()
     existing = directory
     while not existing.exists() and existing != existing.parent:
         if existing.is_symlink():  # a dangling link

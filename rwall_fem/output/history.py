@@ -88,6 +88,8 @@ class History:
         """Sample step ``s.step`` after its update: the kinetic energy K^n is the update's,
         the works are booked up to step n. Between samples, only agree on stop signals;
         the step becomes a sample if any rank received one."""
+        if time.monotonic() - self._written_at > FLUSH_SECONDS:
+            self._flush()
         if s.step not in self.steps and not self._stop_requested(sim, s):
             return
         local = self._sums.local
@@ -117,8 +119,6 @@ class History:
         self._energy_csv.append(self.balance.sample(s.t, energies, s.dt))
         for row in self.wall_table.rows(s, total):
             self._walls_csv.append(row)
-        if time.monotonic() - self._written_at > FLUSH_SECONDS:
-            self._flush()
         signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
         self.guards.check(s, self.balance.error, finite=self._sums.finite(), signals=signals)
 
