@@ -182,6 +182,8 @@ def scene_text(scene) -> str:
             lines.append(header)
         nested = []
         for name, (f, k) in keys_of(cls).items():
+            if not _applies(obj, cls, name, k):
+                continue
             value = getattr(obj, f.name)
             if dataclasses.is_dataclass(value):
                 nested.append((name, value, type(value), False))
@@ -205,6 +207,24 @@ def scene_text(scene) -> str:
 
     table(scene, type(scene), None)
     return "\n".join(lines)
+
+
+def _applies(obj, cls, name: str, k) -> bool:
+    """Whether the key ``name`` (a :class:`~rwall_fem.scene.keys.Key`) belongs to the table
+    ``obj``: a key of its variant (a bar's keys, a plane's), under its ``when``."""
+    variants = cls.__table__.variants
+    if variants is not None and name != variants.on:
+        chosen = getattr(obj, variants.on)
+        if chosen is None and variants.instead is not None:
+            keys = (variants.instead[0], *variants.instead[2])
+        else:
+            keys = (*variants.cases[chosen], *variants.common)
+        if name not in keys:
+            return False
+    return all(
+        getattr(obj, sibling) is None or getattr(obj, sibling) in allowed
+        for sibling, allowed in k.when.items()
+    )
 
 
 def _as_table(cls, value: tuple) -> dict:
