@@ -133,9 +133,9 @@ def build_simulation(
         refuse_above_limits(scene, estimate(scene, comm.size))
     solid = _solid(scene, comm, body, scene.run.max_cells if limits else None)
     dt = _time_step(scene, solid)
-    if limits:
-        steps_above_limit(scene, math.ceil(scene.run.end_time / dt - 1e-9), dt)
     sim = _pipeline(scene, solid, dt)
+    if limits:
+        steps_above_limit(scene, sim.num_steps, dt)
     facts = [
         _mesh_fact(solid, dt),
         f"effects: {', '.join(sim.effects)}; {sim.num_steps} steps to t = "

@@ -89,9 +89,9 @@ def main(argv: list[str] | None = None) -> int:
     except (OutputError, OSError) as err:
         print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
         return 4
-    except KeyboardInterrupt:  # Ctrl-C before the time loop (it stops cleanly in it)
+    except KeyboardInterrupt:  # Ctrl-C outside the time loop (in it, the run stops cleanly)
         if comm.rank == 0:
-            print("rwall-fem: stopped: interrupted before the run started", file=sys.stderr)
+            print("rwall-fem: stopped: interrupted (SIGINT, Ctrl-C)", file=sys.stderr)
         return 3
     except Exception:
         if comm.size == 1:
@@ -125,7 +125,8 @@ def _set_up_logging(quiet: bool, rank: int) -> None:
     log.addHandler(facts)
     log.addHandler(warnings)
     log.propagate = False
-    log.setLevel(logging.CRITICAL + 1 if rank else logging.WARNING if quiet else logging.INFO)
+    level = logging.WARNING if quiet else logging.INFO
+    log.setLevel(level if rank == 0 else logging.CRITICAL + 1)  # only rank 0 speaks
 
 
 class _Console(logging.StreamHandler):

@@ -104,7 +104,7 @@ class History:
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
         # Sent with the sums, so that every rank stops at the same step when any got a signal.
-        self._fill_agreement(local, sim, s)
+        self._fill_agreement(local, sim)
         self.wall_table.fill(local)
         total = self._sums.reduce()
         self._plan_next_poll(s, total)
@@ -122,7 +122,7 @@ class History:
         signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
         self.guards.check(s, self.balance.error, finite=self._sums.finite(), signals=signals)
 
-    def _fill_agreement(self, local: dict, sim, s) -> None:
+    def _fill_agreement(self, local: dict, sim) -> None:
         """This rank's stop signals and its wall time since the latest agreement (s)."""
         local["signals"][:] = [name in sim.stop_requests for name in SIGNALS]
         local["seconds"][...] = time.perf_counter() - self._last[1]
@@ -138,7 +138,7 @@ class History:
 
     def _stop_requested(self, sim, s) -> bool:
         """Agree with the other ranks on whether any received a stop signal (collective)."""
-        self._fill_agreement(self._poll.local, sim, s)
+        self._fill_agreement(self._poll.local, sim)
         total = self._poll.reduce()
         self._plan_next_poll(s, total)
         return bool(total["signals"].any())

@@ -427,7 +427,11 @@ class Gravity:
 # --- [[boundary]] ----------------------------------------------------------------
 
 
-@table("A prescribed velocity (zero: a clamp) of some components of a named node set.")
+@table(
+    "A prescribed velocity (zero: a clamp) of some components of a named node set. On a node"
+    " also secondary to a wall it wins on those components (it acts after the walls; the run"
+    " warns)."
+)
 @dataclass(frozen=True)
 class BoundarySpec:
     group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
