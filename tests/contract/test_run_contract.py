@@ -85,6 +85,7 @@ def test_outputs_of_a_run(shared_dir):
         if importlib.util.find_spec("imageio_ffmpeg"):  # `make test` installs it (extra mp4)
             assert (out / "animation.mp4").stat().st_size > 0
         assert (out / "histories.png").stat().st_size > 0
+        assert "rendering 3 frames after the time loop" in (out / "run.log").read_text()
         xdmf = (out / "fields.xdmf").read_text()
         for name in ("displacement", "velocity", "von_mises_stress"):
             assert xdmf.count(f'<Attribute Name="{name}"') == 2  # two snapshots of each

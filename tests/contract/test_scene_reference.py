@@ -84,6 +84,22 @@ BEYOND = {
     "32_boundary_unknown_group",
     "44_refine_point_far_from_the_body",
     "45_noise_amplitude_not_small",
+    # What only the mesh file, the size estimates or the file system can tell.
+    "53_mesh_file_geo_syntax_error",
+    "54_mesh_file_garbage",
+    "55_mesh_file_empty",
+    "56_density_1e-300",
+    "57_output_directory_is_a_file",
+    "58_output_directory_unwritable",
+    "59_element_size_1e-7",
+    "60_cube_at_1_mm",
+    "61_plate_layers_100000",
+    "62_refine_size_1e-9",
+    "63_end_time_1e9",
+    "64_frames_1e8",
+    "65_wall_secondary_all_excluded",
+    "66_mesh_file_noise_not_small",
+    "67_mesh_file_above_max_cells",
 }
 
 
