@@ -1,14 +1,18 @@
 # rwall_fem: set-up and test driver (Debian 12, run as root or with sudo).
 #
-#   make test                  run the pytest suite on every DOLFINx leg, serially and on NP ranks
+#   make test                  run the pytest suite on every DOLFINx leg, serially and on NP ranks,
+#                              and (on the Debian leg) build the documentation (`make docs`)
 #   make test DOLFINX=0.5      only the Debian leg:  DOLFINx 0.5 (apt) + Open MPI, venv .venv
 #   make test DOLFINX=0.11     only the PyPI leg:    dolfinx-solver-real 0.11 + MPICH, venv .venv-0.11
 #   make venv                  set-up only (honours DOLFINX too)
 #   make demo                  run demos/bar_impact.toml on the Debian leg into results/bar_impact
 #   make demos                 run every demo (scenes and Python scripts) into results/
+#   make docs                  the documentation site (Sphinx + MyST) into docs/_build/html,
+#                              warnings as errors; on the Debian leg, a few seconds, runs no demo
 #   make study / make bench    accuracy vs wall time (results/study, copied to docs/); throughput
 #                              benchmark (bench/results.md); both on the Debian leg, long runs
-#   make clean                 remove both venvs, test logs and Python caches (results/ is kept)
+#   make clean                 remove both venvs, test logs, Python caches and the built docs
+#                              (results/ is kept)
 #   make clean-wheels          remove the wheelhouses (see below; the next set-up refills them)
 #
 # Set-up is incremental: apt runs only when a package is missing (one dpkg-query otherwise),
@@ -103,7 +107,7 @@ ifneq ($(filter 0.11,$(LEGS)),)
   endif
 endif
 
-.PHONY: test venv demo demos study bench clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
+.PHONY: test venv demo demos docs study bench clean clean-wheels apt-0.5 apt-0.11 venv-0.5 venv-0.11 FORCE \
         test-0.5 test-0.5-serial test-0.5-mpi test-0.11 test-0.11-serial test-0.11-mpi
 
 test: $(addprefix test-,$(LEGS))
@@ -125,15 +129,18 @@ $(VENV)/pyvenv.cfg: | apt-0.5
 	$(SYS_PYTHON) -m venv --system-site-packages $(VENV)
 
 # numpy is pinned to Debian's: a newer numpy from PyPI breaks Debian's petsc4py (ABI).
+# The docs extra (Sphinx, MyST) goes here too: `make docs` builds on this leg.
 $(VENV)/.installed: pyproject.toml $(VENV)/pyvenv.cfg | apt-0.5
-	@echo ">>> pip install -e '.[test,mp4]' into $(VENV)"
+	@echo ">>> pip install -e '.[test,mp4,docs]' into $(VENV)"
 	echo "numpy==$$($(SYS_PYTHON) -c 'import numpy; print(numpy.__version__)')" > $(VENV)/constraints.txt
-	$(call PIP_INSTALL,0.5,$(VENV)) -c $(VENV)/constraints.txt -e '.[test,mp4]'
+	$(call PIP_INSTALL,0.5,$(VENV)) -c $(VENV)/constraints.txt -e '.[test,mp4,docs]'
 	touch $@
 
 venv-0.5: $(VENV)/.installed
 
-test-0.5: test-0.5-serial test-0.5-mpi
+# The docs build first: a quick failure (a warning, a broken link to a page) shows early,
+# and --keep-going still runs the test suite after it.
+test-0.5: docs test-0.5-serial test-0.5-mpi
 
 test-0.5-serial: venv-0.5
 	@echo "===== DOLFINx 0.5 (Debian): pytest, serial ====="
@@ -197,6 +204,16 @@ demos: venv-0.5
 	done
 	for script in demos/demo_*.py; do $(RUN_ENV) $(VENV)/bin/python $$script; done
 
+# The documentation (docs/index.md is its front page): Sphinx with MyST, the Python API by autodoc (so on the
+# Debian leg, where DOLFINx imports).  -W: a warning fails the build.  -E: a fresh environment
+# each time, so that a page read by an earlier build cannot hide its warnings from this one.
+# The demos are not run: the tutorial pages show the committed pictures of docs/gallery/.
+DOCS_OUT     := docs/_build/html
+docs: venv-0.5
+	@echo "===== documentation: sphinx-build -W into $(DOCS_OUT) ====="
+	$(RUN_ENV) $(VENV)/bin/python -m sphinx -W --keep-going -E -q -b html docs $(DOCS_OUT)
+	@echo "    open $(DOCS_OUT)/index.html"
+
 # The full study takes 10-20 minutes; its table and plots are copied into docs/ for the README.
 study: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/rwall-fem study --out results/study
@@ -210,7 +227,7 @@ bench: venv-0.5
 	    $(VENV)/bin/python bench/bench.py --out bench/results.md
 
 clean:
-	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info
+	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials
 	find . -path ./.git -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
 
 # The wheelhouses live outside the clone and are shared by all clones: not part of `clean`.

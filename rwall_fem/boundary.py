@@ -38,6 +38,16 @@ class VelocityBoundary:
         self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
         self._reaction = None  # the latest step's reaction (N s), for its v^{n+1/2} half
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The reaction impulse and work so far, and the latest step's reaction (N s)."""
+        reaction = self._reaction if self._reaction is not None else np.zeros((0, len(self.axes)))
+        return {"impulse": self.impulse, "work": np.array(self.work), "reaction": reaction}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.impulse[:] = arrays["impulse"]
+        self.work = float(arrays["work"])
+        self._reaction = arrays["reaction"] if len(arrays["reaction"]) else None
+
     def constrain(self, state) -> None:
         """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n + dt/2)."""
         rows, cols = self.nodes[:, None], self.axes[None, :]

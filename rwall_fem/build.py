@@ -5,7 +5,8 @@ limits of :mod:`rwall_fem.estimate`) -> body (mesh, space, lumped mass, element
 technology) -> stable time step -> pipeline (internal force, body forces, walls, boundary
 conditions: only what the scene asks for) -> what the starter of Radioss would warn
 about (nodes starting behind a wall, walls without nodes, nodes both clamped and held by
-a wall) -> recorders (history, run log, stable-step monitor, fields, frames).
+a wall) -> recorders (history, run log, stable-step monitor, fields, frames) and the
+checkpoints.
 
 Every check that can fail on one rank alone (gmsh runs on rank 0; the results folder is
 checked there) is agreed on by all ranks, so a refusal is the same everywhere.
@@ -25,6 +26,7 @@ from mpi4py import MPI
 
 from rwall_fem import __version__, _compat
 from rwall_fem.boundary import VelocityBoundary
+from rwall_fem.checkpoint import Checkpoints, body_digest, scene_keys
 from rwall_fem.effects import Gravity
 from rwall_fem.elements import ElementForce, GhostedField, Technology
 from rwall_fem.estimate import (
@@ -76,24 +78,31 @@ def run_scene(
     comm: MPI.Comm = MPI.COMM_WORLD,
     *,
     limits: bool = True,
+    resume: bool = False,
 ) -> dict:
     """Build and run a scene (object or TOML path) in its results folder, held for the run
     (:class:`~rwall_fem.output.folder.ResultsFolder`); returns the summary written to
-    ``out``. ``limits=False`` lifts the size limits (``run.max_*``)."""
+    ``out``. ``limits=False`` lifts the size limits (``run.max_*``); with ``resume``, the
+    run continues from the checkpoint in ``out`` (:mod:`rwall_fem.checkpoint`)."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene, list(overrides))
     sim = build_simulation(scene, comm, out, limits=limits)
-    run_in_folder(sim)
+    run_in_folder(sim, resume=resume)
     return sim.history.summary
 
 
-def run_in_folder(sim: Simulation, said: Callable[[Simulation], None] | None = None) -> None:
+def run_in_folder(
+    sim: Simulation, said: Callable[[Simulation], None] | None = None, *, resume: bool = False
+) -> None:
     """Run ``sim`` while holding its results folder (a
-    :class:`~rwall_fem.output.folder.ResultsFolder`: locked, outputs of an earlier run
-    removed, as ``run.log`` says); ``said(sim)`` reports how it ended before the last
-    outputs are awaited, and ``run.log`` ends with the time the outputs took."""
+    :class:`~rwall_fem.output.folder.ResultsFolder`: locked, and for a fresh run the
+    outputs of an earlier run removed, as ``run.log`` says; with ``resume``, continued from
+    its checkpoint instead); ``said(sim)`` reports how it ended before the last outputs
+    are awaited, and ``run.log`` ends with the time the outputs took."""
     run_log = next(r for r in sim.recorders if isinstance(r, RunLog))
-    with ResultsFolder(sim.history.directory, sim.comm) as folder:
+    with ResultsFolder(sim.history.directory, sim.comm, fresh=not resume) as folder:
+        if resume:
+            sim.checkpoints.resume(sim)
         if folder.removed:
             run_log.facts.append(
                 f"removed the outputs of an earlier run: {', '.join(folder.removed)}"
@@ -149,6 +158,19 @@ def build_simulation(
     sim.info["warnings"] = warnings
     facts += [*_constraint_facts(sim), *(f"warning: {w}" for w in warnings)]
     _add_recorders(sim, scene, solid, directory, facts)
+    identity = {
+        "code": __version__,
+        "dolfinx": _compat.DOLFINX_VERSION,
+        "scene": scene_keys(scene),
+        "body": body_digest(sim.state),
+    }
+    sim.checkpoints = Checkpoints(
+        directory / "checkpoint",
+        sim.comm,
+        identity,
+        steps=scene.output.checkpoint_steps,
+        seconds=scene.output.checkpoint_seconds,
+    )
     return sim
 
 
@@ -206,7 +228,11 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
     element = scene.element
     try:
         technology = Technology.choose(
-            cell, element.integration, element.hourglass, element.hourglass_coefficient
+            cell,
+            element.integration,
+            element.hourglass,
+            element.hourglass_coefficient,
+            plastic=scene.material.plastic,
         )
     except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
         raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
@@ -341,10 +367,15 @@ def _add_recorders(
         frames=scene.output.frames,
     )  # fmt: skip
     sim.recorders.append(run_log)
-    if scene.material.model != "linear_elastic":
-        from rwall_fem.hyperelasticity import StableStepMonitor
+    if scene.material.plastic:
+        from rwall_fem.stable_step import ElementStepMonitor
 
-        monitor = StableStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
+        monitor = ElementStepMonitor(solid.V, solid.u, sim.internal, solid.dt_stable, sim.comm)
+        sim.recorders.append(monitor)
+    elif scene.material.model != "linear_elastic":
+        from rwall_fem.stable_step import TangentStepMonitor
+
+        monitor = TangentStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
         sim.recorders.append(monitor)
     if scene.output.fields:
         from rwall_fem.output.fields import Fields

@@ -1,14 +1,16 @@
 """Command line.
 
-- ``rwall-fem run SCENE [--out DIR] [--set key=value ...] [--quiet]``: run a scene;
+- ``rwall-fem run SCENE [--out DIR] [--set key=value ...] [--quiet] [--resume]``: run a
+  scene, or with ``--resume`` continue the run whose checkpoint is in DIR;
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
 - ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
-Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank), 3 run
-stopped by a guard, SIGTERM or SIGINT (Ctrl-C) (one line on stderr; the outputs up to the
-stop are kept), 4 an output could not be written at the end of the run (one line on
-stderr; the others are written).
+Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
+checkpoint that does not fit the scene), 3 run stopped by a guard, SIGTERM or SIGINT
+(Ctrl-C) (one line on stderr; the outputs up to the stop are kept, and a checkpoint of
+the step), 4 an output could not be written at the end of the run (one line on stderr;
+the others are written).
 
 Messages: facts on stdout, warnings and errors on stderr, each line starting with
 ``rwall-fem:``; only rank 0 speaks. ``--quiet`` keeps warnings and errors. While a run
@@ -55,6 +57,11 @@ def main(argv: list[str] | None = None) -> int:
         )
     run.add_argument("--out", help="results directory (default: the scene's output.directory)")
     run.add_argument("--quiet", action="store_true", help="print only warnings and errors")
+    run.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the run whose checkpoint is in the results directory (/RFILE)",
+    )
     render = commands.add_parser("render", help="draw the frames of a results folder again")
     render.add_argument("directory", help="results folder of a run with output.frames > 0")
     render.add_argument("--color", default=COLORS[0], choices=COLORS)
@@ -72,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from mpi4py import MPI
 
+    from rwall_fem.checkpoint import CheckpointError
     from rwall_fem.output import OutputError
     from rwall_fem.scene import SceneError
 
@@ -81,8 +89,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "check":
             return _check(args.scene, args.overrides, comm, args.lift_limits)
-        summary = _run(args.scene, args.out, args.overrides, comm, quiet, args.lift_limits)
-    except SceneError as err:
+        summary = _run(
+            args.scene, args.out, args.overrides, comm, quiet, args.lift_limits, args.resume
+        )
+    except (SceneError, CheckpointError) as err:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
@@ -153,7 +163,7 @@ class _WarningsOnly(logging.Filter):
         return record.levelno >= logging.WARNING
 
 
-def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool) -> dict:
+def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resume: bool) -> dict:
     from rwall_fem.build import build_simulation, run_in_folder
     from rwall_fem.output.run_log import CycleLines, cycle_interval
     from rwall_fem.scene import load_scene
@@ -168,7 +178,7 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool) -> di
         else:
             every = cycle_interval(sim.num_steps, scene.output.print_interval)
             sim.recorders.append(CycleLines(sys.stderr, sim.num_steps, every))
-    run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet))
+    run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet), resume=resume)
     return sim.history.summary
 
 

@@ -24,6 +24,13 @@ class Gravity:
     def accelerate(self, state) -> None:
         state.a += self.g
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The momentum sum m v^{-1/2} of the start (kg m/s), on which its work rests."""
+        return {"initial_momentum": self._initial_momentum}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._initial_momentum[:] = arrays["initial_momentum"]
+
     def work(self, state) -> float:
         """Work of gravity on this rank's nodes up to step n (J), after the update of step n.
 

@@ -12,7 +12,9 @@ C kernels of :mod:`rwall_fem.kernels`. Technologies (the scene's ``[element]``):
   elasticity), ``"stiffness"`` or ``"viscous"`` (Flanagan-Belytschko), or ``"none"``.
 
 Materials: linear elasticity (small strain), Saint Venant-Kirchhoff and
-neo-Hookean (total Lagrangian). The formulas are in ``docs/theory.md``.
+neo-Hookean (total Lagrangian), and J2 elasto-plasticity with isotropic hardening or
+Johnson-Cook (hypoelastic, updated Lagrangian, with a state per integration point).
+The formulas are in ``docs/theory.md``.
 
 MPI: each rank computes its owned cells; displacements (and velocities for the
 viscous hourglass form) of ghost nodes come from their owners with
@@ -29,14 +31,21 @@ import numpy as np
 from dolfinx import fem
 
 from rwall_fem import _compat
-from rwall_fem.kernels import HOURGLASS, MODELS, load
+from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
 
+PLASTIC_MODELS = ("elastic_plastic", "johnson_cook")
+# The flow-stress laws of the kernels (kernels/plasticity.h).
+HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
+
 CELLS = ("tetrahedron", "hexahedron")
-# Default hourglass coefficient of each form: 1 reproduces full integration (physical);
-# LS-DYNA's QM = 0.1 for the Flanagan-Belytschko forms.
+# Default hourglass coefficient of each form: 1 reproduces full integration (physical) for
+# elastic bodies; in plastic flow elastic hourglass stresses would stiffen the element
+# (the Taylor rod at 1.0 ends 4 % short with a 25 % smaller mushroom), hence 0.1 there,
+# LS-DYNA's default QM, also that of the Flanagan-Belytschko forms.
 DEFAULT_COEFFICIENT = {"physical": 1.0, "stiffness": 0.1, "viscous": 0.1, "none": 0.0}
+PLASTIC_COEFFICIENT = 0.1
 
 
 @dataclass(frozen=True)
@@ -50,11 +59,18 @@ class Technology:
 
     @classmethod
     def choose(
-        cls, cell: str, integration=None, hourglass: str = "physical", coefficient=None
+        cls,
+        cell: str,
+        integration=None,
+        hourglass: str = "physical",
+        coefficient=None,
+        *,
+        plastic: bool = False,
     ) -> Technology:
         """The technology for ``cell`` from a scene's ``[element]`` choices: ``integration``
         None means the default of the cell type; ``hourglass`` and ``coefficient`` (None:
-        the form's default) only matter with reduced integration.
+        the default of the form, and of an elasto-plastic body when ``plastic``) only
+        matter with reduced integration.
 
         Raises ValueError (one line, naming the key) for a combination that does not exist.
         """
@@ -72,7 +88,10 @@ class Technology:
         if hourglass not in HOURGLASS:
             raise ValueError(f"element.hourglass: must be one of {HOURGLASS}, got {hourglass!r}")
         if coefficient is None:
-            coefficient = DEFAULT_COEFFICIENT[hourglass]
+            physical = hourglass == "physical"
+            coefficient = (
+                PLASTIC_COEFFICIENT if physical and plastic else DEFAULT_COEFFICIENT[hourglass]
+            )
         return cls(cell, "reduced", hourglass, float(coefficient))
 
     @property
@@ -121,41 +140,87 @@ class GhostedField:
 class ElementForce:
     """Internal force f_int(u) (N) of a body, cell by cell; an effect that *sets* ``state.a``.
 
-    ``u`` (and ``v``, read by the viscous hourglass form) are the body's displacement and
-    velocity fields, shared with the :class:`~rwall_fem.solver.State`. After each
-    :meth:`accelerate`, ``stored_energy`` is the elastic energy (J) of this rank's cells at
-    u^n and ``hourglass_energy`` the hourglass energy: stored (physical and stiffness forms)
-    or dissipated so far (viscous form).
+    ``u`` and ``v`` are the body's displacement and velocity fields, shared with the
+    :class:`~rwall_fem.solver.State` (``v`` is read by the viscous hourglass form and by
+    the elasto-plastic laws, whose strain increment over a step is dt v^{n-1/2}).
+
+    Energies (J, this rank) after each :meth:`accelerate`: ``stored_energy``, the elastic
+    energy at u^n; ``hourglass_energy``, stored (physical and stiffness forms of elastic
+    bodies) or the hourglass work so far (viscous form, elasto-plastic bodies);
+    ``plastic_work``, the plastic dissipation so far. An elasto-plastic body keeps its
+    stress, equivalent plastic strain and temperature per integration point in
+    ``history`` (rows of slots, columns of owned cells).
     """
 
     def __init__(self, V, material, technology: Technology, u: GhostedField, v: GhostedField):
-        if material.model not in MODELS:
-            raise ValueError(f"no element kernel for the material model {material.model!r}")
-        self.name = material.model
+        model = material.model
+        if model not in MODELS and model not in PLASTIC_MODELS:
+            raise ValueError(f"no element kernel for the material model {model!r}")
+        self.name = model
         self.technology = technology
-        self.conservative = technology.conservative
+        self.plastic = model in PLASTIC_MODELS
+        self.conservative = technology.conservative and not self.plastic
         hourglass = technology.integration == "reduced" and technology.hourglass != "none"
         self.energy_names = ("internal", "hourglass") if hourglass else ("internal",)
+        # Parts of the internal energy, reported beside it but not added to the balance.
+        self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
         self.u, self.v = u, v
         self.f = GhostedField(V)
         self.V, self._probe = V, None  # the fields of forces(), made at its first call
         self.ffi, self.lib = ffi, lib = load()
         tdim = V.mesh.topology.dim
         num_cells = V.mesh.topology.index_map(tdim).size_local
-        self.cells = np.ascontiguousarray(_compat.cell_nodes(V)[:num_cells], dtype=np.int32)
         self.X = np.ascontiguousarray(V.tabulate_dof_coordinates(), dtype=np.float64)
+        self.cells = _oriented(np.array(_compat.cell_nodes(V)[:num_cells], dtype=np.int32), self.X)
         self.num_cells = num_cells
         self.params = ffi.new("element_params *")
         lmbda, mu = material.lame
         self.params.lmbda, self.params.mu = lmbda, mu
         self.params.density, self.params.wave_speed = material.density, material.p_wave_speed
         self.params.hourglass_coefficient = technology.hourglass_coefficient
-        self._energy = np.zeros(2)
-        self.hourglass_energy = 0.0
+        self.points = (
+            8 if technology.cell == "hexahedron" and technology.integration == "full" else 1
+        )
+        self.history = None
+        if self.plastic:
+            self._set_plasticity(material)
+        # stored elastic, hourglass, plastic dissipation (J); inverted cells (plastic kernels)
+        self._energy = np.zeros(4)
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy)
         self._inv_mass = None
-        # Without a stored energy (viscous hourglass), the update books the work of f.
+        self._started = False
+        # Without a stored energy, the update books the work of f at mid-step velocities.
         self.booked_force = None if self.conservative else self.f.owned
+
+    def _set_plasticity(self, material) -> None:
+        """The flow-stress law's constants, and the state per integration point: the stress
+        (Pa), the equivalent plastic strain and the temperature (K) of each point, then the
+        hourglass forces (N) of a one-point hexahedron."""
+        p = self.params
+        law = material.hardening if material.model == "elastic_plastic" else "johnson_cook"
+        p.hardening = HARDENING[law]
+        p.yield_stress = material.yield_stress or 0.0
+        p.hardening_modulus = material.hardening_modulus or 0.0
+        p.hardening_coefficient = material.hardening_coefficient or 0.0
+        p.hardening_exponent = material.hardening_exponent or 0.0
+        p.rate_coefficient = material.strain_rate_coefficient
+        p.reference_rate = material.reference_strain_rate
+        if material.hardening_curve is not None:
+            p.table_size = len(material.hardening_curve)
+            for i, (strain, stress) in enumerate(material.hardening_curve):
+                p.table_strain[i], p.table_stress[i] = strain, stress
+        heating = material.heating
+        room = 0.0
+        if heating is not None:
+            p.thermal = 1
+            p.thermal_exponent = heating.softening_exponent
+            p.melting_temperature = heating.melting_temperature
+            p.room_temperature = room = heating.room_temperature
+            p.specific_heat = heating.specific_heat
+            p.taylor_quinney = heating.taylor_quinney
+        slots = self.points * POINT_SLOTS + (12 if self.technology.integration == "reduced" else 0)
+        self.history = np.zeros((slots, self.num_cells))
+        self.history[POINT_SLOTS - 1 : self.points * POINT_SLOTS : POINT_SLOTS] = room
 
     def _bind(self, u: np.ndarray, v: np.ndarray, f: np.ndarray, energy: np.ndarray):
         """The kernel of the technology and material, with its arguments bound."""
@@ -166,10 +231,19 @@ class ElementForce:
 
         common = (self.num_cells, ptr(self.cells, "int32_t *"), ptr(self.X), ptr(u))
         rest = (self.params, ptr(f), ptr(energy))
+        family = "tet4" if t.cell == "tetrahedron" else "hex8"
+        if self.plastic:
+            name = (
+                f"hex8r_plastic_{t.hourglass}"
+                if t.integration == "reduced"
+                else f"{family}_plastic"
+            )
+            state = (ptr(self.history), self.num_cells)
+            return functools.partial(getattr(self.lib, name), *common, ptr(v), self.params, *state,
+                                     ptr(f), ptr(energy))  # fmt: skip
         if t.integration == "reduced":
             kernel = getattr(self.lib, f"hex8r_{model}_{t.hourglass}")
             return functools.partial(kernel, *common, ptr(v), *rest)
-        family = "tet4" if t.cell == "tetrahedron" else "hex8"
         return functools.partial(getattr(self.lib, f"{family}_{model}"), *common, *rest)
 
     @property
@@ -177,30 +251,70 @@ class ElementForce:
         """Elastic energy (J) of this rank's cells at the latest force computation."""
         return float(self._energy[0])
 
+    @property
+    def hourglass_energy(self) -> float:
+        """Hourglass energy (J) of this rank's cells: stored, or the hourglass work so far."""
+        return float(self._energy[1])
+
+    @property
+    def plastic_work(self) -> float:
+        """Plastic dissipation (J) of this rank's cells so far."""
+        return float(self._energy[2])
+
+    @property
+    def inverted_cells(self) -> int:
+        """How many times an owned cell was found inverted (volume <= 0) so far (the
+        elasto-plastic kernels, in the current configuration)."""
+        return int(self._energy[3])
+
     def energies(self, state) -> dict[str, float]:
         """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
-        without a stored energy, the internal work less the hourglass dissipation), and
-        ``"hourglass"`` when the elements have hourglass control."""
+        without a stored energy, the internal work less the hourglass energy), and
+        ``"hourglass"`` when the elements have hourglass control; for an elasto-plastic
+        body also the parts of the internal energy, ``"elastic"`` and ``"plastic_work"``."""
         hourglass = self.hourglass_energy
         internal = self.stored_energy if self.conservative else state.internal_work - hourglass
         energies = {"internal": internal}
         if "hourglass" in self.energy_names:
             energies["hourglass"] = hourglass
+        if self.plastic:
+            energies |= {"elastic": self.stored_energy, "plastic_work": self.plastic_work}
         return energies
+
+    def cell_fields(self, state) -> dict[str, np.ndarray]:
+        """Values per owned cell (means over its integration points) for the outputs: for an
+        elasto-plastic body the equivalent plastic strain ``"plastic_strain"`` and the von
+        Mises stress ``"von_mises_stress"`` (Pa); nothing for an elastic one."""
+        if not self.plastic:
+            return {}
+        points = self.history[: self.points * POINT_SLOTS].reshape(self.points, POINT_SLOTS, -1)
+        s = points[:, :6]
+        pressure = s[:, :3].mean(axis=1, keepdims=True)
+        deviator = s[:, :3] - pressure
+        squares = (deviator**2).sum(axis=1) + 2.0 * (s[:, 3:] ** 2).sum(axis=1)
+        return {
+            "plastic_strain": points[:, 6].mean(axis=0),
+            "von_mises_stress": np.sqrt(1.5 * squares).mean(axis=0),
+        }
+
+    def plastic_strains(self) -> np.ndarray:
+        """The equivalent plastic strain of every integration point of the owned cells."""
+        return self.history[POINT_SLOTS - 2 : self.points * POINT_SLOTS : POINT_SLOTS]
 
     def accelerate(self, state) -> None:
         """Set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
         self.u.scatter_forward()
         if not self.conservative:
             self.v.scatter_forward()
-            self.params.dt = state.dt
+            # The elasto-plastic state is that of u^n: no increment before the first step.
+            self.params.dt = state.dt if self._started or not self.plastic else 0.0
         else:
             self._energy[1] = 0.0
+        self._started = True
         self._energy[0] = 0.0
         self.f.array.fill(0.0)
         self._kernel()
         self.f.scatter_reverse_add()
-        self.hourglass_energy = float(self._energy[1])
         if self._inv_mass is None:
             self._inv_mass = np.ascontiguousarray(state.inv_mass[:, 0])
             self._accelerate = functools.partial(
@@ -216,11 +330,14 @@ class ElementForce:
         """Internal forces (N) on the owned nodes for a displacement ``u`` (owned, (n, 3)), in
         a new array; the body's state is left as it is (the stable step, the tests).
 
-        The viscous hourglass form contributes nothing here (it acts on velocities).
+        The viscous hourglass form contributes nothing here (it acts on velocities); an
+        elasto-plastic force has no such function of u alone.
         """
+        if self.plastic:
+            raise TypeError("an elasto-plastic force depends on the path, not on u alone")
         if self._probe is None:
             V = self.V
-            fields, energy = (GhostedField(V), GhostedField(V), GhostedField(V)), np.zeros(2)
+            fields, energy = (GhostedField(V), GhostedField(V), GhostedField(V)), np.zeros(4)
             self._probe = (*fields, self._bind(*(g.array for g in fields), energy), energy)
         u_probe, _, f_probe, kernel, energy = self._probe
         u_probe.owned[:] = u
@@ -235,7 +352,44 @@ class ElementForce:
         """Elastic and stored hourglass energies (J) of the whole body at a displacement
         ``u`` (owned, (n, 3)), summed over ranks; the body's state is left as it is."""
         self.forces(u)
-        elastic, hourglass = self._probe[4]
+        elastic, hourglass = self._probe[4][:2]
         if not self.conservative:
             hourglass = 0.0
         return tuple(self.V.mesh.comm.allreduce(np.array([elastic, hourglass])))
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The energies of the latest force computation (J: the viscous hourglass form and
+        the elasto-plastic kernels accumulate theirs), whether the first step is done, and
+        the elasto-plastic state per integration point."""
+        arrays = {"energy": self._energy, "started": np.array(self._started)}
+        if self.plastic:
+            arrays["history"] = self.history
+        return arrays
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._energy[:] = arrays["energy"]
+        self._started = bool(arrays["started"])
+        if self.plastic:
+            self.history[...] = arrays["history"]
+
+
+# Node permutations that turn a cell inside out: a mirror of its reference cell.
+_MIRROR = {4: [0, 2, 1, 3], 8: [1, 0, 3, 2, 5, 4, 7, 6]}
+
+
+def _oriented(cells: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """The cells (rows of node indices, DOLFINx numbering) with the mirrored ones turned so
+    that every cell has a positive volume in the reference configuration ``X`` (m): the
+    elasto-plastic kernels then know a cell with a non-positive volume is inverted."""
+    x = X[cells]
+    if cells.shape[1] == 4:
+        det = np.einsum(
+            "ij,ij->i", x[:, 1] - x[:, 0], np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0])
+        )
+    else:  # the Jacobian at the centre of the trilinear map
+        signs = np.array([[2 * (node >> k & 1) - 1 for node in range(8)] for k in range(3)])
+        e = np.einsum("kI,cIi->cki", signs, x)
+        det = np.einsum("ci,ci->c", e[:, 0], np.cross(e[:, 1], e[:, 2]))
+    mirrored = det < 0.0
+    cells[mirrored] = cells[mirrored][:, _MIRROR[cells.shape[1]]]
+    return np.ascontiguousarray(cells)

@@ -20,6 +20,7 @@ from rwall_fem import _compat
 from rwall_fem.scene import Material
 
 __all__ = [
+    "EDGES",
     "coordinate_pattern",
     "critical_time_step",
     "element_time_step",
@@ -31,7 +32,7 @@ __all__ = [
 ]
 
 # Vertices joined by an edge, in DOLFINx's reference-cell numbering.
-_EDGES = {
+EDGES = {
     "tetrahedron": [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)],
     "hexahedron": [
         (0, 1),
@@ -146,7 +147,7 @@ def shortest_edge(V) -> float:
     """The shortest cell edge of the mesh of ``V`` (m), over all ranks."""
     x = V.tabulate_dof_coordinates()
     nodes = _compat.cell_nodes(V)[: V.mesh.topology.index_map(V.mesh.topology.dim).size_local]
-    pairs = np.array(_EDGES[V.mesh.topology.cell_type.name])
+    pairs = np.array(EDGES[V.mesh.topology.cell_type.name])
     lengths = np.linalg.norm(x[nodes[:, pairs[:, 0]]] - x[nodes[:, pairs[:, 1]]], axis=-1)
     return V.mesh.comm.allreduce(lengths.min(initial=np.inf), op=MPI.MIN)
 

@@ -7,11 +7,13 @@ One step, in the order of ``docs/theory.md`` (section "The step"):
 3. recorders sample the steps they are due (fields, frames: ``u^n``, ``v^{n-1/2}``);
 4. the update ``v^{n+1/2} = v^{n-1/2} + dt a^n``, ``u^{n+1} = u^n + dt v^{n+1/2}``, in one
    compiled pass that also books the step's kinetic energy (:class:`CentralDifference`);
-5. bookkeeping: the history samples the energies of step n.
+5. bookkeeping: the history samples the energies of step n; a checkpoint is written when
+   one is due (:mod:`rwall_fem.checkpoint`).
 
 Each effect is an object with a small interface (:class:`Force`, :class:`Constraint`,
 :class:`Recorder`), and only the effects a scene asks for are in the lists, so nothing
-else runs.
+else runs. Every object that carries state from one step to the next is also
+:class:`Stateful`, so that a run can be resumed from a checkpoint.
 """
 
 from __future__ import annotations
@@ -37,11 +39,35 @@ __all__ = [
     "RunStopped",
     "Simulation",
     "State",
+    "Stateful",
 ]
 
 
 class RunStopped(Exception):
     """A guard stopped the run; the message names the step, time, quantity and worst node."""
+
+
+class Stateful(Protocol):
+    """An object that carries state from one step to the next (Radioss /RFILE content).
+
+    :meth:`checkpoint_state` gives that state after the update and the history of step n
+    as named NumPy arrays (this rank's share; SI units; arrays may be views of the live
+    state: they are written at once). The names are the same at every step of a run. An
+    object that writes outputs puts them on disk first (collectively, if it writes them
+    so): a checkpoint promises the outputs up to its step.
+    :meth:`restore_state` takes those arrays back from a checkpoint of the same scene on
+    as many ranks, so that step n + 1 runs exactly as it would have; it raises ValueError
+    (one line) when an output it continues does not fit the checkpoint. What an object
+    derives from the scene alone when it is built (masses, node sets, histories of
+    prescribed velocities) needs no place in it.
+
+    The pieces of a run are listed by :attr:`Simulation.stateful`; a recorder is
+    stateful when it has these methods (a progress bar needs none).
+    """
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]: ...
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None: ...
 
 
 @dataclass
@@ -67,6 +93,25 @@ class State:
         self.mass_moment = np.zeros(3)
         self.inv_mass = (1.0 / self.mass)[:, None]  # 1/kg, shape (n, 1)
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """u^{n+1} and v^{n+1/2} (``a`` is set again by the internal force), the step, and
+        what the update of step n booked."""
+        return {
+            "u": self.u,
+            "v": self.v,
+            "clock": np.array([self.step, self.t]),
+            "booked": np.array([self.kinetic, self.internal_work]),
+            "mass_moment": self.mass_moment,
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.u[:] = arrays["u"]
+        self.v[:] = arrays["v"]
+        step, self.t = arrays["clock"].tolist()
+        self.step = int(step)
+        self.kinetic, self.internal_work = arrays["booked"].tolist()
+        self.mass_moment[:] = arrays["mass_moment"]
+
 
 class Force(Protocol):
     """An effect on the acceleration ``state.a`` (m/s^2) of step n."""
@@ -79,13 +124,15 @@ class Force(Protocol):
 class InternalForce(Force, Protocol):
     """The body's internal force: first in the pipeline, it *sets* ``state.a``.
 
-    ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``);
-    :meth:`energies` gives them (J) on this rank's share of the body at step n.
+    ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``),
+    ``energy_parts`` parts of them reported beside them (e.g. ``"plastic_work"``);
+    :meth:`energies` gives them all (J) on this rank's share of the body at step n.
     ``booked_force`` is None for a force with a stored energy; otherwise it is the nodal
     force (N, owned nodes) whose work the update books in ``state.internal_work``.
     """
 
     energy_names: tuple[str, ...]
+    energy_parts: tuple[str, ...]
     booked_force: np.ndarray | None
 
     def energies(self, state: State) -> dict[str, float]: ...
@@ -154,6 +201,13 @@ class CentralDifference:
             state.internal_work = self._done + first
             self._done += first + second
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The booked work of the finished steps (J)."""
+        return {"done": np.array(self._done)}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._done = float(arrays["done"])
+
 
 @dataclass
 class Simulation:
@@ -175,6 +229,8 @@ class Simulation:
     status: str = "not run"  # "done", "stopped: <reason>" or "failed: <error>"
     # Names of the stop signals received ("SIGTERM", "SIGINT"); the history acts on them.
     stop_requests: set[str] = field(default_factory=set)
+    checkpoints: Any = None  # rwall_fem.checkpoint.Checkpoints: written after the history
+    first_step: int = 0  # after a resume, the step after the checkpoint's
 
     def __post_init__(self):
         if self.update is None:
@@ -194,15 +250,30 @@ class Simulation:
         """Names of the effects in the step pipeline, in the order they act."""
         return [e.name for e in [self.internal, *self.forces, *self.constraints]]
 
+    @property
+    def stateful(self) -> dict[str, Stateful]:
+        """Every object of the run that carries state from one step to the next, by a name
+        that is the same in every run of the scene: what a checkpoint holds."""
+        pieces = {"state": self.state, "update": self.update, "internal": self.internal}
+        pieces |= {f"force[{i}]": f for i, f in enumerate(self.forces)}
+        pieces |= {f"wall[{i}]": w for i, w in enumerate(self.walls)}
+        pieces |= {f"boundary[{i}]": b for i, b in enumerate(self.boundaries)}
+        if self.history is not None:
+            pieces["history"] = self.history
+        recorders = [r for r in self.recorders if hasattr(r, "checkpoint_state")]
+        return pieces | {f"recorder[{i}]": r for i, r in enumerate(recorders)}
+
     def run(self) -> str:
-        """Advance from t = 0 to ``end_time`` (s), then close every recorder.
+        """Advance from t = 0 (or the step after a checkpoint's, after a resume) to
+        ``end_time`` (s), then close every recorder.
 
         Returns ``self.status``: "done", or "stopped: ..." when a guard (see
         :mod:`rwall_fem.output.guards`), SIGTERM or SIGINT (Ctrl-C) stopped the run; the
-        outputs up to the last sample stay valid. Any other error propagates after every
-        recorder was closed; a recorder that fails to close does not keep the others from
-        closing, and never hides an error raised before it (it is noted on it). A
-        simulation runs once: build another to run again.
+        outputs up to the last sample stay valid, and a stop after a whole step writes a
+        checkpoint. Any other error propagates after every recorder was closed; a recorder
+        that fails to close does not keep the others from closing, and never hides an error
+        raised before it (it is noted on it). A simulation runs once: build another to run
+        again (a resumed run is another simulation).
         """
         if self.status != "not run":
             raise RuntimeError(
@@ -211,14 +282,18 @@ class Simulation:
             )
         s, last, update, history = self.state, self.num_steps, self.update, self.history
         forces, constraints = [self.internal, *self.forces], self.constraints
+        first, checkpoints = self.first_step, self.checkpoints
         with contextlib.ExitStack() as closing:
             outputs = [history, *self.recorders] if history is not None else self.recorders
             for recorder in reversed(outputs):  # closed in the order of the list
                 closing.push(_closer(recorder, self))
             closing.enter_context(_stop_signals(self))
+            if checkpoints is not None:
+                checkpoints.start(first)
             started = time.perf_counter()
+            updated = first - 1  # the latest step whose update is done
             try:
-                for step in range(last + 1):
+                for step in range(first, last + 1):
                     s.step, s.t = step, step * s.dt
                     for force in forces:
                         force.accelerate(s)
@@ -228,11 +303,16 @@ class Simulation:
                         if recorder.due(step):
                             recorder.record(self, s)
                     update(s)
+                    updated = step
                     if history is not None and history.due(step):
                         history.record(self, s)
+                    if checkpoints is not None and checkpoints.due(step):
+                        checkpoints.save(self)
                 self.status = "done"
             except RunStopped as stop:
                 self.status = f"stopped: {stop}"
+                if checkpoints is not None and updated == s.step:
+                    checkpoints.save(self)  # stopped after its history: a whole step
             except Exception as error:
                 self.status = f"failed: {type(error).__name__}: {error}"
                 raise

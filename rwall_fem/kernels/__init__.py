@@ -30,7 +30,7 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
-__all__ = ["KernelBuildError", "load"]
+__all__ = ["HOURGLASS", "MODELS", "POINT_SLOTS", "KernelBuildError", "load"]
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "tetrahedron.c", "hexahedron.c",
            "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
@@ -40,10 +40,12 @@ FLAG_SETS = (
     ["-O3", "-march=native", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
     ["-O3", "-fopenmp-simd", "-fno-math-errno", "-fvisibility=hidden"],
 )
-MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
+MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")  # the elastic laws
+POINT_SLOTS = 8  # state values per integration point of the plastic kernels (plasticity.h)
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
 
-_CDEF = """
+_CDEF = (
+    """
 typedef struct {
   double lmbda, mu, density, wave_speed, hourglass_coefficient, dt;
   int hardening;
@@ -62,25 +64,30 @@ void tet4_plastic(int64_t n, const int32_t *cells, const double *X, const double
 void hex8_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
                   const double *v, const element_params *p, double *state, int64_t stride,
                   double *f, double *energy);
-""" + "".join(
-    f"void hex8r_plastic_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
-    " const double *u, const double *v, const element_params *p, double *state,"
-    " int64_t stride, double *f, double *energy);\n"
-    for hourglass in HOURGLASS
-) + """
+"""
+    + "".join(
+        f"void hex8r_plastic_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
+        " const double *u, const double *v, const element_params *p, double *state,"
+        " int64_t stride, double *f, double *energy);\n"
+        for hourglass in HOURGLASS
+    )
+    + """
 void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
-void central_difference(int64_t n, double dt, const double *mass, const double *a, double *v, double *u,
-             const double *f, double out[6]);
-""" + "".join(
-    f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"
-    " const element_params *p, double *f, double *energy);\n"
-    for family in ("tet4", "hex8")
-    for model in MODELS
-) + "".join(
-    f"void hex8r_{model}_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
-    " const double *u, const double *v, const element_params *p, double *f, double *energy);\n"
-    for model in MODELS
-    for hourglass in HOURGLASS
+void central_difference(int64_t n, double dt, const double *mass, const double *a, double *v,
+                        double *u, const double *f, double out[6]);
+"""
+    + "".join(
+        f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"
+        " const element_params *p, double *f, double *energy);\n"
+        for family in ("tet4", "hex8")
+        for model in MODELS
+    )
+    + "".join(
+        f"void hex8r_{model}_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
+        " const double *u, const double *v, const element_params *p, double *f, double *energy);\n"
+        for model in MODELS
+        for hourglass in HOURGLASS
+    )
 )
 
 

@@ -16,6 +16,7 @@
 #define RWALL_BATCH_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #define LANES 4

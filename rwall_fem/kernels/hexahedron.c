@@ -107,21 +107,22 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
 /* Elasto-plastic Q1 hexahedra, 2x2x2 points with mean dilatation (B-bar: every point
  * takes the element's mean volumetric increment, and the pressure acts through the mean
  * gradient), updated Lagrangian as tet4_plastic; the state holds POINT_SLOTS slots per
- * point.  energy[0] += stored elastic energy (J), energy[2] += plastic dissipation. */
+ * point.  energy[0] += stored elastic energy (J), energy[2] += plastic dissipation,
+ * energy[3] += the number of cells with an inverted point (det J <= 0). */
 void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
                   double *restrict state, int64_t stride, double *restrict f,
                   double *restrict energy)
 {
   vec Xe[24], ue[24], ve[24], fe[24];
-  double stored = 0.0, dissipated = 0.0;
+  double stored = 0.0, dissipated = 0.0, inverted = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
     gather(cells, 8, c0, nb, X, Xe);
     gather(cells, 8, c0, nb, u, ue);
     gather(cells, 8, c0, nb, v, ve);
-    vec x[24], xm[24], du[24];
+    vec x[24], xm[24], du[24], smallest = VZERO + INFINITY;
     for (int i = 0; i < 24; ++i)
     {
       du[i] = p->dt * ve[i];
@@ -159,7 +160,8 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     for (int q = 0; q < 8; ++q)
     {
       vec g[8][3];
-      const vec w = vabs(hex8_point_geometry(x, q, g));
+      const vec det = hex8_point_geometry(x, q, g), w = vabs(det);
+      smallest = vmin(smallest, det);
       const vec pq = (1.0 / 3.0) * (sigma[q][0] + sigma[q][4] + sigma[q][8]);
       vec s[9];
       for (int i = 0; i < 9; ++i)
@@ -180,9 +182,11 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     scatter_add(cells, 8, c0, nb, fe, f);
     stored += lane_sum(elastic, nb);
     dissipated += lane_sum(dissipation, nb);
+    inverted += lane_sum(vselect(smallest <= 0.0, VZERO + 1.0, VZERO), nb);
   }
   energy[0] += stored;
   energy[2] += dissipated;
+  energy[3] += inverted;
 }
 
 /* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */

@@ -66,6 +66,7 @@ INLINE void hourglass_stress_times(const vec a[3], const vec g[3], const vec b[3
 /* What the one-point hexahedron needs of its nodal coordinates. */
 typedef struct
 {
+  vec V;         /* signed volume, m^3 (positive for the orientation of elasto-plastic cells) */
   vec c[4][3];   /* hourglass parts of the coordinates, m */
   vec E[3][3];   /* e1 x e2, e2 x e0, e0 x e1: det0 times the rows of J0^-1, m^2 */
   vec det0;      /* det J0, m^3 / 8 */
@@ -126,6 +127,7 @@ INLINE void hex8r_geometry(const vec *restrict x, hex8r_geometry_t *geo)
   cross(e[1], c[0], t1);
   V += dot3(c[2], t1);
   V = 8.0 * geo->det0 + (8.0 / 3.0) * V;
+  geo->V = V;
   geo->volume = vabs(V);
   const vec inv_V = 1.0 / V;
   for (int I = 0; I < 8; ++I)
@@ -173,14 +175,17 @@ INLINE void hourglass_modes(const hex8r_geometry_t *geo, const vec *restrict w, 
   }
 }
 
-/* The generalized hourglass forces Q_a of amplitudes q_a: linear in q (see the header). */
+/* The generalized hourglass forces Q_a of amplitudes q_a: linear in q (see the header).
+ * ``lambda`` is the first Lame parameter of the physical form's hourglass stresses: the
+ * material's for elastic bodies (full integration on parallelepipeds), 0 for plastic flow,
+ * where a volumetric hourglass stiffness would lock the nearly incompressible flow. */
 INLINE void hourglass_forces(int hourglass, const hex8r_geometry_t *geo, const vec q[4][3],
-                             const element_params *p, vec Q[4][3])
+                             const element_params *p, double lambda, vec Q[4][3])
 {
   const double scale = p->hourglass_coefficient;
   if (hourglass == HOURGLASS_PHYSICAL)
   {
-    const double lambda = p->lmbda, mu = p->mu;
+    const double mu = p->mu;
     const vec zero[3] = {VZERO, VZERO, VZERO};
     vec g[3][3], s1[3], s2[3], s3[3];
     const vec inv_det0 = 1.0 / geo->det0;
@@ -252,7 +257,7 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
     return;
   vec gamma[4][8], q[4][3], Q[4][3];
   hourglass_modes(&geo, hourglass == HOURGLASS_VISCOUS ? v : u, gamma, q);
-  hourglass_forces(hourglass, &geo, q, p, Q);
+  hourglass_forces(hourglass, &geo, q, p, p->lmbda, Q);
   vec work = VZERO;
   for (int a = 0; a < 4; ++a)
     work += dot3(Q[a], q[a]);
@@ -290,7 +295,8 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
  * element's rotation R and dq the hourglass amplitudes of du in the current configuration
  * (the viscous form: Q = Q(dq / dt)); the state keeps Q after the point's slots.
  * energy[0] += stored elastic energy (J), energy[1] += hourglass work of the step,
- * energy[2] += plastic dissipation of the step. */
+ * energy[2] += plastic dissipation of the step, energy[3] += the number of inverted cells
+ * (volume <= 0). */
 INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restrict cells,
                           const double *restrict X, const double *restrict u,
                           const double *restrict v, const element_params *p,
@@ -298,7 +304,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
                           double *restrict energy)
 {
   vec Xe[24], ue[24], ve[24], fe[24];
-  double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0;
+  double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0, inverted = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
@@ -320,6 +326,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
     store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
     hex8r_geometry(x, &geo);
+    inverted += lane_sum(vselect(geo.V <= 0.0, VZERO + 1.0, VZERO), nb);
     hex8r_nodal_forces(&geo, sigma, fe);
     stored += lane_sum(geo.volume * elastic_energy_density(p, sigma), nb);
     dissipated += lane_sum(mid_volume * dissipation, nb);
@@ -333,7 +340,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
         for (int a = 0; a < 4; ++a)
           for (int i = 0; i < 3; ++i)
             dq[a][i] *= rate;
-        hourglass_forces(hourglass, &geo, dq, p, Q);
+        hourglass_forces(hourglass, &geo, dq, p, 0.0, Q);
         for (int a = 0; a < 4; ++a)
           work += p->dt * dot3(Q[a], dq[a]);
       }
@@ -349,7 +356,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
               value[k] = state[(POINT_SLOTS + 3 * a + i) * stride + c0 + (k < nb ? k : 0)];
             Q_old[a][i] = value;
           }
-        hourglass_forces(hourglass, &geo, dq, p, dQ);
+        hourglass_forces(hourglass, &geo, dq, p, 0.0, dQ);
         for (int a = 0; a < 4; ++a)
         {
           for (int i = 0; i < 3; ++i)
@@ -371,6 +378,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
   energy[0] += stored;
   energy[1] += hourglass_work;
   energy[2] += dissipated;
+  energy[3] += inverted;
 }
 
 /* One function per law and hourglass control: f += f_int(u) on the cells (N); energy[0] +=

@@ -11,8 +11,9 @@
 #include "materials.h"
 #include "plasticity.h"
 
-/* Shape function gradients g[I] (1/m) and volume (m^3) of the tetrahedra at x[3 I + i]. */
-INLINE vec tet4_geometry(const vec *restrict x, vec g[4][3])
+/* Shape function gradients g[I] (1/m) and volume (m^3) of the tetrahedra at x[3 I + i];
+ * *det the signed 6 V (positive for the orientation of elasto-plastic cells). */
+INLINE vec tet4_geometry_signed(const vec *restrict x, vec g[4][3], vec *det_out)
 {
   vec d[3][3];
   for (int a = 0; a < 3; ++a)
@@ -29,7 +30,14 @@ INLINE vec tet4_geometry(const vec *restrict x, vec g[4][3])
     g[3][i] *= inv_det;
     g[0][i] = -(g[1][i] + g[2][i] + g[3][i]);
   }
+  *det_out = det;
   return (1.0 / 6.0) * vabs(det);
+}
+
+INLINE vec tet4_geometry(const vec *restrict x, vec g[4][3])
+{
+  vec det;
+  return tet4_geometry_signed(x, g, &det);
 }
 
 /* L = sum_I w_I (x) g_I for nodal vectors w[3 I + i]. */
@@ -82,14 +90,15 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
  * (dt = 0 at the first step: the state is the initial one) has its gradient taken in the
  * mid-step configuration; the force is that of the updated stress in the current one,
  * x = X + u.  energy[0] += stored elastic energy, energy[2] += plastic dissipation of the
- * step (J).  state: POINT_SLOTS rows of `stride` (>= cells rounded up to LANES) values. */
+ * step (J), energy[3] += the number of inverted cells (volume <= 0: the cells are
+ * oriented positively at the start).  state: POINT_SLOTS rows of `stride` values. */
 void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
                   double *restrict state, int64_t stride, double *restrict f,
                   double *restrict energy)
 {
   vec Xe[12], ue[12], ve[12], fe[12];
-  double stored = 0.0, dissipated = 0.0;
+  double stored = 0.0, dissipated = 0.0, inverted = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
@@ -108,14 +117,17 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     load_point(state, stride, c0, nb, 0, sigma, &eps_p, &T);
     const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
     store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
-    const vec volume = tet4_geometry(x, g);
+    vec det;
+    const vec volume = tet4_geometry_signed(x, g, &det);
     tet4_nodal_forces(volume, sigma, g, fe);
     scatter_add(cells, 4, c0, nb, fe, f);
     stored += lane_sum(volume * elastic_energy_density(p, sigma), nb);
     dissipated += lane_sum(mid_volume * dissipation, nb);
+    inverted += lane_sum(vselect(det <= 0.0, VZERO + 1.0, VZERO), nb);
   }
   energy[0] += stored;
   energy[2] += dissipated;
+  energy[3] += inverted;
 }
 
 /* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */

@@ -41,8 +41,10 @@ class EnergyBalance:
     """The running balance of energies (J) already summed over ranks.
 
     ``stored`` names the energies the body holds (kinetic first, then those of the
-    internal force), ``works`` the works done on it; :attr:`columns` are those of
-    ``energy.csv``: time, stored..., works..., balance error, total energy, error in %, dt.
+    internal force), ``works`` the works done on it, ``parts`` parts of a stored energy
+    reported beside it (the elastic energy and plastic work within the internal energy of
+    an elasto-plastic body), not added again; :attr:`columns` are those of ``energy.csv``:
+    time, stored..., parts..., works..., balance error, total energy, error in %, dt.
     """
 
     def __init__(
@@ -50,10 +52,11 @@ class EnergyBalance:
         initial: float,
         stored: Sequence[str] = ("kinetic", "internal"),
         works: Sequence[str] = ("external_work", "wall_work"),
+        parts: Sequence[str] = (),
     ):
-        self.stored, self.works = tuple(stored), tuple(works)
+        self.stored, self.works, self.parts = tuple(stored), tuple(works), tuple(parts)
         self.columns = (
-            "time", *self.stored, *self.works, "balance_error", "total_energy",
+            "time", *self.stored, *self.parts, *self.works, "balance_error", "total_energy",
             "energy_error_percent", "dt",
         )  # fmt: skip
         self.initial = initial  # E0, J
@@ -66,6 +69,19 @@ class EnergyBalance:
         """Balance error of the latest sample (None before the first)."""
         return None if self.latest is None else self.latest["balance_error"]
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """E0, E_ref and the largest error so far, and the latest sample (empty: none)."""
+        latest = () if self.latest is None else tuple(self.latest.values())
+        return {
+            "books": np.array([self.initial, self.reference, self.max_error]),
+            "latest": np.array(latest, dtype=float),
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.initial, self.reference, self.max_error = arrays["books"].tolist()
+        latest = arrays["latest"].tolist()
+        self.latest = dict(zip(self.columns, latest, strict=True)) if latest else None
+
     def sample(self, t: float, energies: Mapping[str, float], dt: float) -> tuple:
         """Book the energies (J, summed over ranks) of time ``t`` (s), reached with the
         step ``dt`` (s); returns the row."""
@@ -77,8 +93,8 @@ class EnergyBalance:
         error = (balance - self.initial) / max(self.reference, np.finfo(float).tiny)
         self.max_error = max(self.max_error, abs(error))
         row = (
-            t, *(energies[name] for name in (*self.stored, *self.works)), error, stored,
-            100.0 * error, dt,
+            t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error,
+            stored, 100.0 * error, dt,
         )  # fmt: skip
         self.latest = dict(zip(self.columns, row, strict=True))
         return row

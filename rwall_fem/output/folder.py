@@ -6,8 +6,9 @@
 - :class:`ResultsFolder` is held while a run writes: rank 0 creates the lock file
   ``.rwall-fem.lock`` atomically (a second run into the same folder is refused in one
   line), removes the outputs an earlier run left there (:data:`STALE`: they would mix
-  with this run's), and removes the lock when the run ends, however it ends. A lock
-  left by a killed run on this host is taken over once its process is gone.
+  with this run's; a resumed run continues them instead, and a fresh run drops an
+  earlier checkpoint itself), and removes the lock when the run ends, however it ends.
+  A lock left by a killed run on this host is taken over once its process is gone.
 
 Every rank learns rank 0's outcome (one broadcast), so all of them refuse alike.
 """
@@ -64,13 +65,14 @@ def _unusable(directory: Path) -> str | None:
 
 
 class ResultsFolder:
-    """Context manager that holds ``directory`` for one run on ``comm`` (see the module).
+    """Context manager that holds ``directory`` for one run on ``comm`` (see the module);
+    ``fresh``: the run starts at step 0 (not a resume), so an earlier run's outputs go.
 
     :attr:`removed` lists the outputs of an earlier run that were removed (rank 0).
     """
 
-    def __init__(self, directory: Path, comm):
-        self.directory, self.comm = Path(directory), comm
+    def __init__(self, directory: Path, comm, *, fresh: bool = True):
+        self.directory, self.comm, self.fresh = Path(directory), comm, fresh
         self.lock = self.directory / LOCK
         self.removed: list[str] = []
 
@@ -82,7 +84,7 @@ class ResultsFolder:
                 error = self._take_lock()
             except OSError as err:
                 error = f"cannot create {self.directory} ({err.strerror})"
-            if error is None:
+            if error is None and self.fresh:
                 self.removed = self._remove_stale()
         error = self.comm.bcast(error, root=0)
         if error:

@@ -107,6 +107,23 @@ class Frames:
             np.savez(self.data / f"frame_{self._count:04d}.npz", t=s.t, u=u, v=v, offsets=offsets)
         self._count += 1
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """How many frames are stored."""
+        return {"frames": np.array(self._count)}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Continue the numbering; frames stored after the checkpoint are removed."""
+        self._count, error = int(arrays["frames"]), None
+        if self.comm.rank == 0:
+            if self._count and not (self.data / "mesh.npz").is_file():
+                error = f"{self.data / 'mesh.npz'}: missing, and the checkpoint has frames"
+            for later in self.data.glob("frame_*.npz"):
+                if int(later.stem.removeprefix("frame_")) >= self._count:
+                    later.unlink()
+        error = self.comm.bcast(error, root=0)
+        if error:
+            raise ValueError(error)
+
     def close(self, sim) -> None:
         """Render the stored frames into PNGs and ``animation.gif`` (rank 0)."""
         if self.comm.rank != 0 or not self._count:

@@ -62,6 +62,7 @@ class History:
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
+            parts=sim.internal.energy_parts,
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -71,14 +72,16 @@ class History:
         self._written_at = time.monotonic()
         self._sums = _Sums(
             comm,
-            {name: () for name in self.balance.stored}
+            {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2)}
             | {"signals": (len(SIGNALS),), "seconds": ()}
             | self.wall_table.sums,
         )
         self._poll = _Sums(comm, {"signals": (len(SIGNALS),), "seconds": ()})
-        self._next_poll = 1  # the next step at which the ranks agree on stop signals
-        self._last = (0, time.perf_counter())  # step and wall time of the latest agreement
+        self._next_poll = 0  # the next step at which the ranks agree on stop signals
+        # Step and wall time of the latest agreement (none yet: since the history was built).
+        self._last: tuple[int, float] | None = None
+        self._built = time.perf_counter()
         self._drawing: subprocess.Popen | None = None
 
     def due(self, step: int) -> bool:
@@ -109,7 +112,9 @@ class History:
         total = self._sums.reduce()
         self._plan_next_poll(s, total)
 
-        energies = {name: float(total[name]) for name in self.balance.stored}
+        energies = {
+            name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)
+        }
         for w in sim.walls:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic = 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity
@@ -125,12 +130,12 @@ class History:
     def _fill_agreement(self, local: dict, sim) -> None:
         """This rank's stop signals and its wall time since the latest agreement (s)."""
         local["signals"][:] = [name in sim.stop_requests for name in SIGNALS]
-        local["seconds"][...] = time.perf_counter() - self._last[1]
+        local["seconds"][...] = time.perf_counter() - (self._last or (0, self._built))[1]
 
     def _plan_next_poll(self, s, total: dict) -> None:
         """The next agreement, about ``POLL_SECONDS`` of wall time ahead at the mean time
         per step since the latest one (the same on every rank: from the sums)."""
-        steps = max(s.step - self._last[0], 1)
+        steps = max(s.step - self._last[0], 1) if self._last else 1
         per_step = float(total["seconds"]) / self._sums.comm.size / steps
         ahead = POLL_SECONDS / per_step if per_step > 0 else 1.0
         self._next_poll = s.step + max(1, int(min(ahead, 1e9)))
@@ -142,6 +147,36 @@ class History:
         total = self._poll.reduce()
         self._plan_next_poll(s, total)
         return bool(total["signals"].any())
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The energy balance, the wall table, the momentum of the start and how many rows
+        ``energy.csv`` and ``walls.csv`` have; both files are flushed first, so that they
+        hold those rows when the checkpoint exists."""
+        self._flush()
+        rows = [self._energy_csv.count, self._walls_csv.count]
+        arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
+        arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
+        return arrays | {f"walls_{k}": v for k, v in self.wall_table.checkpoint_state().items()}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        """Also reads back the rows of ``energy.csv`` and ``walls.csv`` up to the checkpoint
+        and drops those after it; ValueError if the files do not hold them, or if the
+        energy row of the checkpoint's step is not the one in the file."""
+        self.initial_momentum = arrays["initial_momentum"].copy()
+        self.balance.restore_state(
+            {k.removeprefix("balance_"): v for k, v in arrays.items() if k.startswith("balance_")}
+        )
+        self.wall_table.restore_state(
+            {k.removeprefix("walls_"): v for k, v in arrays.items() if k.startswith("walls_")}
+        )
+        energy_rows, wall_rows = arrays["rows"].tolist()
+        latest = self._energy_csv.resume(energy_rows) or ()
+        self._walls_csv.resume(wall_rows)
+        if list(latest) != arrays["balance_latest"].tolist():
+            raise ValueError(
+                f"{self._energy_csv.path}: row {energy_rows} is not the checkpoint's (the file "
+                "was changed, or is another run's)"
+            )
 
     def _flush(self) -> None:
         self._written_at = time.monotonic()

@@ -114,10 +114,12 @@ class RunLog:
         from rwall_fem.provenance import git_hash, library_versions
 
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file = open(self.path, "w")
+        self._file = open(self.path, "a" if sim.first_step else "w")  # a resume continues it
         self._started = time.perf_counter()
         versions = ", ".join(f"{k} {v}" for k, v in library_versions().items())
+        resumed = ["", f"resumed at step {sim.first_step}"] if sim.first_step else []
         lines = [
+            *resumed,
             f"rwall-fem {__version__} (git {git_hash() or 'unknown: not a git checkout'})",
             f"started {time.strftime('%Y-%m-%d %H:%M:%S %z')} on {socket.gethostname()}, "
             f"{self.comm.size} MPI rank(s)",

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["momentum", "run_summary", "write_summary"]
+__all__ = ["deformed_bounds", "momentum", "run_summary", "write_summary"]
 
 
 def momentum(state, walls, comm) -> np.ndarray:
@@ -38,7 +38,7 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
     outcome, _, reason = sim.status.partition(": ")
     latest = balance.latest or {}
     energy = {"initial": balance.initial}
-    energy |= {name: latest.get(name) for name in (*balance.stored, *balance.works)}
+    energy |= {name: latest.get(name) for name in (*balance.stored, *balance.parts, *balance.works)}
     energy["max_balance_error"] = balance.max_error
     return sim.info | {
         "status": outcome,
@@ -54,6 +54,8 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         "initial_momentum": initial_momentum.tolist(),
         "final_momentum": momentum(s, sim.walls, comm).tolist(),
         "energy": energy,
+        "deformed_bounds": deformed_bounds(s, comm),
+        **_plasticity(sim.internal, comm),
         "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
         "boundaries": [
             {
@@ -64,6 +66,27 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
             }
             for b in sim.boundaries
         ],
+    }
+
+
+def deformed_bounds(state, comm) -> list[list[float]]:
+    """[min corner], [max corner] (m) of the body at the time of the latest step, read
+    after its update (u^{n+1} - dt v^{n+1/2} = u^n)."""
+    x = state.X + state.u - state.dt * state.v
+    low = comm.allreduce(x.min(axis=0, initial=np.inf), MPI.MIN)
+    high = comm.allreduce(x.max(axis=0, initial=-np.inf), MPI.MAX)
+    return [low.tolist(), high.tolist()]
+
+
+def _plasticity(internal, comm) -> dict:
+    """The plastic work (J) and the largest equivalent plastic strain of an elasto-plastic
+    body; nothing for an elastic one."""
+    if not getattr(internal, "plastic", False):
+        return {}
+    fields = internal.plastic_strains()
+    return {
+        "plastic_work": comm.allreduce(internal.plastic_work),
+        "max_plastic_strain": comm.allreduce(float(fields.max(initial=0.0)), MPI.MAX),
     }
 
 

@@ -4,11 +4,13 @@ Rank 0 turns each row into its line as it comes and keeps at most ``PENDING_LINE
 lines (or what :meth:`CsvTable.flush` has not yet written): memory stays flat
 however long the run. The pending lines go to the file in one write followed by a
 flush, so the file only ever holds whole lines. Other ranks keep nothing (the rows
-are sums over ranks, the same everywhere).
+are sums over ranks, the same everywhere). A resumed run keeps the rows up to its
+checkpoint (:meth:`CsvTable.resume`).
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -52,6 +54,28 @@ class CsvTable:
         self._file.flush()
         self._pending.clear()
 
+    def resume(self, count: int) -> tuple | None:
+        """Continue the table of a resumed run after the first ``count`` rows of its file;
+        the rows after them, written after the checkpoint, are dropped by replacing the
+        file whole (rank 0, line by line). Returns the last row kept (None: none), read
+        back exactly, on every rank. Raises ValueError (one line, the same on every rank)
+        when the file lacks them."""
+        last, error = None, None
+        if self.comm.rank == 0 and count:
+            temporary = self.path.with_name(self.path.name + ".partial")
+            try:
+                last = _copy_rows(self.path, temporary, self.columns, count)
+                os.replace(temporary, self.path)
+                self._file = open(self.path, "a")
+            except (OSError, ValueError) as err:
+                error = f"{self.path}: {err.strerror}" if isinstance(err, OSError) else str(err)
+                temporary.unlink(missing_ok=True)
+        last, error = self.comm.bcast((last, error), root=0)
+        if error:
+            raise ValueError(error)
+        self.count = count
+        return last
+
     def close(self) -> None:
         """Write what is left and close the file."""
         self.flush()
@@ -68,6 +92,40 @@ class CsvTable:
             rows = np.loadtxt(self.path, delimiter=",", skiprows=1, ndmin=2)
             rows = rows.reshape(-1, len(self.columns))
         return self.comm.bcast(rows, root=0)
+
+
+def _copy_rows(path: Path, target: Path, columns: Sequence[str], count: int) -> tuple:
+    """Copy the header and the first ``count`` rows of the CSV file ``path`` to ``target``
+    (on disk when this returns), each checked to be a whole line of numbers with the
+    ``columns``; returns the last, read back exactly (integers as int)."""
+    header = ",".join(columns)
+    kept, last = 0, None
+    with open(path) as source, open(target, "w") as copy:
+        if source.readline().rstrip("\n") != header:
+            raise ValueError(f"{path}: its columns are not those of this run")
+        copy.write(header + "\n")
+        for line in source:
+            if kept == count or not line.endswith("\n"):  # enough, or a line cut by a kill
+                break
+            try:
+                last = tuple(map(_number, line.rstrip("\n").split(",")))
+            except ValueError:
+                raise ValueError(f"{path}: a row of the first {count} is not numbers") from None
+            if len(last) != len(columns):
+                raise ValueError(
+                    f"{path}: a row of the first {count} has not {len(columns)} columns"
+                )
+            copy.write(line)
+            kept += 1
+        if kept < count:
+            raise ValueError(f"{path}: holds {kept} rows; the checkpoint has {count}")
+        copy.flush()
+        os.fsync(copy.fileno())
+    return last
+
+
+def _number(text: str) -> int | float:
+    return int(text) if text.lstrip("-").isdigit() else float(text)
 
 
 def _line(row) -> str:

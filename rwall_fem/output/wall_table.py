@@ -40,6 +40,20 @@ class WallTable:
         self._last_impulses = np.zeros((n, 6))  # normal and tangential, N s
         self._last_step = -1
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The impulses (N s) and step of the latest sample (forces are differences from
+        them), and the peak contact counts."""
+        return {
+            "last_impulses": self._last_impulses,
+            "last_step": np.array(self._last_step),
+            "peak_contacts": self.peak_contacts,
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self._last_impulses[:] = arrays["last_impulses"]
+        self._last_step = int(arrays["last_step"])
+        self.peak_contacts[:] = arrays["peak_contacts"]
+
     def fill(self, local: dict) -> None:
         """Write this rank's impulses (N s) and contact counts into the ``local`` sums."""
         for i, w in enumerate(self.walls):

@@ -17,6 +17,7 @@ from rwall_fem.scene.read import load_scene, parse_scene
 from rwall_fem.scene.schema import (
     MATERIAL_MODELS,
     MESH_SHAPES,
+    PLASTIC_MODELS,
     SHAPE_KEYS,
     BoundarySpec,
     Element,
@@ -33,6 +34,7 @@ from rwall_fem.scene.schema import (
 
 __all__ = [
     "MATERIAL_MODELS",
+    "PLASTIC_MODELS",
     "MESH_SHAPES",
     "SHAPE_KEYS",
     "BoundarySpec",

@@ -27,6 +27,7 @@ from typing import Any, NoReturn
 __all__ = [
     "Choice",
     "Context",
+    "Curve",
     "Each",
     "Flag",
     "Integer",
@@ -394,6 +395,39 @@ class Velocity(ValueType):
     def json(self):
         row = {"type": "array", "items": {"type": "number"}, "minItems": 4, "maxItems": 4}
         return {"anyOf": [Vector(3).json(), {"type": "array", "items": row, "minItems": 1}]}
+
+
+@dataclass(frozen=True)
+class Curve(ValueType):
+    """A tabulated curve: rows [x, y] with x starting at ``first_x`` and increasing, y > 0,
+    at most ``rows`` rows (linear between rows, held beyond the last)."""
+
+    first_x: float = 0.0
+    rows: int = 64
+    type_text = "rows [x, y]"
+
+    def read(self, value, ctx):
+        ok = (
+            isinstance(value, (list, tuple))
+            and 2 <= len(value) <= self.rows
+            and all(_numbers(r, 2) and _float(r[1]) > 0 for r in value)
+        )
+        if ok:
+            x = [_float(r[0]) for r in value]
+            ok = x[0] == self.first_x and all(b > a for a, b in zip(x, x[1:], strict=False))
+        if not ok:
+            raise Invalid(
+                f"must be 2 to {self.rows} rows [x, y], x from {self.first_x:g} increasing, "
+                f"y > 0, got {show(value)}"
+            )
+        return tuple((_float(r[0]), _float(r[1])) for r in value)
+
+    def allowed_text(self):
+        return f"2 to {self.rows} rows; x from {self.first_x:g} increasing; y > 0"
+
+    def json(self):
+        row = {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}
+        return {"type": "array", "items": row, "minItems": 2, "maxItems": self.rows}
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from rwall_fem.scene.keys import (
     Choice,
+    Curve,
     Each,
     Flag,
     Integer,
@@ -34,10 +35,12 @@ from rwall_fem.scene.keys import (
 
 __all__ = [
     "MATERIAL_MODELS",
+    "PLASTIC_MODELS",
     "MESH_SHAPES",
     "SHAPE_KEYS",
     "BoundarySpec",
     "Element",
+    "Heating",
     "Initial",
     "Material",
     "MeshSpec",
@@ -49,8 +52,38 @@ __all__ = [
     "WallSpec",
 ]
 
-# Small strain (constant stiffness), and the large-deformation (hyperelastic) models.
-MATERIAL_MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")
+# Small strain (constant stiffness), the large-deformation hyperelastic models, and the
+# elasto-plastic ones (J2 with isotropic hardening; Johnson-Cook).
+MATERIAL_MODELS = (
+    "linear_elastic",
+    "saint_venant_kirchhoff",
+    "neo_hookean",
+    "elastic_plastic",
+    "johnson_cook",
+)
+PLASTIC_MODELS = ("elastic_plastic", "johnson_cook")
+_ELASTIC_KEYS = ("density", "young", "poisson")
+# The keys of each material model besides "model".
+MATERIAL_KEYS = {model: _ELASTIC_KEYS for model in MATERIAL_MODELS} | {
+    "elastic_plastic": (
+        *_ELASTIC_KEYS,
+        "hardening",
+        "yield_stress",
+        "hardening_modulus",
+        "hardening_coefficient",
+        "hardening_exponent",
+        "hardening_curve",
+    ),
+    "johnson_cook": (
+        *_ELASTIC_KEYS,
+        "yield_stress",
+        "hardening_coefficient",
+        "hardening_exponent",
+        "strain_rate_coefficient",
+        "reference_strain_rate",
+        "heating",
+    ),
+}
 
 # The keys of each mesh shape besides "shape", "noise" and the refinement keys.
 MESH_SHAPES = {
@@ -345,18 +378,120 @@ def _noise_is_small(v, raw, fail):
 
 
 @table(
-    "The body's material: one elastic law for the whole body.",
-    variants=Variants("model", {m: ("density", "young", "poisson") for m in MATERIAL_MODELS}),
+    "Adiabatic heating and thermal softening of a Johnson-Cook material (Radioss LAW2's "
+    "thermal terms); no [material.heating]: none.",
+)
+@dataclass(frozen=True)
+class Heating:
+    softening_exponent: float = key(
+        Real(low=0.0), doc="m in the softening factor 1 - T*^m, T* = (T - T_room)/(T_melt - T_room)"
+    )
+    melting_temperature: float = key(Real(low=0.0), unit="K", doc="T_melt")
+    specific_heat: float = key(Real(low=0.0), unit="J/(kg K)", doc="heat capacity per mass")
+    room_temperature: float = key(
+        Real(low=0.0), 293.15, unit="K", doc="T_room, also the initial temperature"
+    )
+    taylor_quinney: float = key(
+        Real(low=0.0, low_open=False, high=1.0),
+        0.9,
+        doc="share of the plastic work that heats the material",
+    )
+
+
+@rule(Heating)
+def _melting_above_room(v, raw, fail):
+    """melting_temperature is above room_temperature."""
+    if v["melting_temperature"] <= v["room_temperature"]:
+        fail(
+            "melting_temperature",
+            f"must be above room_temperature ({v['room_temperature']:g} K), "
+            f"got {v['melting_temperature']:g} K",
+        )
+
+
+@table(
+    "The body's material: one law for the whole body.",
+    variants=Variants("model", MATERIAL_KEYS, noun="the {} model"),
 )
 @dataclass(frozen=True)
 class Material:
     model: str = key(
         Choice(MATERIAL_MODELS),
-        doc="linear_elastic: small strain; saint_venant_kirchhoff, neo_hookean: large deformation",
+        doc="linear_elastic: small strain; saint_venant_kirchhoff, neo_hookean: hyperelastic, "
+        "large deformation; elastic_plastic (J2, isotropic hardening), johnson_cook: "
+        "elasto-plastic, large deformation",
     )
     density: float = key(Real(low=0.0), unit="kg/m^3", doc="mass density")
     young: float = key(Real(low=0.0), unit="Pa", doc="Young's modulus")
     poisson: float = key(Real(low=-1.0, high=0.5, high_open=True), doc="Poisson's ratio")
+    hardening: str | None = key(
+        Choice(("linear", "power", "table")),
+        None,
+        required=True,
+        doc="elastic_plastic: how the yield stress grows with the equivalent plastic strain "
+        "eps_p: linear A + H eps_p, power A + B eps_p^n, or a table",
+    )
+    yield_stress: float | None = key(
+        Real(low=0.0),
+        None,
+        required=True,
+        unit="Pa",
+        when={"hardening": ("linear", "power")},
+        doc="initial yield stress A",
+    )
+    hardening_modulus: float | None = key(
+        Real(low=0.0, low_open=False),
+        None,
+        required=True,
+        unit="Pa",
+        when={"hardening": ("linear",)},
+        doc="H, the slope of the yield stress against eps_p (0: perfectly plastic)",
+    )
+    hardening_coefficient: float | None = key(
+        Real(low=0.0, low_open=False),
+        None,
+        required=True,
+        unit="Pa",
+        when={"hardening": ("power",)},
+        doc="B in A + B eps_p^n",
+    )
+    hardening_exponent: float | None = key(
+        Real(low=0.0, low_open=False, high=1.0),
+        None,
+        required=True,
+        when={"hardening": ("power",)},
+        doc="n in A + B eps_p^n",
+    )
+    hardening_curve: tuple | None = key(
+        Curve(first_x=0.0, rows=64),
+        None,
+        required=True,
+        unit="-, Pa",
+        when={"hardening": ("table",)},
+        doc="rows [eps_p, yield stress], the first at eps_p = 0 (the initial yield stress)",
+    )
+    strain_rate_coefficient: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        doc="C in the rate factor 1 + C ln max(rate / reference_strain_rate, 1)",
+    )
+    reference_strain_rate: float = key(
+        Real(low=0.0),
+        1.0,
+        unit="1/s",
+        doc="the rate below which the flow stress is that of A + B eps_p^n",
+    )
+    heating: Heating | None = key(
+        Sub(Heating),
+        None,
+        doc="adiabatic heating and thermal softening",
+        default_doc="none: isothermal",
+    )
+
+    @property
+    def plastic(self) -> bool:
+        """Whether the law is elasto-plastic (path-dependent: no stored energy)."""
+        return self.model in PLASTIC_MODELS
 
     @property
     def lame(self) -> tuple[float, float]:
@@ -391,21 +526,15 @@ class Element:
         doc="physical: assumed-strain stabilisation (Belytschko-Bindeman, Radioss HEPH); "
         "stiffness, viscous: Flanagan-Belytschko forms; none",
     )
-    hourglass_coefficient: float = key(
+    hourglass_coefficient: float | None = key(
         Real(low=0.0),
-        1.0,
+        None,
         when={"integration": ("reduced",), "hourglass": _HOURGLASS_FORMS},
         doc="scales the hourglass forces",
-        default_doc="1.0 for physical, 0.1 for stiffness and viscous (LS-DYNA's QM)",
+        default_doc="physical: 1.0 (full integration on parallelepipeds) on elastic bodies, 0.1 "
+        "on elasto-plastic ones (elastic hourglass stresses would stiffen the plastic flow); "
+        "stiffness, viscous: 0.1 (LS-DYNA's QM)",
     )
-
-
-@rule(Element)
-def _coefficient_by_form(v, raw, fail):
-    """hourglass_coefficient defaults by form: 1.0 (physical), 0.1 (stiffness, viscous);
-    with hourglass = "none" it is 0."""
-    if "hourglass_coefficient" not in raw:
-        v["hourglass_coefficient"] = {"physical": 1.0, "none": 0.0}.get(v["hourglass"], 0.1)
 
 
 @table("The initial state of the body.")
@@ -619,6 +748,17 @@ class Output:
         doc="what colours the frames",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
+    checkpoint_steps: int = key(
+        Integer(low=0),
+        0,
+        doc="steps between checkpoints (directory/checkpoint, for run --resume); 0: none",
+    )
+    checkpoint_seconds: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="s",
+        doc="wall time between checkpoints; 0: none (a stop by SIGTERM or a guard writes one)",
+    )
 
 
 # --- the scene -----------------------------------------------------------------------

@@ -156,6 +156,60 @@ class RigidWall:
         self.deepest_penetration = float(deepest[0])
         self.deepest_position = np.array(deepest[1:])
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """What the wall booked so far, the latest step's contacts (the v^{n+1/2} halves of
+        their work are booked at the next step), the friction filter's previous
+        impulses, the near set and the wall's motion."""
+        latest = self._latest or (self.nodes[:0], np.zeros((0, 3)), None, np.zeros(0))
+        nodes, normal, tangential, final = latest
+        arrays = {
+            "normal_impulse": self.normal_impulse,
+            "tangential_impulse": self.tangential_impulse,
+            "works": np.array(
+                [self.normal_work, self.friction_work, self.driving_work, self._pending_driving]
+            ),
+            "contact_times": np.array([self.first_contact, self.last_contact]),
+            "contacts": np.array(self.contacts),
+            "touching": self.touching,
+            "latest_nodes": nodes,
+            "latest_normal": normal,
+            "latest_tangential": np.zeros((0, 3)) if tangential is None else tangential,
+            "latest_final": final,  # empty: no latest step
+            "filtered_rows": self._filtered_rows,
+            "near": self._near,
+            "near_X": self._near_X,
+            "near_mass": self._near_mass,
+            "near_budget": np.array([self._budget, self._travel, *self._anchor]),
+        }
+        if self._previous_tangential is not None:
+            arrays["previous_tangential"] = self._previous_tangential
+        return arrays | {f"motion_{k}": v for k, v in self.motion.checkpoint_state().items()}
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.normal_impulse[:] = arrays["normal_impulse"]
+        self.tangential_impulse[:] = arrays["tangential_impulse"]
+        works = arrays["works"].tolist()
+        self.normal_work, self.friction_work, self.driving_work, self._pending_driving = works
+        self.first_contact, self.last_contact = arrays["contact_times"].tolist()
+        self.contacts = int(arrays["contacts"])
+        self.touching = arrays["touching"]
+        self._latest = None
+        if len(arrays["latest_final"]):
+            tangential = None if self.slide == "free" else arrays["latest_tangential"]
+            self._latest = (
+                arrays["latest_nodes"], arrays["latest_normal"], tangential, arrays["latest_final"]
+            )  # fmt: skip
+        self._filtered_rows = arrays["filtered_rows"]
+        if self._previous_tangential is not None:
+            self._previous_tangential[:] = arrays["previous_tangential"]
+        self._near, self._near_X, self._near_mass = (
+            arrays[k] for k in ("near", "near_X", "near_mass")
+        )
+        self._near_nodes = self.nodes[self._near]
+        self._budget, self._travel, *self._anchor = arrays["near_budget"].tolist()
+        motion = {k[7:]: v for k, v in arrays.items() if k.startswith("motion_")}
+        self.motion.restore_state(motion)
+
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
         dt, motion, shape = state.dt, self.motion, self.shape

@@ -32,6 +32,19 @@ class FixedMotion:
     def advance(self, velocity: np.ndarray, dt: float) -> None:
         """Take ``velocity`` (m/s) as V^{n+1/2} and move by ``dt`` (s)."""
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The translation (m) and the velocities over the latest two steps (m/s)."""
+        return {
+            "offset": self.offset,
+            "velocity": self.velocity,
+            "previous_velocity": self.previous_velocity,
+        }
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.offset = arrays["offset"].copy()
+        self.velocity = arrays["velocity"].copy()
+        self.previous_velocity = arrays["previous_velocity"].copy()
+
 
 class _Translating(FixedMotion):
     """A wall that moves: each step translates it by dt times its velocity over the step."""

@@ -21,8 +21,8 @@ BAD = Path(__file__).resolve().parents[1] / "bad_scenes"
 @pytest.mark.parametrize(
     "command, scene, message",
     [
-        ("run", "53_mesh_file_geo_syntax_error.toml", "syntax_error.geo: gmsh cannot read it"),
-        ("check", "54_mesh_file_garbage.toml", "garbage.msh: not a gmsh mesh file"),
+        ("run", "62_mesh_file_geo_syntax_error.toml", "syntax_error.geo: gmsh cannot read it"),
+        ("check", "63_mesh_file_garbage.toml", "garbage.msh: not a gmsh mesh file"),
     ],
 )
 def test_a_bad_mesh_file_ends_every_rank_with_one_line(command, scene, message, tmp_path):

@@ -29,7 +29,24 @@ FULL = {
         "refine_size": 0.0015,
         "noise": {"amplitude": 1e-7, "seed": 7},
     },
-    "material": {"model": "linear_elastic", "density": 2700.0, "young": 70e9, "poisson": 0.3},
+    "material": {
+        "model": "johnson_cook",
+        "density": 8960.0,
+        "young": 124e9,
+        "poisson": 0.34,
+        "yield_stress": 90e6,
+        "hardening_coefficient": 292e6,
+        "hardening_exponent": 0.31,
+        "strain_rate_coefficient": 0.025,
+        "reference_strain_rate": 1.0,
+        "heating": {
+            "softening_exponent": 1.09,
+            "melting_temperature": 1356.0,
+            "specific_heat": 383.0,
+            "room_temperature": 294.0,
+            "taylor_quinney": 0.9,
+        },
+    },  # fmt: skip
     "element": {"integration": "reduced", "hourglass": "viscous"},
     "initial": {"velocity": [0.0, 0.0, -1.0]},
     "gravity": {"acceleration": [0.0, 0.0, -9.81]},
@@ -55,7 +72,40 @@ OTHERS = [
     FULL
     | {
         "mesh": {"shape": "round_bar", "radius": 0.01, "length": 0.1, "element_size": 0.01},
+        "material": {
+            "model": "elastic_plastic",
+            "density": 8930.0,
+            "young": 117e9,
+            "poisson": 0.35,
+            "hardening": "power",
+            "yield_stress": 400e6,
+            "hardening_coefficient": 1e8,
+            "hardening_exponent": 0.5,
+        },  # fmt: skip
         "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1], "slide": 1}],
+    },
+    FULL
+    | {
+        "material": {
+            "model": "elastic_plastic",
+            "density": 8930.0,
+            "young": 117e9,
+            "poisson": 0.35,
+            "hardening": "linear",
+            "yield_stress": 400e6,
+            "hardening_modulus": 1e8,
+        },  # fmt: skip
+    },
+    FULL
+    | {
+        "material": {
+            "model": "elastic_plastic",
+            "density": 8930.0,
+            "young": 117e9,
+            "poisson": 0.35,
+            "hardening": "table",
+            "hardening_curve": [[0.0, 400e6], [1.0, 500e6]],
+        },  # fmt: skip
     },
     FULL
     | {
@@ -137,7 +187,7 @@ def _one_line_or_scene(raw, source="fuzz.toml"):
 
 def test_full_scene_is_valid():
     scene = parse_scene(copy.deepcopy(FULL))
-    assert scene.walls[0].motion.mass == 1.0 and scene.element.hourglass_coefficient == 0.1
+    assert scene.walls[0].motion.mass == 1.0 and scene.element.hourglass_coefficient is None
 
 
 @pytest.mark.parametrize("where, name", list(_key_paths()), ids=".".join)

@@ -78,12 +78,12 @@ def test_seed_takes_the_whole_64_bit_range():
 
 
 def test_element_defaults_by_cell_type_and_form():
-    assert _parse(bar_scene(elements=4)).element == Element(None, "physical", 1.0)
-    assert Element() == Element(None, "physical", 1.0)
-    for form, coefficient in [("physical", 1.0), ("stiffness", 0.1), ("viscous", 0.1)]:
+    """None: decided when the body is built (the cell type, the form and the material)."""
+    assert _parse(bar_scene(elements=4)).element == Element(None, "physical", None)
+    assert Element() == Element(None, "physical", None)
+    for form in ("physical", "stiffness", "viscous", "none"):
         element = _parse(_with("element", hourglass=form)).element
-        assert element == Element(None, form, coefficient)
-    assert _parse(_with("element", hourglass="none")).element.hourglass_coefficient == 0.0
+        assert element == Element(None, form, None)
     given = _with("element", integration="reduced", hourglass="viscous", hourglass_coefficient=0.3)
     assert _parse(given).element == Element("reduced", "viscous", 0.3)
     full = _parse(_with("element", integration="full")).element

@@ -4,7 +4,7 @@ run.log), and the run goes on as the spec says:
 - secondary nodes that start behind a wall (the bar's axis flipped, or normal_point on
   the wrong side): before, 329 nodes were held at t = 0 without a word;
 - a wall whose secondary set is empty (refused when the scene's own exclusions emptied
-  it: ``bad_scenes/65_*``);
+  it: ``bad_scenes/74_*``);
 - nodes both prescribed by a [[boundary]] and secondary to a wall: the boundary
   condition wins on its components (it acts after the walls).
 

@@ -111,7 +111,6 @@ def test_full_integration_equals_ufl(cell, model):
     assert abs(stored - energy) < TOL * abs(energy) and hourglass == 0.0
 
 
-
 @pytest.mark.parametrize("model", MODELS)
 def test_physical_hourglass_equals_full_integration_on_parallelepipeds(model):
     """On a mesh of parallelepipeds, one point + physical hourglass control equals 2x2x2

@@ -12,6 +12,7 @@ class Push:
 
     name = "push"
     energy_names = ("internal",)
+    energy_parts = ()
     booked_force = None
 
     def __init__(self, a=1.0, fail=None):

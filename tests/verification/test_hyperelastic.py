@@ -18,7 +18,8 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
-from rwall_fem.hyperelasticity import StableStepMonitor, strain_energy_density
+from rwall_fem.hyperelasticity import strain_energy_density
+from rwall_fem.stable_step import TangentStepMonitor
 
 MODELS = ["saint_venant_kirchhoff", "neo_hookean"]
 
@@ -68,7 +69,7 @@ def test_stable_step_guard_stops_the_run(shared_dir):
     sim = build_simulation(
         parse_scene(bar("neo_hookean"), source="test"), MPI.COMM_WORLD, shared_dir
     )
-    monitor = next(r for r in sim.recorders if isinstance(r, StableStepMonitor))
+    monitor = next(r for r in sim.recorders if isinstance(r, TangentStepMonitor))
     monitor.dt_stable = 0.5 * sim.state.dt  # as if the deformation had halved the limit
     status = sim.run()
     assert status.startswith("stopped: step 0, t = 0 s: the deformation lowered the stable")
@@ -113,7 +114,7 @@ def test_stable_step_estimate_against_the_assembled_tangent(model, shared_dir):
     above it."""
     scene = fast_bar(model, dt_scale=0.5, integration="full")
     sim = build_simulation(scene, MPI.COMM_WORLD, shared_dir)
-    monitor = next(r for r in sim.recorders if isinstance(r, StableStepMonitor))
+    monitor = next(r for r in sim.recorders if isinstance(r, TangentStepMonitor))
     V = sim.internal.V
     u = fem.Function(V)
     F = ufl.variable(ufl.Identity(3) + ufl.grad(u))
