@@ -7,7 +7,6 @@ uncommitted changes to tracked files gets ``+dirty``.
 
 from __future__ import annotations
 
-import functools
 import platform
 import subprocess
 from pathlib import Path
@@ -15,7 +14,6 @@ from pathlib import Path
 __all__ = ["git_hash", "library_versions"]
 
 
-@functools.cache
 def git_hash() -> str | None:
     """The commit of the repository holding this package (``+dirty`` if modified), or None."""
     root = Path(__file__).resolve().parents[1]

@@ -73,8 +73,10 @@ def deformed_bounds(state, comm) -> list[list[float]]:
     """[min corner], [max corner] (m) of the body at the time of the latest step, read
     after its update (u^{n+1} - dt v^{n+1/2} = u^n)."""
     x = state.X + state.u - state.dt * state.v
-    low = comm.allreduce(x.min(axis=0, initial=np.inf), MPI.MIN)
-    high = comm.allreduce(x.max(axis=0, initial=-np.inf), MPI.MAX)
+    low, high = np.empty(3), np.empty(3)
+    # Buffers, not pickled objects: mpi4py 3 reduces pickled arrays with Python's min.
+    comm.Allreduce(x.min(axis=0, initial=np.inf), low, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
     return [low.tolist(), high.tolist()]
 
 
