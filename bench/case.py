@@ -132,7 +132,8 @@ def main():
     raw = scene(a.cell, a.n, a.steps, a.history_interval, wall=not a.no_wall)
     sc = parse_scene(raw, source="bench")
     t_build = time.perf_counter()
-    sim = build_simulation(sc, comm, f"/tmp/rwall-bench-{a.cell}-{a.n}-{comm.size}")
+    # A fixed number of steps is timed, whatever end_time: no size limits.
+    sim = build_simulation(sc, comm, f"/tmp/rwall-bench-{a.cell}-{a.n}-{comm.size}", limits=False)
     build_seconds = time.perf_counter() - t_build
     # Exactly a.steps + 1 steps (the loop runs steps 0..num_steps).
     sim.end_time = a.steps * sim.state.dt
@@ -248,7 +249,9 @@ def extras(sim, K, x, y, a):
     for _ in range(3):
         for label, (secondary, every) in variants.items():
             sc = parse_scene(scene(a.cell, a.n, a.steps, every, secondary), source="bench")
-            other = build_simulation(sc, comm, f"/tmp/rwall-bench-x-{a.cell}-{comm.size}")
+            other = build_simulation(
+                sc, comm, f"/tmp/rwall-bench-x-{a.cell}-{comm.size}", limits=False
+            )
             other.end_time = a.steps * other.state.dt
             other.run()
             steps[label].append(other.history.summary["wall_seconds"] / (a.steps + 1))

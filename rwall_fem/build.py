@@ -1,15 +1,23 @@
 """From a validated scene to a ready-to-run :class:`~rwall_fem.solver.Simulation`.
 
-Data flows one way: scene -> body (mesh, space, lumped mass, element technology) -> stable
-time step -> pipeline (internal force, body forces, walls, boundary conditions: only what
-the scene asks for) -> recorders (history, stable-step monitor, fields, frames) and the
+Data flows one way: scene -> checks that need no mesh (the results folder, the size
+limits of :mod:`rwall_fem.estimate`) -> body (mesh, space, lumped mass, element
+technology) -> stable time step -> pipeline (internal force, body forces, walls, boundary
+conditions: only what the scene asks for) -> what the starter of Radioss would warn
+about (nodes starting behind a wall, walls without nodes, nodes both clamped and held by
+a wall) -> recorders (history, run log, stable-step monitor, fields, frames) and the
 checkpoints.
+
+Every check that can fail on one rank alone (gmsh runs on rank 0; the results folder is
+checked there) is agreed on by all ranks, so a refusal is the same everywhere.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -21,26 +29,46 @@ from rwall_fem.boundary import VelocityBoundary
 from rwall_fem.checkpoint import Checkpoints, body_digest, scene_keys
 from rwall_fem.effects import Gravity
 from rwall_fem.elements import ElementForce, GhostedField, Technology
-from rwall_fem.mechanics import critical_time_step, element_time_step, lumped_mass
+from rwall_fem.estimate import (
+    LIFT_HINT,
+    estimate,
+    refuse_above_limits,
+    steps_above_limit,
+    unphysical_material,
+)
+from rwall_fem.mechanics import (
+    critical_time_step,
+    element_time_step,
+    lumped_mass,
+    shortest_edge,
+)
 from rwall_fem.meshing import (
     BodyMesh,
+    MeshTooLarge,
     body_mesh,
     boundary_nodes,
     coordinate_noise,
     group_nodes,
     perturb,
 )
+from rwall_fem.output.folder import ResultsFolder, check_folder
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.history import History
+from rwall_fem.output.run_log import RunLog, cycle_interval
+from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
 from rwall_fem.walls import RigidWall
 from rwall_fem.walls.motion import MainNodeMotion, PrescribedMotion
 from rwall_fem.walls.shapes import SHAPES
 
-__all__ = ["build_simulation", "run_scene"]
+__all__ = ["build_simulation", "run_in_folder", "run_scene"]
 
 log = logging.getLogger("rwall_fem")
+
+# The mesher leaves round-off (1e-19 m seen) on nodes placed on a wall: distances within
+# this fraction of the body's size count as zero, the tolerance of degenerate walls.
+_ROUND_OFF = 1e-10
 
 
 def run_scene(
@@ -49,18 +77,44 @@ def run_scene(
     overrides=(),
     comm: MPI.Comm = MPI.COMM_WORLD,
     *,
+    limits: bool = True,
     resume: bool = False,
 ) -> dict:
-    """Build and run a scene (object or TOML path); returns the summary written to ``out``.
-    With ``resume``, the run continues from the checkpoint in ``out``
-    (:mod:`rwall_fem.checkpoint`)."""
+    """Build and run a scene (object or TOML path) in its results folder, held for the run
+    (:class:`~rwall_fem.output.folder.ResultsFolder`); returns the summary written to
+    ``out``. ``limits=False`` lifts the size limits (``run.max_*``); with ``resume``, the
+    run continues from the checkpoint in ``out`` (:mod:`rwall_fem.checkpoint`)."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene, list(overrides))
-    sim = build_simulation(scene, comm, out)
-    if resume:
-        sim.checkpoints.resume(sim)
-    sim.run()
+    sim = build_simulation(scene, comm, out, limits=limits)
+    run_in_folder(sim, resume=resume)
     return sim.history.summary
+
+
+def run_in_folder(
+    sim: Simulation, said: Callable[[Simulation], None] | None = None, *, resume: bool = False
+) -> None:
+    """Run ``sim`` while holding its results folder (a
+    :class:`~rwall_fem.output.folder.ResultsFolder`: locked, and for a fresh run the
+    outputs of an earlier run removed, as ``run.log`` says; with ``resume``, continued from
+    its checkpoint instead); ``said(sim)`` reports how it ended before the last outputs
+    are awaited, and ``run.log`` ends with the time the outputs took."""
+    run_log = next(r for r in sim.recorders if isinstance(r, RunLog))
+    with ResultsFolder(sim.history.directory, sim.comm, fresh=not resume) as folder:
+        if resume:
+            sim.checkpoints.resume(sim)
+        if folder.removed:
+            run_log.facts.append(
+                f"removed the outputs of an earlier run: {', '.join(folder.removed)}"
+            )
+        sim.run()
+        if said is not None:
+            said(sim)
+        sim.history.wait()
+        line = f"outputs written {time.perf_counter() - run_log.ended_at:.2f} s after the time loop"
+        if run_log.frames:
+            log.info("%s", line)
+        run_log.write(line)
 
 
 def build_simulation(
@@ -69,19 +123,41 @@ def build_simulation(
     out: str | Path | None = None,
     *,
     body: BodyMesh | None = None,
+    limits: bool = True,
 ) -> Simulation:
     """Mesh the body, lump its mass, choose dt and assemble the pipeline.
 
     ``body`` is a mesh of your own (``BodyMesh(msh, facet_tags, groups)``, any
     distributed DOLFINx mesh of tetrahedra or hexahedra); it replaces the
     scene's ``[mesh]`` and sets the communicator. Outputs go to ``out``, by default
-    the scene's ``output.directory``.
+    the scene's ``output.directory``; that folder is checked first (nothing is written
+    to it here). Unless ``limits`` is False, a scene whose estimated or counted cells,
+    steps or frames pass ``run.max_cells``, ``run.max_steps`` or ``run.max_frames`` is
+    refused (before meshing when the estimate passes them).
     """
-    solid = _solid(scene, comm, body)
+    directory = Path(out) if out is not None else scene.output.directory
+    where = "--out" if out is not None else f"{scene.source}: output.directory"
+    check_folder(directory, where, comm)
+    if limits:
+        refuse_above_limits(scene, estimate(scene, comm.size))
+    solid = _solid(scene, comm, body, scene.run.max_cells if limits else None)
     dt = _time_step(scene, solid)
     sim = _pipeline(scene, solid, dt)
-    directory = Path(out) if out is not None else scene.output.directory
-    _add_recorders(sim, scene, solid, directory)
+    if limits:
+        steps_above_limit(scene, sim.num_steps, dt)
+    facts = [
+        _mesh_fact(solid, dt),
+        f"effects: {', '.join(sim.effects)}; {sim.num_steps} steps to t = "
+        f"{sim.num_steps * dt:.4g} s",
+    ]
+    for line in facts:
+        log.info("%s", line)
+    warnings = _starter_warnings(sim, solid)
+    for line in warnings:
+        log.warning("%s", line)
+    sim.info["warnings"] = warnings
+    facts += [*_constraint_facts(sim), *(f"warning: {w}" for w in warnings)]
+    _add_recorders(sim, scene, solid, directory, facts)
     identity = {
         "code": __version__,
         "dolfinx": _compat.DOLFINX_VERSION,
@@ -95,12 +171,6 @@ def build_simulation(
         steps=scene.output.checkpoint_steps,
         seconds=scene.output.checkpoint_seconds,
     )
-    log.info(
-        "effects: %s; %d steps to t = %.4g s",
-        ", ".join(sim.effects),
-        sim.num_steps,
-        sim.num_steps * dt,
-    )
     return sim
 
 
@@ -109,8 +179,8 @@ class _Solid:
     """The discretised body: its communicator and mesh, the P1/Q1 vector space, the owned
     nodes' reference coordinates (m) and lumped masses (kg), its displacement and velocity
     fields, its element technology with the linear elastic force of that technology (the
-    tangent at rest of every material), and the stable steps (s) from the largest
-    eigenvalue and from the shortest edge."""
+    tangent at rest of every material), the stable steps (s) from the largest
+    eigenvalue and from the shortest edge, and the diagonal of its box (m)."""
 
     comm: MPI.Comm
     body: BodyMesh
@@ -123,15 +193,16 @@ class _Solid:
     elastic: ElementForce
     dt_stable: float
     dt_element: float
+    size: float
 
     @property
     def owned(self) -> int:
         return len(self.X)
 
 
-def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
+def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _Solid:
     """The body of the scene's ``[mesh]`` (or ``body``), with its mass, its element
-    technology and stable step."""
+    technology and stable step; refused above ``max_cells`` cells (None: no limit)."""
     spec = scene.mesh
     if body is None and spec is None:
         raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
@@ -139,11 +210,16 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
         comm = body.msh.comm  # the caller's mesh: it lives as long as the caller keeps it
     else:  # keep the caller's comm: a DOLFINx 0.5 mesh's comm dies with the mesh
         try:
-            body = body_mesh(comm, spec)
-        except ValueError as err:  # e.g. a file with mixed cell types
-            raise SceneError(f"{scene.source}: mesh: {err}") from None
-    if spec is not None and spec.noise is not None:
-        perturb(body, *spec.noise)
+            body = body_mesh(comm, spec, max_cells)
+        except MeshTooLarge as err:
+            raise SceneError(
+                f"{scene.source}: run.max_cells: the mesh has {err.cells} cells, more than "
+                f"run.max_cells = {max_cells:g}; coarsen the mesh, raise run.max_cells, "
+                f"{LIFT_HINT}"
+            ) from None
+        except ValueError as err:  # a file gmsh cannot read, mixed cell types, ...
+            where = "mesh.file" if spec.file is not None else "mesh"
+            raise SceneError(f"{scene.source}: {where}: {err}") from None
     cell = body.msh.topology.cell_type.name
     if cell not in ("tetrahedron", "hexahedron"):
         raise SceneError(
@@ -161,6 +237,10 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
     except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
         raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
     V = _compat.vector_space(body.msh)
+    if spec is not None and spec.noise is not None:
+        if spec.file is not None:  # a built-in shape's noise was checked with the scene
+            _noise_is_small(scene, shortest_edge(V))
+        perturb(body, *spec.noise)
     X = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local].copy()
     try:
         mass = lumped_mass(V, scene.material.density)
@@ -168,9 +248,42 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None) -> _Solid:
         raise SceneError(f"{scene.source}: mesh: {err}") from None
     u, v = GhostedField(V), GhostedField(V)
     elastic = ElementForce(V, replace(scene.material, model="linear_elastic"), technology, u, v)
-    dt_stable = critical_time_step(elastic, mass, X, comm)
+    dt_stable = _stable_step(scene, elastic, mass, X, comm)
     dt_element = element_time_step(V, scene.material)
-    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, dt_element)
+    low, high = np.empty(3), np.empty(3)
+    comm.Allreduce(X.min(axis=0, initial=np.inf), low, op=MPI.MIN)
+    comm.Allreduce(X.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
+    size = float(np.linalg.norm(high - low))
+    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, dt_element, size)
+
+
+def _noise_is_small(scene: Scene, edge: float) -> None:
+    """The rule of the scene's built-in shapes for a mesh file: a noise amplitude of at
+    most 0.1 x the shortest edge (m)."""
+    amplitude = scene.mesh.noise[0]
+    if amplitude > 0.1 * edge:
+        raise SceneError(
+            f"{scene.source}: mesh.noise.amplitude: {amplitude:g} m is more than 0.1 x the "
+            f"shortest edge of the mesh file ({edge:g} m): it would distort the elements and "
+            f"shrink the stable step; at most {0.1 * edge:g} m"
+        )
+
+
+def _stable_step(scene: Scene, elastic: ElementForce, mass, X, comm) -> float:
+    """The stable step (s) of :func:`critical_time_step`, or one line naming the material
+    when the eigenvalue cannot be found (e.g. a density off by orders of magnitude)."""
+    from petsc4py import PETSc
+
+    try:
+        dt = critical_time_step(elastic, mass, X, comm)
+    except (RuntimeError, PETSc.Error) as err:
+        reason = " ".join(str(err).split())
+        dt = math.nan
+    else:
+        reason = f"it came out as {dt:g} s"
+    if not (math.isfinite(dt) and dt > 0.0):
+        raise unphysical_material(scene, reason)
+    return dt
 
 
 def _time_step(scene: Scene, solid: _Solid) -> float:
@@ -182,21 +295,17 @@ def _time_step(scene: Scene, solid: _Solid) -> float:
                 f"{solid.dt_stable:.6g} s (2/omega_max); use a smaller dt or drop it to use "
                 "dt_scale"
             )
-        dt = scene.run.dt
-    else:
-        dt = _round_down(scene.run.dt_scale * solid.dt_stable)
-    log.info(
-        "mesh: %d %s cells, %d nodes; %s; stable dt %.4g s (eigenvalue), %.4g s (shortest edge /"
-        " c_p); dt = %.4g s",
-        solid.body.num_cells,
-        solid.body.msh.topology.cell_type.name,
-        solid.V.dofmap.index_map.size_global,
-        solid.technology.describe(),
-        solid.dt_stable,
-        solid.dt_element,
-        dt,
+        return scene.run.dt
+    return _round_down(scene.run.dt_scale * solid.dt_stable)
+
+
+def _mesh_fact(solid: _Solid, dt: float) -> str:
+    return (
+        f"mesh: {solid.body.num_cells} {solid.body.msh.topology.cell_type.name} cells, "
+        f"{solid.V.dofmap.index_map.size_global} nodes; {solid.technology.describe()}; stable "
+        f"dt {solid.dt_stable:.4g} s (eigenvalue), {solid.dt_element:.4g} s (shortest edge / "
+        f"c_p); dt = {dt:.4g} s"
     )
-    return dt
 
 
 def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
@@ -217,6 +326,8 @@ def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
         boundaries=[_boundary(scene, i, solid) for i in range(len(scene.boundaries))],
         info={
             "scene": scene.source,
+            "version": __version__,
+            "git_hash": comm.bcast(git_hash() if comm.rank == 0 else None, root=0),
             "dolfinx_version": _compat.DOLFINX_VERSION,
             "cell": solid.body.msh.topology.cell_type.name,
             "element": solid.technology.describe(),
@@ -229,9 +340,13 @@ def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
     )
 
 
-def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path) -> None:
-    """The history (always), the stable-step monitor of a hyperelastic body, and the
-    fields and frames the scene asks for."""
+def _add_recorders(
+    sim: Simulation, scene: Scene, solid: _Solid, directory: Path, facts: list[str]
+) -> None:
+    """The history and the run log (always; ``facts`` are the run log's lines on what was
+    built), the stable-step monitor of a hyperelastic body, and the fields and frames the
+    scene asks for. The run log is the first recorder: it closes right after the history,
+    before the fields and frames, and says what is still being written."""
     owned = np.arange(solid.owned, dtype=np.int32)
     guards = Guards(
         sim.comm,
@@ -246,6 +361,12 @@ def _add_recorders(sim: Simulation, scene: Scene, solid: _Solid, directory: Path
         guards=guards,
         plot=scene.output.plot,
     )
+    every = cycle_interval(sim.num_steps, scene.output.print_interval)
+    run_log = RunLog(
+        directory, scene, facts, num_steps=sim.num_steps, every=every, comm=sim.comm,
+        frames=scene.output.frames,
+    )  # fmt: skip
+    sim.recorders.append(run_log)
     if scene.material.plastic:
         from rwall_fem.stable_step import ElementStepMonitor
 
@@ -372,19 +493,67 @@ def _secondary_nodes(spec: WallSpec, where: str, shape, solid: _Solid, state: St
     if sec.search_distance is None and not sec.add:
         selected[_owned(boundary_nodes(V), owned)] = True
     if sec.search_distance is not None:
-        # The mesher leaves round-off (1e-19 m seen) on nodes placed at d = 0: distances
-        # within 1e-10 of the body size count as zero, the tolerance of degenerate walls.
-        comm = V.mesh.comm
-        low, high = np.empty(3), np.empty(3)
-        comm.Allreduce(state.X.min(axis=0, initial=np.inf), low, op=MPI.MIN)
-        comm.Allreduce(state.X.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
         d = shape.distance(state.X)
-        selected |= (d >= -1e-10 * np.linalg.norm(high - low)) & (d <= sec.search_distance)
+        selected |= (d >= -_ROUND_OFF * solid.size) & (d <= sec.search_distance)
     for name in sec.add:
         selected[_owned(group_nodes(V, body, name), owned)] = True
+    before = V.mesh.comm.allreduce(int(selected.sum()))
     for name in sec.exclude:
         selected[_owned(group_nodes(V, body, name), owned)] = False
+    if before and not V.mesh.comm.allreduce(int(selected.sum())):
+        raise SceneError(
+            f"{where}.secondary.exclude: leaves the wall no secondary node (it removes all "
+            f"{before} selected); exclude fewer node sets"
+        )
     return np.flatnonzero(selected)
+
+
+def _constraint_facts(sim: Simulation) -> list[str]:
+    """A line per wall and boundary condition: what it is and how many nodes it holds."""
+    comm = sim.comm
+    lines = []
+    for w in sim.walls:
+        count = comm.allreduce(len(w.nodes))
+        lines.append(f"{w.name}: {w.shape.kind}, slide {w.slide}, {count} secondary nodes")
+    for b in sim.boundaries:
+        count = comm.allreduce(len(b.nodes))
+        axes = "".join("xyz"[i] for i in b.axes)
+        lines.append(f"{b.name}: {count} nodes, components {axes}")
+    return lines
+
+
+def _starter_warnings(sim: Simulation, solid: _Solid) -> list[str]:
+    """What Radioss's starter warns about, one line each: secondary nodes that start
+    behind a wall (kept there, ``docs/theory.md``), a wall without secondary nodes, nodes
+    both prescribed by a boundary condition and secondary to a wall (the condition wins
+    on its components: it acts after the walls)."""
+    comm, warnings = sim.comm, []
+    for w in sim.walls:
+        w.find_initial_penetration(sim.state, _ROUND_OFF * solid.size)
+        if w.initially_penetrated:
+            x = ", ".join(f"{c:.4g}" for c in w.deepest_position)
+            warnings.append(
+                f"{w.name}: {w.initially_penetrated} secondary nodes start behind the wall, "
+                f"the deepest {w.deepest_penetration:.4g} m at ({x}) m; the wall keeps them "
+                "there unless one step takes them out (is the normal on the body's side? is "
+                "the body where it should be?)"
+            )
+        if not comm.allreduce(len(w.nodes)):
+            warnings.append(
+                f"{w.name}: no secondary node; the wall acts on nothing (widen "
+                "secondary.search_distance, or add node sets)"
+            )
+    for b in sim.boundaries:
+        axes = "".join("xyz"[i] for i in b.axes)
+        for w in sim.walls:
+            shared = comm.allreduce(len(np.intersect1d(b.nodes, w.nodes)))
+            if shared:
+                warnings.append(
+                    f"{b.name} prescribes components {axes} of {shared} nodes that are also "
+                    f"secondary to {w.name}: on those components the boundary condition wins "
+                    "(it acts after the walls), on the others the wall acts"
+                )
+    return warnings
 
 
 def _owned(nodes: np.ndarray, owned: int) -> np.ndarray:

@@ -6,15 +6,22 @@
 - ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
-Exit codes: 0 done, 2 bad input (one line on stderr, no traceback; also a checkpoint
-that does not fit the scene), 3 run stopped by a guard or by SIGTERM (one line on
-stderr; the outputs up to the stop are kept, and a checkpoint of the step), 4 an output
-could not be written at the end of the run (one line on stderr; the others are written).
+Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
+checkpoint that does not fit the scene), 3 run stopped by a guard, SIGTERM or SIGINT
+(Ctrl-C) (one line on stderr; the outputs up to the stop are kept, and a checkpoint of
+the step), 4 an output could not be written at the end of the run (one line on stderr;
+the others are written).
+
+Messages: facts on stdout, warnings and errors on stderr, each line starting with
+``rwall-fem:``; only rank 0 speaks. ``--quiet`` keeps warnings and errors. While a run
+goes, a terminal shows a progress bar; otherwise (a batch job, ``mpirun``) stderr gets a
+cycle line at the interval of ``run.log``.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import logging
 import sys
 import time
@@ -43,8 +50,13 @@ def main(argv: list[str] | None = None) -> int:
             metavar="KEY=VALUE",
             help="override a scene key, value read as TOML (e.g. mesh.element_size=5e-4)",
         )
+        sub.add_argument(
+            "--lift-limits",
+            action="store_true",
+            help="run whatever the size (run.max_cells, run.max_steps, run.max_frames)",
+        )
     run.add_argument("--out", help="results directory (default: the scene's output.directory)")
-    run.add_argument("--quiet", action="store_true", help="print only errors")
+    run.add_argument("--quiet", action="store_true", help="print only warnings and errors")
     run.add_argument(
         "--resume",
         action="store_true",
@@ -72,70 +84,141 @@ def main(argv: list[str] | None = None) -> int:
     from mpi4py import MPI
 
     from rwall_fem.checkpoint import CheckpointError
+    from rwall_fem.kernels import KernelBuildError
     from rwall_fem.output import OutputError
     from rwall_fem.scene import SceneError
 
     comm = MPI.COMM_WORLD
     quiet = getattr(args, "quiet", False)
-    logging.getLogger().setLevel(logging.WARNING)  # the form compiler logs at INFO
-    log = logging.getLogger("rwall_fem")
-    for old in list(log.handlers):  # main() may run more than once in a process (tests)
-        log.removeHandler(old)
-    handler = logging.StreamHandler(sys.stdout)
-    handler.setFormatter(logging.Formatter("rwall-fem: %(message)s"))
-    log.addHandler(handler)
-    log.propagate = False
-    log.setLevel(logging.WARNING if quiet or comm.rank != 0 else logging.INFO)
+    _set_up_logging(quiet, comm.rank)
     try:
         if args.command == "check":
-            return _check(args.scene, args.overrides, comm)
-        summary = _run(args.scene, args.out, args.overrides, comm, quiet, args.resume)
-    except (SceneError, CheckpointError) as err:
+            return _check(args.scene, args.overrides, comm, args.lift_limits)
+        summary = _run(
+            args.scene, args.out, args.overrides, comm, quiet, args.lift_limits, args.resume
+        )
+    except (SceneError, CheckpointError, KernelBuildError) as err:
         if comm.rank == 0:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
         return 2
     except (OutputError, OSError) as err:
         print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
         return 4
-    if summary["status"] != "done":
+    except KeyboardInterrupt:  # Ctrl-C outside the time loop (in it, the run stops cleanly)
         if comm.rank == 0:
-            print(f"rwall-fem: stopped: {summary['reason']}", file=sys.stderr)
+            print("rwall-fem: stopped: interrupted (SIGINT, Ctrl-C)", file=sys.stderr)
         return 3
+    except Exception:
+        if comm.size == 1:
+            raise
+        # A failure of this rank alone: the others may wait for it in a collective call.
+        import traceback
+
+        traceback.print_exc()
+        print(f"rwall-fem: error: internal error on rank {comm.rank}", file=sys.stderr)
+        comm.Abort(1)
+    return 0 if summary["status"] == "done" else 3
+
+
+def _set_up_logging(quiet: bool, rank: int) -> None:
+    """``rwall_fem``'s logger: facts on stdout (unless ``quiet``), warnings on stderr, rank 0
+    only. Below warnings, nothing else reaches the root logger's handlers: the form
+    compiler's JIT (FFCx through setuptools) logs its gcc commands there at INFO."""
+    root = logging.getLogger()
+    root.setLevel(logging.WARNING)
+    if not any(isinstance(f, _WarningsOnly) for f in root.filters):
+        root.addFilter(_WarningsOnly())
+    log = logging.getLogger("rwall_fem")
+    for old in list(log.handlers):  # main() may run more than once in a process (tests)
+        log.removeHandler(old)
+    facts = _Console("stdout")
+    facts.setFormatter(logging.Formatter("rwall-fem: %(message)s"))
+    facts.addFilter(lambda record: record.levelno < logging.WARNING)
+    warnings = _Console("stderr")
+    warnings.setLevel(logging.WARNING)
+    warnings.setFormatter(logging.Formatter("rwall-fem: warning: %(message)s"))
+    log.addHandler(facts)
+    log.addHandler(warnings)
+    log.propagate = False
+    level = logging.WARNING if quiet else logging.INFO
+    log.setLevel(level if rank == 0 else logging.CRITICAL + 1)  # only rank 0 speaks
+
+
+class _Console(logging.StreamHandler):
+    """A handler writing to ``sys.<name>`` as it is when a record comes (tests swap it)."""
+
+    def __init__(self, name: str):
+        self._stream_name = name
+        super().__init__()
+
+    @property
+    def stream(self):
+        return getattr(sys, self._stream_name)
+
+    @stream.setter
+    def stream(self, value):
+        """The stream is always the current ``sys.<name>``."""
+
+
+class _WarningsOnly(logging.Filter):
+    """Drops records below WARNING, whatever level the root logger is set to later
+    (setuptools sets it to INFO while it compiles)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.levelno >= logging.WARNING
+
+
+def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resume: bool) -> dict:
+    from rwall_fem.build import build_simulation, run_in_folder
+    from rwall_fem.output.run_log import CycleLines, cycle_interval
+    from rwall_fem.scene import load_scene
+
+    scene = load_scene(scene_file, overrides)
+    sim = build_simulation(scene, comm, out, limits=not lift_limits)
     if comm.rank == 0 and not quiet:
+        if sys.stderr.isatty():
+            from rwall_fem.output.progress import Progress
+
+            sim.recorders.append(Progress(sim.num_steps))
+        else:
+            every = cycle_interval(sim.num_steps, scene.output.print_interval)
+            sim.recorders.append(CycleLines(sys.stderr, sim.num_steps, every))
+    run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet), resume=resume)
+    return sim.history.summary
+
+
+def _say_how_it_ended(sim, quiet: bool) -> None:
+    """One line from rank 0: stopped (stderr, always) or done (stdout, unless quiet)."""
+    summary = sim.history.summary
+    if sim.comm.rank != 0:
+        return
+    if summary["status"] != "done":
+        print(f"rwall-fem: stopped: {summary['reason']}", file=sys.stderr, flush=True)
+    elif not quiet:
         e = summary["energy"]
         print(
             f"rwall-fem: done: {summary['steps']} steps of {summary['dt']:.4g} s on "
             f"{summary['ranks']} rank(s) in {summary['wall_seconds']:.2f} s; "
-            f"max energy balance error {e['max_balance_error']:.2e}"
+            f"max energy balance error {e['max_balance_error']:.2e}",
+            flush=True,
         )
-    return 0
 
 
-def _run(scene_file, out, overrides, comm, quiet: bool, resume: bool) -> dict:
-    from rwall_fem.build import build_simulation
-    from rwall_fem.scene import load_scene
-
-    sim = build_simulation(load_scene(scene_file, overrides), comm, out)
-    if resume:
-        sim.checkpoints.resume(sim)
-    if comm.rank == 0 and not quiet and sys.stderr.isatty():
-        from rwall_fem.output.progress import Progress
-
-        sim.recorders.append(Progress(sim.num_steps))
-    sim.run()
-    return sim.history.summary
-
-
-def _check(scene_file, overrides, comm) -> int:
-    """Build everything a run needs (mesh, mass, stiffness, stable step, effects) and print
-    it, with the wall time estimated from the cost of the internal force."""
+def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
+    """Print the size of the run estimated before meshing, then build everything a run
+    needs (mesh, mass, stiffness, stable step, effects; refused as ``run`` would) and
+    print it, with the wall time estimated from the cost of the internal force."""
     from mpi4py import MPI
 
     from rwall_fem.build import build_simulation
+    from rwall_fem.estimate import estimate
     from rwall_fem.scene import load_scene
 
     scene = load_scene(scene_file, overrides)
-    sim = build_simulation(scene, comm, out=None)
+    guess = estimate(scene, comm.size)  # on every rank: it may refuse the scene
+    if comm.rank == 0:
+        print(f"rwall-fem: estimate before meshing: {guess.describe()}")
+    sim = build_simulation(scene, comm, out=None, limits=not lift_limits)
     started = time.perf_counter()
     for _ in range(5):
         sim.internal.accelerate(sim.state)

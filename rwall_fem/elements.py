@@ -35,7 +35,6 @@ from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
 
-PLASTIC_MODELS = ("elastic_plastic", "johnson_cook")
 # The flow-stress laws of the kernels (kernels/plasticity.h).
 HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
 
@@ -154,11 +153,11 @@ class ElementForce:
 
     def __init__(self, V, material, technology: Technology, u: GhostedField, v: GhostedField):
         model = material.model
-        if model not in MODELS and model not in PLASTIC_MODELS:
+        self.plastic = material.plastic
+        if model not in MODELS and not self.plastic:
             raise ValueError(f"no element kernel for the material model {model!r}")
         self.name = model
         self.technology = technology
-        self.plastic = model in PLASTIC_MODELS
         self.conservative = technology.conservative and not self.plastic
         hourglass = technology.integration == "reduced" and technology.hourglass != "none"
         self.energy_names = ("internal", "hourglass") if hourglass else ("internal",)
@@ -371,6 +370,7 @@ class ElementForce:
         self._started = bool(arrays["started"])
         if self.plastic:
             self.history[...] = arrays["history"]
+
 
 # Node permutations that turn a cell inside out: a mirror of its reference cell.
 _MIRROR = {4: [0, 2, 1, 3], 8: [1, 0, 3, 2, 5, 4, 7, 6]}

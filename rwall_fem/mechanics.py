@@ -25,6 +25,7 @@ __all__ = [
     "critical_time_step",
     "element_time_step",
     "lumped_mass",
+    "shortest_edge",
     "stiffness_form",
     "strain",
     "stress",
@@ -142,11 +143,15 @@ def coordinate_pattern(X: np.ndarray) -> np.ndarray:
     return np.sin(X @ np.array([12.9898, 78.233, 37.719]) * 1e3)
 
 
-def element_time_step(V, material: Material) -> float:
-    """Element-size estimate of the stable step: shortest edge / p-wave speed (s)."""
+def shortest_edge(V) -> float:
+    """The shortest cell edge of the mesh of ``V`` (m), over all ranks."""
     x = V.tabulate_dof_coordinates()
     nodes = _compat.cell_nodes(V)[: V.mesh.topology.index_map(V.mesh.topology.dim).size_local]
     pairs = np.array(EDGES[V.mesh.topology.cell_type.name])
     lengths = np.linalg.norm(x[nodes[:, pairs[:, 0]]] - x[nodes[:, pairs[:, 1]]], axis=-1)
-    shortest = V.mesh.comm.allreduce(lengths.min(initial=np.inf), op=MPI.MIN)
-    return shortest / material.p_wave_speed
+    return V.mesh.comm.allreduce(lengths.min(initial=np.inf), op=MPI.MIN)
+
+
+def element_time_step(V, material: Material) -> float:
+    """Element-size estimate of the stable step: shortest edge / p-wave speed (s)."""
+    return shortest_edge(V) / material.p_wave_speed

@@ -18,6 +18,7 @@ from rwall_fem import _compat
 
 __all__ = [
     "BodyMesh",
+    "MeshTooLarge",
     "Refinement",
     "bar_mesh",
     "body_mesh",
@@ -62,11 +63,21 @@ class Refinement:
     radius: float
 
 
-def body_mesh(comm: MPI.Comm, spec) -> BodyMesh:
-    """The body a scene's ``[mesh]`` table (a :class:`~rwall_fem.scene.MeshSpec`) describes."""
+class MeshTooLarge(ValueError):
+    """gmsh made (or read) more cells than allowed; ``cells`` is how many."""
+
+    def __init__(self, cells: int):
+        super().__init__(f"{cells} cells")
+        self.cells = cells
+
+
+def body_mesh(comm: MPI.Comm, spec, max_cells: float | None = None) -> BodyMesh:
+    """The body a scene's ``[mesh]`` table (a :class:`~rwall_fem.scene.MeshSpec`) describes;
+    :class:`MeshTooLarge` when it has more than ``max_cells`` cells."""
     if spec.file is not None:
-        return read_mesh(comm, spec.file)
+        return read_mesh(comm, spec.file, max_cells=max_cells)
     common = {"element_size": spec.element_size, "cell": spec.cell, "axis": spec.axis}
+    common["max_cells"] = max_cells
     if spec.refine_point is not None:
         common["refine"] = Refinement(spec.refine_point, spec.refine_size, spec.refine_radius)
     if spec.shape == "bar":
@@ -96,6 +107,7 @@ def bar_mesh(
     cell: str,
     axis=(0.0, 0.0, 1.0),
     refine: Refinement | None = None,
+    max_cells: float | None = None,
 ) -> BodyMesh:
     """Rectangular bar ``meshes/bar.geo``: the box ``origin`` + [0, size] (m), turned about
     ``origin`` so that its own z axis points along ``axis``.
@@ -104,7 +116,7 @@ def bar_mesh(
     Structured unless ``refine`` is given (then an unstructured section swept in graded layers).
     """
     params = dict(zip(("lx", "ly", "lz"), size, strict=True))
-    return _swept_body(comm, "bar.geo", params, origin, axis, element_size, cell, refine)
+    return _swept_body(comm, "bar.geo", params, origin, axis, element_size, cell, refine, max_cells)
 
 
 def round_bar_mesh(
@@ -116,6 +128,7 @@ def round_bar_mesh(
     cell: str,
     axis=(0.0, 0.0, 1.0),
     refine: Refinement | None = None,
+    max_cells: float | None = None,
 ) -> BodyMesh:
     """Cylinder ``meshes/round_bar.geo`` of ``radius`` and ``length`` (m): its own z axis from
     ``origin`` (the centre of its bottom face) turned onto ``axis``.
@@ -124,7 +137,9 @@ def round_bar_mesh(
     axis in layers at most ``element_size`` thick: hexahedra, or prisms split into tetrahedra.
     """
     params = {"radius": radius, "length": length}
-    return _swept_body(comm, "round_bar.geo", params, origin, axis, element_size, cell, refine)
+    return _swept_body(
+        comm, "round_bar.geo", params, origin, axis, element_size, cell, refine, max_cells
+    )
 
 
 def plate_mesh(
@@ -136,6 +151,7 @@ def plate_mesh(
     axis=(0.0, 0.0, 1.0),
     layers: int = 0,
     refine: Refinement | None = None,
+    max_cells: float | None = None,
 ) -> BodyMesh:
     """Plate ``meshes/plate.geo``: the box ``origin`` + [0, size] (m) with the thickness
     ``size[2]`` along its own z, turned about ``origin`` so that its own z points along ``axis``.
@@ -143,7 +159,9 @@ def plate_mesh(
     ``layers`` elements through the thickness (0: the fewest at most ``element_size`` thick).
     """
     params = dict(zip(("lx", "ly", "thickness"), size, strict=True)) | {"layers": layers}
-    return _swept_body(comm, "plate.geo", params, origin, axis, element_size, cell, refine)
+    return _swept_body(
+        comm, "plate.geo", params, origin, axis, element_size, cell, refine, max_cells
+    )
 
 
 def plate_with_hole_mesh(
@@ -157,6 +175,7 @@ def plate_with_hole_mesh(
     hole_offset=(0.0, 0.0),
     layers: int = 0,
     refine: Refinement | None = None,
+    max_cells: float | None = None,
 ) -> BodyMesh:
     """:func:`plate_mesh` with a circular through-hole (``meshes/plate_with_hole.geo``) of
     ``hole_radius`` (m), its centre ``hole_offset`` (m, own x and y) from the plate's centre.
@@ -167,11 +186,11 @@ def plate_with_hole_mesh(
     params |= {"hole_radius": hole_radius, "layers": layers}
     params |= dict(zip(("hole_dx", "hole_dy"), hole_offset, strict=True))
     return _swept_body(
-        comm, "plate_with_hole.geo", params, origin, axis, element_size, cell, refine
+        comm, "plate_with_hole.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
 
 
-def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine) -> BodyMesh:
+def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine, max_cells) -> BodyMesh:
     """Mesh ``meshes/<geo>`` in the body's own frame and turn it about ``origin`` onto ``axis``."""
     origin = np.asarray(origin, dtype=float)
     R = rotation_to(axis)
@@ -185,7 +204,7 @@ def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine) -> 
     # Shipped as the package rwall_fem.meshes (the repository's meshes/ folder); gmsh reads
     # the file from disk and finds its Include "refine.geo" beside it.
     with importlib.resources.as_file(importlib.resources.files("rwall_fem.meshes") / geo) as path:
-        body = read_mesh(comm, path, params)
+        body = read_mesh(comm, path, params, max_cells)
     x = body.msh.geometry.x
     x[:] = (x - origin) @ R.T + origin
     return body
@@ -202,50 +221,105 @@ def rotation_to(axis) -> np.ndarray:
     return np.eye(3) + K + K @ K / (1 + c)
 
 
-def read_mesh(comm: MPI.Comm, path: Path, parameters: dict[str, float] | None = None) -> BodyMesh:
-    """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``."""
+def read_mesh(
+    comm: MPI.Comm,
+    path: Path,
+    parameters: dict[str, float] | None = None,
+    max_cells: float | None = None,
+) -> BodyMesh:
+    """Mesh a gmsh ``.geo`` (with ``DefineConstant`` ``parameters``) or read a ``.msh``.
+
+    Rank 0 runs gmsh alone; whatever goes wrong there (a syntax error, a file that is not
+    a mesh, no cells, mixed cell types, more than ``max_cells`` cells: a
+    :class:`MeshTooLarge`) reaches every rank as the same ``ValueError`` of one line,
+    before any collective call that the others would wait in for ever.
+    """
     import gmsh
 
-    groups, error = None, None
+    groups, error, cells = None, None, 0
     if comm.rank == 0:
         argv = [""]
         for name, value in (parameters or {}).items():
             argv += ["-setnumber", name, repr(float(value))]
-        gmsh.initialize(argv)
-        gmsh.option.setNumber("General.Terminal", 0)
-        # ONELAB keeps DefineConstant values across sessions in a process: start afresh, so
-        # that a parameter not given takes its default in the .geo, not the last file's value.
-        gmsh.onelab.clear()
-        gmsh.open(str(path))
-        if len(gmsh.model.mesh.getElements(3)[0]) == 0:
-            gmsh.model.mesh.generate(3)
-        groups = {
-            gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
-            for dim, tag in gmsh.model.getPhysicalGroups()
-            if dim == 2
-        }
-        if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
-            # DOLFINx reads only cells that belong to a physical group.
-            gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
-        kinds = [
-            gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)
-        ]
-        if len(kinds) > 1:
-            error = (
-                f"{path.name}: mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
-                " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
-            )
-    groups, error = comm.bcast((groups, error), root=0)
-    if error:
+        gmsh.initialize(argv, readConfigFiles=False)
+        try:
+            groups = _gmsh_model(Path(path))
+            cells = sum(len(tags) for tags in gmsh.model.mesh.getElements(3)[1])
+        except _GmshError as err:
+            error = f"{Path(path).name}: {err}"
+        except UnicodeDecodeError:  # gmsh's own message quotes the file's bytes
+            error = f"{Path(path).name}: gmsh cannot read it: not a mesh or a geometry file"
+        except Exception as err:  # gmsh raises plain Exceptions, naming the file
+            error = " ".join(str(err).replace(f"'{path}', ", "").split())
+            error = f"{Path(path).name}: gmsh cannot read it: {error}"
+    groups, error, cells = comm.bcast((groups, error, cells), root=0)
+    if error or (max_cells is not None and cells > max_cells):
         if comm.rank == 0:
             gmsh.finalize()
-        raise ValueError(error)
+        raise ValueError(error) if error else MeshTooLarge(cells)
     try:
         msh, _, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
     finally:
         if comm.rank == 0:
             gmsh.finalize()
     return BodyMesh(msh, facet_tags, groups)
+
+
+class _GmshError(Exception):
+    """What is wrong with the model gmsh read, in one line."""
+
+
+def _gmsh_model(path: Path) -> dict[str, int]:
+    """Open ``path`` in the current gmsh session, mesh it in 3-D if it holds no volume
+    cells, and return its named surface groups; raises on anything DOLFINx cannot take."""
+    import gmsh
+
+    _looks_like_gmsh(path)
+    gmsh.option.setNumber("General.Terminal", 0)
+    # Never ask "Do you really want to continue?" on stdin (tiny sizes): the size limits
+    # of rwall_fem.estimate refuse such scenes before they get here, unless lifted.
+    gmsh.option.setNumber("General.ExpertMode", 1)
+    # ONELAB keeps DefineConstant values across sessions in a process: start afresh, so
+    # that a parameter not given takes its default in the .geo, not the last file's value.
+    gmsh.onelab.clear()
+    gmsh.open(str(path))
+    if len(gmsh.model.mesh.getElements(3)[0]) == 0:
+        gmsh.model.mesh.generate(3)
+    if not any(len(gmsh.model.mesh.getElements(dim)[0]) for dim in (2, 3)):
+        raise _GmshError("no cells: the file holds no mesh, and no geometry to mesh")
+    groups = {
+        gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
+        for dim, tag in gmsh.model.getPhysicalGroups()
+        if dim == 2
+    }
+    if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
+        # DOLFINx reads only cells that belong to a physical group.
+        gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
+    kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)]
+    if len(kinds) > 1:
+        raise _GmshError(
+            f"mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
+            " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
+        )
+    return groups
+
+
+def _looks_like_gmsh(path: Path) -> None:
+    """Refuse a .msh that does not start as one, or a .geo that is not text, before gmsh
+    reads it: on bytes it cannot parse, gmsh queues errors that it raises again in later
+    calls of the process (seen with gmsh 4.8 and 4.15), failing the next good file."""
+    with open(path, "rb") as file:
+        head = file.read(4096)
+    if path.suffix == ".msh" and not head.lstrip().startswith(b"$MeshFormat"):
+        raise _GmshError("not a gmsh mesh file (it does not start with $MeshFormat)")
+    if path.suffix == ".geo":
+        try:
+            if b"\0" in head:
+                raise UnicodeDecodeError("utf-8", head, head.index(b"\0"), len(head), "NUL")
+            head.decode("utf-8")
+        except UnicodeDecodeError as err:
+            if err.end < len(head) or err.reason == "NUL":  # not a cut multi-byte character
+                raise _GmshError(f"not a text file (binary data at byte {err.start})") from None
 
 
 def boundary_nodes(V) -> np.ndarray:

@@ -227,7 +227,8 @@ class Simulation:
     update: CentralDifference | None = None  # built from the state when not given
     wall_seconds: float = 0.0  # of the time loop, on this rank
     status: str = "not run"  # "done", "stopped: <reason>" or "failed: <error>"
-    terminate_requested: bool = False  # set by SIGTERM; acted on at the next history sample
+    # Names of the stop signals received ("SIGTERM", "SIGINT"); the history acts on them.
+    stop_requests: set[str] = field(default_factory=set)
     checkpoints: Any = None  # rwall_fem.checkpoint.Checkpoints: written after the history
     first_step: int = 0  # after a resume, the step after the checkpoint's
 
@@ -267,12 +268,18 @@ class Simulation:
         ``end_time`` (s), then close every recorder.
 
         Returns ``self.status``: "done", or "stopped: ..." when a guard (see
-        :mod:`rwall_fem.output.guards`) or SIGTERM stopped the run; the outputs up to
-        the last sample stay valid, and a stop after a whole step writes a checkpoint.
-        Any other error propagates after every recorder was closed; a recorder that
-        fails to close does not keep the others from closing, and never hides an error
-        raised before it (it is noted on it).
+        :mod:`rwall_fem.output.guards`), SIGTERM or SIGINT (Ctrl-C) stopped the run; the
+        outputs up to the last sample stay valid, and a stop after a whole step writes a
+        checkpoint. Any other error propagates after every recorder was closed; a recorder
+        that fails to close does not keep the others from closing, and never hides an error
+        raised before it (it is noted on it). A simulation runs once: build another to run
+        again (a resumed run is another simulation).
         """
+        if self.status != "not run":
+            raise RuntimeError(
+                f"Simulation.run: this simulation has already run ({self.status.partition(':')[0]}"
+                "); build a new one (build_simulation) to run the scene again"
+            )
         s, last, update, history = self.state, self.num_steps, self.update, self.history
         forces, constraints = [self.internal, *self.forces], self.constraints
         first, checkpoints = self.first_step, self.checkpoints
@@ -280,7 +287,7 @@ class Simulation:
             outputs = [history, *self.recorders] if history is not None else self.recorders
             for recorder in reversed(outputs):  # closed in the order of the list
                 closing.push(_closer(recorder, self))
-            closing.enter_context(_sigterm_requests(self))
+            closing.enter_context(_stop_signals(self))
             if checkpoints is not None:
                 checkpoints.start(first)
             started = time.perf_counter()
@@ -332,19 +339,21 @@ def _closer(recorder: Recorder, sim: Simulation):
 
 
 @contextlib.contextmanager
-def _sigterm_requests(sim: Simulation):
-    """While the loop runs, SIGTERM only sets ``sim.terminate_requested``: the history's
-    guard stops the run at its next sample, on every rank at the same step. Signals can
-    be handled in the main thread only; elsewhere SIGTERM keeps its handler."""
+def _stop_signals(sim: Simulation):
+    """While the loop runs, SIGTERM and SIGINT (Ctrl-C) only add their name to
+    ``sim.stop_requests``: the history stops the run within a fraction of a second, on
+    every rank at the same step. Signals can be handled in the main thread only;
+    elsewhere they keep their handlers."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def request(signum, frame):
-        sim.terminate_requested = True
+        sim.stop_requests.add(signal.Signals(signum).name)
 
-    previous = signal.signal(signal.SIGTERM, request)
+    previous = {n: signal.signal(n, request) for n in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)

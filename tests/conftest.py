@@ -13,6 +13,10 @@ measures one rank); under ``mpirun`` it is skipped.
 
 import copy
 import math
+import os
+import shutil
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -46,6 +50,18 @@ normal_point = [0.0, 0.0, 1.0]
 [output]
 frames = 3
 """
+
+
+def mpi_launch(ranks: int) -> tuple[list[str], dict]:
+    """The command prefix and environment that start ``ranks`` ranks of this leg's Python:
+    the MPICH ``mpiexec`` beside it (the PyPI leg), else Open MPI's ``mpirun`` (Debian);
+    the environment is this one without the variables of the session's own MPI job."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    beside = Path(sys.executable).parent / "mpiexec"
+    if beside.exists():
+        return [str(beside), "-n", str(ranks)], env | {"UCX_TLS": "self,sm,tcp"}
+    launcher = [shutil.which("mpirun") or "mpirun", "--allow-run-as-root", "--oversubscribe"]
+    return [*launcher, "-n", str(ranks)], env | {"OMPI_MCA_btl_vader_single_copy_mechanism": "none"}
 
 
 def bar_scene(

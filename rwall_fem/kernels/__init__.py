@@ -163,12 +163,13 @@ def load():
         except PermissionError:  # a read-only cache: compile for this process only
             path = _compile(name, flags, Path(tempfile.mkdtemp(prefix="rwall_fem_kernels_")))
         except Exception as err:  # the compiler's failure, whatever setuptools wraps it in
-            failures.append(f"{' '.join(flags)}: {str(err).strip().splitlines()[-1:]}")
+            lines = str(err).strip().splitlines() or [type(err).__name__]
+            failures.append(f"{' '.join(flags[:2])}: {lines[-1]}")
             continue
         module = _import(name, path)
         return module.ffi, module.lib
     raise KernelBuildError(
         "could not compile the element kernels with the C compiler "
-        f"({os.environ.get('CC', 'cc')}; tried {'; '.join(failures)}): install gcc (Debian: "
-        "apt-get install gcc libc6-dev) or set CC"
+        f"{os.environ.get('CC', 'cc')} ({'; '.join(failures)}): install gcc (Debian: "
+        "apt-get install gcc libc6-dev) or set CC to a C compiler"
     )

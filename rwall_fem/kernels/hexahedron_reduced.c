@@ -350,12 +350,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
         rotation(dL, R);
         for (int a = 0; a < 4; ++a)
           for (int i = 0; i < 3; ++i)
-          {
-            vec value = VZERO;
-            for (int k = 0; k < LANES; ++k)
-              value[k] = state[(POINT_SLOTS + 3 * a + i) * stride + c0 + (k < nb ? k : 0)];
-            Q_old[a][i] = value;
-          }
+            Q_old[a][i] = load_slot(state, stride, c0, nb, POINT_SLOTS + 3 * a + i);
         hourglass_forces(hourglass, &geo, dq, p, 0.0, dQ);
         for (int a = 0; a < 4; ++a)
         {
@@ -365,8 +360,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
                                 + R[3 * i + 2] * Q_old[a][2];
             Q[a][i] = rotated + dQ[a][i];
             work += (rotated + 0.5 * dQ[a][i]) * dq[a][i];
-            for (int k = 0; k < nb; ++k)
-              state[(POINT_SLOTS + 3 * a + i) * stride + c0 + k] = Q[a][i][k];
+            store_slot(state, stride, c0, nb, POINT_SLOTS + 3 * a + i, Q[a][i]);
           }
         }
       }

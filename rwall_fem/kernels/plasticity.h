@@ -231,13 +231,34 @@ INLINE vec elastic_energy_density(const element_params *p, const vec sigma[9])
 
 /* The POINT_SLOTS values of cells c0 .. c0 + LANES - 1 at point slot `base` of the state
  * (slot k of cell c at state[k * stride + c]); lanes from nb on repeat cell c0. */
+INLINE vec load_slot(const double *restrict state, int64_t stride, int64_t c0, int nb, int slot)
+{
+  vec v;
+  const double *row = state + slot * stride + c0;
+  if (nb == LANES)
+    __builtin_memcpy(&v, row, sizeof v);
+  else
+    for (int k = 0; k < LANES; ++k)
+      v[k] = row[k < nb ? k : 0];
+  return v;
+}
+
+INLINE void store_slot(double *restrict state, int64_t stride, int64_t c0, int nb, int slot, vec v)
+{
+  double *row = state + slot * stride + c0;
+  if (nb == LANES)
+    __builtin_memcpy(row, &v, sizeof v);
+  else
+    for (int k = 0; k < nb; ++k)
+      row[k] = v[k];
+}
+
 INLINE void load_point(const double *restrict state, int64_t stride, int64_t c0, int nb,
                        int base, vec sigma[9], vec *eps_p, vec *T)
 {
-  vec v[POINT_SLOTS] = {0};
+  vec v[POINT_SLOTS];
   for (int slot = 0; slot < POINT_SLOTS; ++slot)
-    for (int k = 0; k < LANES; ++k)
-      v[slot][k] = state[(base + slot) * stride + c0 + (k < nb ? k : 0)];
+    v[slot] = load_slot(state, stride, c0, nb, base + slot);
   sigma[0] = v[0], sigma[4] = v[1], sigma[8] = v[2];
   sigma[1] = sigma[3] = v[3];
   sigma[5] = sigma[7] = v[4];
@@ -252,8 +273,7 @@ INLINE void store_point(double *restrict state, int64_t stride, int64_t c0, int 
   const vec v[POINT_SLOTS] = {sigma[0], sigma[4], sigma[8], sigma[1],
                               sigma[5], sigma[2], eps_p,    T};
   for (int slot = 0; slot < POINT_SLOTS; ++slot)
-    for (int k = 0; k < nb; ++k)
-      state[(base + slot) * stride + c0 + k] = v[slot][k];
+    store_slot(state, stride, c0, nb, base + slot, v[slot]);
 }
 
 #endif

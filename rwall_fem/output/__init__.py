@@ -11,6 +11,9 @@
   DOLFINx, with :mod:`~rwall_fem.output.coloring` and :mod:`~rwall_fem.output.view`);
   :mod:`~rwall_fem.output.plots` (``histories.png``);
   :mod:`~rwall_fem.output.progress` (the command line's progress bar);
+- :mod:`~rwall_fem.output.run_log` (``run.log`` and the cycle lines of batch runs);
+- :mod:`~rwall_fem.output.folder`: the results folder, checked before meshing and locked
+  while a run writes;
 - :mod:`~rwall_fem.output.schedule`: the steps at which recorders sample.
 
 Importing this package imports nothing heavy: ``python -m rwall_fem.output.render``

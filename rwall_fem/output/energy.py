@@ -15,6 +15,10 @@
 - the balance error is (sum of the stored energies - W_ext - W_wall - E0) / E_ref with
   E0 the initial kinetic energy (walls included) and E_ref the largest of E0, the stored
   energy and |W| of each work so far (a body dropped from rest starts with E0 = 0).
+
+Each row of ``energy.csv`` also carries what LS-DYNA's GLSTAT and Radioss's energy
+report print: the total energy (the sum of the stored energies), the balance error in
+percent, and the time step of that step (s).
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ class EnergyBalance:
     internal force), ``works`` the works done on it, ``parts`` parts of a stored energy
     reported beside it (the elastic energy and plastic work within the internal energy of
     an elasto-plastic body), not added again; :attr:`columns` are those of ``energy.csv``:
-    time, stored..., parts..., works..., balance error.
+    time, stored..., parts..., works..., balance error, total energy, error in %, dt.
     """
 
     def __init__(
@@ -51,7 +55,10 @@ class EnergyBalance:
         parts: Sequence[str] = (),
     ):
         self.stored, self.works, self.parts = tuple(stored), tuple(works), tuple(parts)
-        self.columns = ("time", *self.stored, *self.parts, *self.works, "balance_error")
+        self.columns = (
+            "time", *self.stored, *self.parts, *self.works, "balance_error", "total_energy",
+            "energy_error_percent", "dt",
+        )  # fmt: skip
         self.initial = initial  # E0, J
         self.reference = initial  # E_ref so far, J
         self.max_error = 0.0  # largest |balance error| so far
@@ -75,8 +82,9 @@ class EnergyBalance:
         latest = arrays["latest"].tolist()
         self.latest = dict(zip(self.columns, latest, strict=True)) if latest else None
 
-    def sample(self, t: float, energies: Mapping[str, float]) -> tuple:
-        """Book the energies (J, summed over ranks) of time ``t`` (s); returns the row."""
+    def sample(self, t: float, energies: Mapping[str, float], dt: float) -> tuple:
+        """Book the energies (J, summed over ranks) of time ``t`` (s), reached with the
+        step ``dt`` (s); returns the row."""
         stored = sum(energies[name] for name in self.stored)
         self.reference = max(self.reference, stored, *(abs(energies[name]) for name in self.works))
         balance = stored
@@ -84,6 +92,9 @@ class EnergyBalance:
             balance -= energies[name]
         error = (balance - self.initial) / max(self.reference, np.finfo(float).tiny)
         self.max_error = max(self.max_error, abs(error))
-        row = (t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error)
+        row = (
+            t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error,
+            stored, 100.0 * error, dt,
+        )  # fmt: skip
         self.latest = dict(zip(self.columns, row, strict=True))
         return row

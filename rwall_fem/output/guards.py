@@ -3,7 +3,7 @@
 The guards act at every history sample, on values already summed over ranks, so every
 rank takes the same decision at the same step: a NaN or Inf in a nodal array (seen as a
 non-finite sum), an energy balance error above ``max_energy_error``, a time step below
-``min_dt``, or a SIGTERM received by any rank stop the run with one
+``min_dt``, or a SIGTERM or SIGINT (Ctrl-C) received by any rank stop the run with one
 :class:`~rwall_fem.solver.RunStopped` message naming the step, the time, the quantity
 and the worst node.
 """
@@ -28,10 +28,11 @@ class Guards:
         self.comm, self.node_ids = comm, node_ids
         self.max_energy_error, self.min_dt = max_energy_error, min_dt
 
-    def check(self, s, error: float, *, finite: bool, terminate: bool) -> None:
+    def check(self, s, error: float, *, finite: bool, signals: tuple[str, ...] = ()) -> None:
         """Raise :class:`RunStopped` (on every rank alike) if a guard trips at the sample of
         the state ``s``: ``error`` is its balance error, ``finite`` whether every sum of
-        the sample is finite, ``terminate`` whether any rank received SIGTERM."""
+        the sample is finite, ``signals`` the stop signals any rank received ("SIGTERM",
+        "SIGINT")."""
         where = f"step {s.step}, t = {s.t:.6g} s"
         if not finite:
             bad = ~(np.isfinite(s.u).all(axis=1) & np.isfinite(s.v).all(axis=1))
@@ -47,8 +48,10 @@ class Guards:
             raise RunStopped(
                 f"{where}: time step {s.dt:.4g} s is below run.min_dt = {self.min_dt:g} s"
             )
-        if terminate:
+        if "SIGTERM" in signals:
             raise RunStopped(f"{where}: terminated by SIGTERM")
+        if "SIGINT" in signals:
+            raise RunStopped(f"{where}: interrupted (SIGINT, Ctrl-C)")
 
     def _worst(self, score: np.ndarray, s, detail: str = "") -> str:
         """'<global id> at (x, y, z) m' of the node with the largest ``score`` on any rank."""

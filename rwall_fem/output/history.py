@@ -1,23 +1,34 @@
 """Time histories of a run: ``energy.csv``, ``walls.csv`` and ``summary.json``.
 
 At each sample every rank puts its share of what is booked (energies, works, wall
-impulses and contacts, whether it received SIGTERM) into named arrays that one
+impulses and contacts, which stop signals it received) into named arrays that one
 ``Allreduce`` sums; the energy balance (:mod:`~rwall_fem.output.energy`), the wall
 table (:mod:`~rwall_fem.output.wall_table`) and the guards
 (:mod:`~rwall_fem.output.guards`) then read the same sums on every rank.
 
-Rows are written in whole lines, at least every ``FLUSH_SECONDS`` of wall time and when
-the run ends or stops, so a killed run leaves complete lines up to its last flush.
+Rows stream to disk (:mod:`~rwall_fem.output.tables`) in whole lines, at least every
+``FLUSH_SECONDS`` of wall time and when the run ends or stops, so a killed run leaves
+complete lines up to its last flush, and memory stays flat however long the run.
+
+Stop signals (SIGTERM, SIGINT) are honoured within about ``POLL_SECONDS`` of wall time
+whatever ``history_interval`` is: between samples the ranks also agree, at steps they
+all derive from the measured time per step, on whether any of them received one (one
+small ``Allreduce``); if so the step becomes a sample and the run stops there. Open
+MPI's ``mpirun`` sends SIGTERM one second before SIGKILL: that second is enough.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from rwall_fem.output import OutputError
 from rwall_fem.output.energy import EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every
@@ -25,17 +36,20 @@ from rwall_fem.output.summary import momentum, run_summary, write_summary
 from rwall_fem.output.tables import CsvTable
 from rwall_fem.output.wall_table import WALL_COLUMNS, WallTable
 
-__all__ = ["FLUSH_SECONDS", "History"]
+__all__ = ["FLUSH_SECONDS", "POLL_SECONDS", "History"]
 
 FLUSH_SECONDS = 1.0  # longest wall time between writes of the CSV files, s
+POLL_SECONDS = 0.1  # longest wall time between agreements on stop signals, s
+SIGNALS = ("SIGTERM", "SIGINT")  # the stop requests the ranks agree on
 
 
 class History:
     """Recorder of the energies and wall forces every ``every`` steps (and at the last
     step) of ``sim``, into ``directory``; it writes the run summary when closed.
 
-    :attr:`energy` and :meth:`wall` give the samples as arrays, :attr:`summary` the
-    summary once the run has ended; :attr:`balance` is the energy balance.
+    :attr:`energy` and :meth:`wall` read the samples back from the files as arrays
+    (collective calls), :attr:`summary` is the summary once the run has ended;
+    :attr:`balance` is the energy balance.
     """
 
     def __init__(self, sim, directory: Path, *, every: int, guards: Guards, plot: bool = False):
@@ -59,16 +73,28 @@ class History:
         self._sums = _Sums(
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
-            | {"external_work": (), "wall_work": (len(walls), 2), "terminate": ()}
+            | {"external_work": (), "wall_work": (len(walls), 2)}
+            | {"signals": (len(SIGNALS),), "seconds": ()}
             | self.wall_table.sums,
         )
+        self._poll = _Sums(comm, {"signals": (len(SIGNALS),), "seconds": ()})
+        self._next_poll = 0  # the next step at which the ranks agree on stop signals
+        # Step and wall time of the latest agreement (none yet: since the history was built).
+        self._last: tuple[int, float] | None = None
+        self._built = time.perf_counter()
+        self._drawing: subprocess.Popen | None = None
 
     def due(self, step: int) -> bool:
-        return step in self.steps
+        return step in self.steps or step >= self._next_poll
 
     def record(self, sim, s) -> None:
         """Sample step ``s.step`` after its update: the kinetic energy K^n is the update's,
-        the works are booked up to step n."""
+        the works are booked up to step n. Between samples, only agree on stop signals;
+        the step becomes a sample if any rank received one."""
+        if time.monotonic() - self._written_at > FLUSH_SECONDS:
+            self._flush()
+        if s.step not in self.steps and not self._stop_requested(sim, s):
+            return
         local = self._sums.local
         local["kinetic"][...] = s.kinetic
         for name, value in sim.internal.energies(s).items():
@@ -80,10 +106,11 @@ class History:
         )
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
-        # Sent with the sums, so that every rank stops at the same step when any got SIGTERM.
-        local["terminate"][...] = sim.terminate_requested
+        # Sent with the sums, so that every rank stops at the same step when any got a signal.
+        self._fill_agreement(local, sim)
         self.wall_table.fill(local)
         total = self._sums.reduce()
+        self._plan_next_poll(s, total)
 
         energies = {
             name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)
@@ -94,21 +121,39 @@ class History:
                 energies["kinetic"] += kinetic
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
-        row = self.balance.sample(s.t, energies)
-        self._energy_csv.rows.append(row)
-        self._walls_csv.rows += self.wall_table.rows(s, total)
-        if time.monotonic() - self._written_at > FLUSH_SECONDS:
-            self._flush()
-        self.guards.check(
-            s, self.balance.error, finite=self._sums.finite(), terminate=bool(total["terminate"])
-        )
+        self._energy_csv.append(self.balance.sample(s.t, energies, s.dt))
+        for row in self.wall_table.rows(s, total):
+            self._walls_csv.append(row)
+        signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
+        self.guards.check(s, self.balance.error, finite=self._sums.finite(), signals=signals)
+
+    def _fill_agreement(self, local: dict, sim) -> None:
+        """This rank's stop signals and its wall time since the latest agreement (s)."""
+        local["signals"][:] = [name in sim.stop_requests for name in SIGNALS]
+        local["seconds"][...] = time.perf_counter() - (self._last or (0, self._built))[1]
+
+    def _plan_next_poll(self, s, total: dict) -> None:
+        """The next agreement, about ``POLL_SECONDS`` of wall time ahead at the mean time
+        per step since the latest one (the same on every rank: from the sums)."""
+        steps = max(s.step - self._last[0], 1) if self._last else 1
+        per_step = float(total["seconds"]) / self._sums.comm.size / steps
+        ahead = POLL_SECONDS / per_step if per_step > 0 else 1.0
+        self._next_poll = s.step + max(1, int(min(ahead, 1e9)))
+        self._last = (s.step, time.perf_counter())
+
+    def _stop_requested(self, sim, s) -> bool:
+        """Agree with the other ranks on whether any received a stop signal (collective)."""
+        self._fill_agreement(self._poll.local, sim)
+        total = self._poll.reduce()
+        self._plan_next_poll(s, total)
+        return bool(total["signals"].any())
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """The energy balance, the wall table, the momentum of the start and how many rows
         ``energy.csv`` and ``walls.csv`` have; both files are flushed first, so that they
         hold those rows when the checkpoint exists."""
         self._flush()
-        rows = [len(self._energy_csv.rows), len(self._walls_csv.rows)]
+        rows = [self._energy_csv.count, self._walls_csv.count]
         arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
         arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
         return arrays | {f"walls_{k}": v for k, v in self.wall_table.checkpoint_state().items()}
@@ -125,9 +170,8 @@ class History:
             {k.removeprefix("walls_"): v for k, v in arrays.items() if k.startswith("walls_")}
         )
         energy_rows, wall_rows = arrays["rows"].tolist()
-        self._energy_csv.resume(energy_rows)
+        latest = self._energy_csv.resume(energy_rows) or ()
         self._walls_csv.resume(wall_rows)
-        latest = self._energy_csv.rows[-1] if energy_rows else ()
         if list(latest) != arrays["balance_latest"].tolist():
             raise ValueError(
                 f"{self._energy_csv.path}: row {energy_rows} is not the checkpoint's (the file "
@@ -141,26 +185,60 @@ class History:
 
     @property
     def energy(self) -> np.ndarray:
-        """Energy samples as an array with the columns of ``energy.csv``."""
-        return np.array(self._energy_csv.rows)
+        """Energy samples, read back from ``energy.csv``, with its columns (collective)."""
+        return self._energy_csv.read()
 
     def wall(self, i: int) -> np.ndarray:
-        """Samples of wall ``i`` as an array with the columns of ``walls.csv``."""
-        return np.array([r for r in self._walls_csv.rows if r[1] == i])
+        """Samples of wall ``i``, read back from ``walls.csv``, with its columns (collective)."""
+        rows = self._walls_csv.read()
+        return rows[rows[:, 1] == i]
 
     def close(self, sim) -> None:
         """Write ``summary.json`` and the rows not yet written, close the CSV files (rank 0)
-        and draw ``histories.png`` if asked."""
+        and draw ``histories.png`` if asked.
+
+        The drawing runs in a process of its own session, so that it finishes even when
+        this one is killed (Open MPI's ``mpirun`` sends SIGKILL one second after
+        SIGTERM): after a stop signal it is not waited for here but in :meth:`wait`,
+        once the caller has said that the run stopped.
+        """
         peaks = self.wall_table.peak_contacts
         self.summary = run_summary(sim, self.balance, peaks, self.initial_momentum)
         for table in self._tables:
             table.close()
         if sim.comm.rank == 0:
             write_summary(self.directory, self.summary)
-            if self.plot and self._energy_csv.rows:
-                from rwall_fem.output.plots import plot_histories
+            if self.plot and self._energy_csv.count:
+                self._drawing = _draw_histories(self.directory)
+                if not sim.stop_requests:
+                    self.wait()
 
-                plot_histories(self.directory)
+    def wait(self) -> None:
+        """Wait for ``histories.png`` to be drawn; raises :class:`OutputError` if that failed."""
+        drawing, self._drawing = self._drawing, None
+        if drawing is None:
+            return
+        _, stderr = drawing.communicate()
+        if drawing.returncode != 0:
+            lines = stderr.strip().splitlines() or ["no message"]
+            error = OutputError(f"drawing histories.png failed: {lines[-1]}")
+            error.add_note(stderr[-2000:])
+            raise error
+
+
+def _draw_histories(directory: Path) -> subprocess.Popen:
+    """Start drawing ``directory/histories.png`` (:mod:`rwall_fem.output.plots`) in a new
+    session, without the MPI variables of this process."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    code = "import sys; from rwall_fem.output.plots import plot_histories as p; p(sys.argv[1])"
+    return subprocess.Popen(
+        [sys.executable, "-c", code, str(directory)],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
 
 
 class _Sums:

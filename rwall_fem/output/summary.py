@@ -1,7 +1,13 @@
 """``summary.json``: what ran, how it ended, and the totals of every effect (SI units).
 
 Every value is summed (or reduced) over ranks, so the summary is the same on every
-rank; rank 0 writes it.
+rank; rank 0 writes it. Besides what was built (``Simulation.info``: the code's
+``version`` and ``git_hash``, mesh, stable steps, ``warnings``), it holds the outcome
+(``status``: done, stopped or failed, and its ``reason``), ``steps`` done (the step of the
+last state) out of ``planned_steps``, the ``time`` reached (s) and ``end_time`` planned,
+the energies of the last sample, and per wall its impulses, works, contacts and the
+secondary nodes that started behind it (``initially_penetrated``, ``deepest_penetration``
+in m: kept there by the wall, as Radioss's starter warns).
 """
 
 from __future__ import annotations
@@ -32,14 +38,16 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
     outcome, _, reason = sim.status.partition(": ")
     latest = balance.latest or {}
     energy = {"initial": balance.initial}
-    energy |= {name: latest.get(name) for name in balance.columns[1:-1]}
+    energy |= {name: latest.get(name) for name in (*balance.stored, *balance.parts, *balance.works)}
     energy["max_balance_error"] = balance.max_error
     return sim.info | {
         "status": outcome,
         "reason": reason or None,
         "ranks": comm.size,
-        "steps": sim.num_steps,
+        "steps": s.step,
+        "planned_steps": sim.num_steps,
         "dt": s.dt,
+        "time": s.t,
         "end_time": sim.num_steps * s.dt,
         "wall_seconds": comm.allreduce(sim.wall_seconds, MPI.MAX),
         "effects": sim.effects,
@@ -65,9 +73,10 @@ def deformed_bounds(state, comm) -> list[list[float]]:
     """[min corner], [max corner] (m) of the body at the time of the latest step, read
     after its update (u^{n+1} - dt v^{n+1/2} = u^n)."""
     x = state.X + state.u - state.dt * state.v
-    low, high = np.empty(3), np.empty(3)  # buffers: the pickling allreduce compares arrays
-    comm.Allreduce(x.min(axis=0, initial=np.inf), low, MPI.MIN)
-    comm.Allreduce(x.max(axis=0, initial=-np.inf), high, MPI.MAX)
+    low, high = np.empty(3), np.empty(3)
+    # Buffers, not pickled objects: mpi4py 3 reduces pickled arrays with Python's min.
+    comm.Allreduce(x.min(axis=0, initial=np.inf), low, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
     return [low.tolist(), high.tolist()]
 
 
@@ -98,6 +107,8 @@ def _wall(w, peak_contacts: int, comm) -> dict:
         "first_contact": _finite_or_none(comm.allreduce(w.first_contact, MPI.MIN)),
         "last_contact": _finite_or_none(comm.allreduce(w.last_contact, MPI.MAX)),
         "peak_contacts": int(peak_contacts),
+        "initially_penetrated": w.initially_penetrated,
+        "deepest_penetration": w.deepest_penetration,
     }
     if w.motion.dynamic or w.motion.prescribed:
         entry["motion"] = "main node" if w.motion.dynamic else "prescribed"

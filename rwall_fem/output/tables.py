@@ -1,8 +1,11 @@
-"""CSV files that a killed run leaves readable: rows are written in whole lines.
+"""CSV files that stream to disk and that a killed run leaves readable.
 
-Every rank keeps the rows in memory (they are the same on every rank: sums over
-ranks); rank 0 appends the rows not yet written when the table is flushed. A resumed
-run reads back the rows up to its checkpoint (:meth:`CsvTable.resume`).
+Rank 0 turns each row into its line as it comes and keeps at most ``PENDING_LINES``
+lines (or what :meth:`CsvTable.flush` has not yet written): memory stays flat
+however long the run. The pending lines go to the file in one write followed by a
+flush, so the file only ever holds whole lines. Other ranks keep nothing (the rows
+are sums over ranks, the same everywhere). A resumed run keeps the rows up to its
+checkpoint (:meth:`CsvTable.resume`).
 """
 
 from __future__ import annotations
@@ -11,7 +14,11 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["CsvTable"]
+import numpy as np
+
+__all__ = ["PENDING_LINES", "CsvTable"]
+
+PENDING_LINES = 1000  # lines kept before they are written, whatever the time since the last
 
 
 class CsvTable:
@@ -19,68 +26,102 @@ class CsvTable:
 
     def __init__(self, path: Path, columns: Sequence[str], comm):
         self.path, self.columns, self.comm = Path(path), list(columns), comm
-        self.rows: list[tuple] = []
-        self._written = 0  # rows already in the file
+        self.count = 0  # rows so far
+        self._pending: list[str] = []
         self._file = None
+        self._closed = False
+
+    def append(self, row: Sequence) -> None:
+        """Add a row (numbers); it is written at the next :meth:`flush`, or now when
+        ``PENDING_LINES`` lines are waiting."""
+        self.count += 1
+        if self.comm.rank != 0:
+            return
+        self._pending.append(_line(row))
+        if len(self._pending) >= PENDING_LINES:
+            self.flush()
 
     def flush(self) -> None:
-        """Append the rows not yet written as whole lines and flush the file (rank 0); the
-        first flush creates the directory and the file with its header."""
-        if self.comm.rank != 0:
+        """Write the pending lines and flush the file (rank 0); the first flush creates the
+        directory and the file with its header."""
+        if self.comm.rank != 0 or self._closed:
             return
         if self._file is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._file = open(self.path, "w")
             self._file.write(",".join(self.columns) + "\n")
-        start, self._written = self._written, len(self.rows)
-        self._file.write("".join(_line(r) for r in self.rows[start:]))
+        self._file.write("".join(self._pending))
         self._file.flush()
+        self._pending.clear()
 
-    def resume(self, count: int) -> None:
-        """Continue the table of a resumed run after the first ``count`` rows of its file:
-        they are read back (on rank 0, then sent to every rank), and the rows after them,
-        written after the checkpoint, are dropped from the file by replacing it whole.
-        Raises ValueError (one line, the same on every rank) when the file lacks them."""
-        rows, error = [], None
+    def resume(self, count: int) -> tuple | None:
+        """Continue the table of a resumed run after the first ``count`` rows of its file;
+        the rows after them, written after the checkpoint, are dropped by replacing the
+        file whole (rank 0, line by line). Returns the last row kept (None: none), read
+        back exactly, on every rank. Raises ValueError (one line, the same on every rank)
+        when the file lacks them."""
+        last, error = None, None
         if self.comm.rank == 0 and count:
+            temporary = self.path.with_name(self.path.name + ".partial")
             try:
-                rows = _read_rows(self.path, self.columns, count)
-                temporary = self.path.with_name(self.path.name + ".partial")
-                with open(temporary, "w") as file:
-                    file.write(",".join(self.columns) + "\n" + "".join(_line(r) for r in rows))
-                    file.flush()
-                    os.fsync(file.fileno())
+                last = _copy_rows(self.path, temporary, self.columns, count)
                 os.replace(temporary, self.path)
                 self._file = open(self.path, "a")
             except (OSError, ValueError) as err:
                 error = f"{self.path}: {err.strerror}" if isinstance(err, OSError) else str(err)
-        rows, error = self.comm.bcast((rows, error), root=0)
+                temporary.unlink(missing_ok=True)
+        last, error = self.comm.bcast((last, error), root=0)
         if error:
             raise ValueError(error)
-        self.rows, self._written = rows, count
+        self.count = count
+        return last
 
     def close(self) -> None:
         """Write what is left and close the file."""
         self.flush()
         if self._file is not None:
             self._file.close()
+        self._closed = True
+
+    def read(self) -> np.ndarray:
+        """Every row written so far, as an array (rows, columns), on every rank: rank 0
+        flushes and reads the file, the others receive it (collective)."""
+        rows = None
+        if self.comm.rank == 0:
+            self.flush()
+            rows = np.loadtxt(self.path, delimiter=",", skiprows=1, ndmin=2)
+            rows = rows.reshape(-1, len(self.columns))
+        return self.comm.bcast(rows, root=0)
 
 
-def _read_rows(path: Path, columns: Sequence[str], count: int) -> list[tuple]:
-    """The first ``count`` rows of the CSV file ``path``, each a whole line with the
-    ``columns``; numbers read back exactly (integers as int)."""
-    lines = path.read_text().split("\n")
-    if lines[0] != ",".join(columns):
-        raise ValueError(f"{path}: its columns are not those of this run")
-    if len(lines) < count + 2:  # the header, the rows, and what follows their last newline
-        raise ValueError(f"{path}: holds {max(len(lines) - 2, 0)} rows; the checkpoint has {count}")
-    try:
-        rows = [tuple(map(_number, line.split(","))) for line in lines[1 : count + 1]]
-    except ValueError:
-        raise ValueError(f"{path}: a row of the first {count} is not numbers") from None
-    if any(len(r) != len(columns) for r in rows):
-        raise ValueError(f"{path}: a row of the first {count} has not {len(columns)} columns")
-    return rows
+def _copy_rows(path: Path, target: Path, columns: Sequence[str], count: int) -> tuple:
+    """Copy the header and the first ``count`` rows of the CSV file ``path`` to ``target``
+    (on disk when this returns), each checked to be a whole line of numbers with the
+    ``columns``; returns the last, read back exactly (integers as int)."""
+    header = ",".join(columns)
+    kept, last = 0, None
+    with open(path) as source, open(target, "w") as copy:
+        if source.readline().rstrip("\n") != header:
+            raise ValueError(f"{path}: its columns are not those of this run")
+        copy.write(header + "\n")
+        for line in source:
+            if kept == count or not line.endswith("\n"):  # enough, or a line cut by a kill
+                break
+            try:
+                last = tuple(map(_number, line.rstrip("\n").split(",")))
+            except ValueError:
+                raise ValueError(f"{path}: a row of the first {count} is not numbers") from None
+            if len(last) != len(columns):
+                raise ValueError(
+                    f"{path}: a row of the first {count} has not {len(columns)} columns"
+                )
+            copy.write(line)
+            kept += 1
+        if kept < count:
+            raise ValueError(f"{path}: holds {kept} rows; the checkpoint has {count}")
+        copy.flush()
+        os.fsync(copy.fileno())
+    return last
 
 
 def _number(text: str) -> int | float:

@@ -116,7 +116,10 @@ _WALL_KEYS = ("point", "slide", "friction", "friction_filter", "secondary", "mot
 # --- [run] -------------------------------------------------------------------------
 
 
-@table("How long, and with which time step.")
+@table(
+    "How long, with which time step, and within which limits (`rwall-fem run --lift-limits`"
+    " lifts them)."
+)
 @dataclass(frozen=True)
 class RunSettings:
     end_time: float = key(Real(low=0.0), unit="s", doc="simulated time")
@@ -140,6 +143,25 @@ class RunSettings:
         0.0,
         unit="s",
         doc="guard: the run stops when the step falls below it",
+    )
+    max_cells: float = key(
+        Real(low=0.0),
+        2e6,
+        unit="cells",
+        doc="limit: a mesh estimated (before meshing) or counted (after) above it is refused;"
+        " about 1.7 kB per hexahedron, 0.8 kB per tetrahedron",
+    )
+    max_steps: float = key(
+        Real(low=0.0),
+        1e7,
+        unit="steps",
+        doc="limit: a run of more steps (estimated before meshing, counted with the stable"
+        " step) is refused",
+    )
+    max_frames: int = key(
+        Integer(low=0),
+        1000,
+        doc="limit: output.frames and output.fields above it are refused",
     )
 
 
@@ -302,6 +324,18 @@ def _body_box(v) -> tuple[tuple[float, ...], tuple[float, ...]]:
         r = v["radius"]
         return (-r, -r, 0.0), (r, r, v["length"])
     return (0.0, 0.0, 0.0), v["size"]
+
+
+@rule(MeshSpec)
+def _refinement_is_meshable(v, raw, fail):
+    """refine_size is at least 1e-5 x element_size: gmsh's section mesher crashed at a
+    ratio of 1e-6."""
+    if v["refine_size"] is not None and v["refine_size"] < 1e-5 * v["element_size"]:
+        fail(
+            "refine_size",
+            f"{v['refine_size']:g} m is less than 1e-5 x element_size "
+            f"({1e-5 * v['element_size']:g} m): gmsh cannot grade a mesh over that ratio",
+        )
 
 
 @rule(MeshSpec)
@@ -522,7 +556,11 @@ class Gravity:
 # --- [[boundary]] ----------------------------------------------------------------
 
 
-@table("A prescribed velocity (zero: a clamp) of some components of a named node set.")
+@table(
+    "A prescribed velocity (zero: a clamp) of some components of a named node set. On a node"
+    " also secondary to a wall it wins on those components (it acts after the walls; the run"
+    " warns)."
+)
 @dataclass(frozen=True)
 class BoundarySpec:
     group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
@@ -696,6 +734,13 @@ class Output:
     )
     history_interval: int = key(
         Integer(low=1), 1, doc="steps between rows of energy.csv and walls.csv"
+    )
+    print_interval: int | None = key(
+        Integer(low=1),
+        None,
+        doc="steps between cycle lines (cycle, time, dt, energy error, elapsed) in run.log, "
+        "and on stderr when it is not a terminal",
+        default_doc="about 20 lines over the run",
     )
     color: str = key(
         Choice(("normal_velocity", "speed", "displacement", "plastic_strain")),

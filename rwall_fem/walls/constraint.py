@@ -74,6 +74,9 @@ class RigidWall:
     and ``tangential_impulse`` (N s, the push of the structure on the wall),
     ``normal_work`` and ``friction_work`` (J, work of the wall on the structure
     relative to the wall), ``driving_work`` (J, prescribed walls), contact counts.
+    Over all ranks, after :meth:`find_initial_penetration`: ``initially_penetrated``
+    secondary nodes started behind the wall, the deepest ``deepest_penetration`` (m)
+    behind it at ``deepest_position`` (m).
     """
 
     def __init__(
@@ -116,6 +119,9 @@ class RigidWall:
         self._near = self._near_nodes = self.nodes[:0]
         self._near_X, self._near_mass = np.zeros((0, 3)), np.zeros((0, 1))
         self._budget, self._travel, self._anchor = -np.inf, 0.0, [0.0, 0.0, 0.0]
+        self.initially_penetrated = 0
+        self.deepest_penetration = 0.0  # m
+        self.deepest_position = np.zeros(3)  # m
 
     @property
     def work(self) -> float:
@@ -131,6 +137,24 @@ class RigidWall:
     def position(self) -> np.ndarray:
         """Current position (m) of the wall's defining point M (the main node)."""
         return self.shape.point + self.motion.offset
+
+    def find_initial_penetration(self, state, tolerance: float) -> None:
+        """Count the secondary nodes (over all ranks) that start more than ``tolerance``
+        (m) behind the wall: those the wall holds there (inside a parallelogram, those
+        within its two steps of normal travel: it pushes them back onto it). Collective."""
+        x = state.X[self.nodes] + state.u[self.nodes]
+        d = self.shape.distance(x, self.motion.offset)
+        behind = d < -tolerance
+        if self.finite:
+            speed = np.abs((state.v[self.nodes] - self.motion.velocity) @ self.shape.normal)
+            behind &= self.shape.inside_patch(x, self.motion.offset) & (d >= -2 * state.dt * speed)
+        depth = -d[behind]
+        i = int(np.argmax(depth)) if len(depth) else -1
+        mine = (depth[i], *x[behind][i]) if i >= 0 else (0.0, 0.0, 0.0, 0.0)
+        deepest = max(self.comm.allgather(mine), key=lambda c: c[0])
+        self.initially_penetrated = self.comm.allreduce(int(behind.sum()))
+        self.deepest_penetration = float(deepest[0])
+        self.deepest_position = np.array(deepest[1:])
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """What the wall booked so far, the latest step's contacts (the v^{n+1/2} halves of

@@ -18,6 +18,8 @@ COARSE = {  # scene -> overrides that keep it to a few seconds
     "plate_on_sphere": ["mesh.element_size=0.003", "run.end_time=0.005"],
     "bar_on_parallelogram_edge": ["mesh.element_size=0.005", "run.end_time=2e-4"],
     "every_key": ["mesh.element_size=0.005", "run.end_time=5e-5"],
+    "taylor_rod": ["mesh.element_size=0.0008", "run.dt_scale=0.1", "run.end_time=1e-5"],
+    "taylor_johnson_cook": ["mesh.element_size=0.001", "run.end_time=1e-5"],
 }
 
 
@@ -46,7 +48,11 @@ def test_demo_scene(name, shared_dir):
 
 # Python demo -> (frames it draws, bound on its balance error: round-off for linear
 # elasticity, O(dt^2) for the neo-Hookean sheet, 8e-4 seen).
-SCRIPTS = {"demo_bar_impact": (12, 1e-10), "demo_plate_on_cylinder": (10, 2e-3)}
+SCRIPTS = {
+    "demo_bar_impact": (12, 1e-10),
+    "demo_plate_on_cylinder": (10, 2e-3),
+    "demo_taylor_rod": (0, 1e-10),
+}
 
 
 def test_every_script_is_tested():
@@ -57,6 +63,7 @@ def test_every_script_is_tested():
 def test_python_demo(name, shared_dir, monkeypatch):
     frames, balance = SCRIPTS[name]
     monkeypatch.chdir(shared_dir)
+    monkeypatch.setenv("TAYLOR_ELEMENT_SIZE", "0.8e-3")  # the Taylor rod's quick look
     runpy.run_path(str(DEMOS / f"{name}.py"), run_name="__main__")
     if MPI.COMM_WORLD.rank == 0:
         out = Path(shared_dir) / "results" / name

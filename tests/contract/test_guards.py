@@ -11,11 +11,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SCENE, bar_scene, run
+from conftest import SCENE, bar_scene, mpi_launch, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
 from rwall_fem.output.wall_table import WALL_COLUMNS
+
+# time, kinetic, internal, hourglass, external and wall work, balance error, total energy,
+# error in %, dt (the default element is a one-point hexahedron with hourglass control)
+ENERGY_COLUMNS = 10
 
 
 def complete_rows(path: Path, columns: int) -> list[list[float]]:
@@ -37,7 +41,7 @@ def test_nan_in_the_state_stops_the_run_and_names_the_node(shared_dir):
     if MPI.COMM_WORLD.rank == 0:
         summary = json.loads((Path(shared_dir) / "summary.json").read_text())
         assert summary["status"] == "stopped" and "NaN" in summary["reason"]
-        complete_rows(Path(shared_dir) / "energy.csv", 7)
+        complete_rows(Path(shared_dir) / "energy.csv", ENERGY_COLUMNS)
 
 
 def test_energy_error_guard(shared_dir):
@@ -62,23 +66,45 @@ def test_min_dt_guard(shared_dir):
 LONG = SCENE.replace("end_time = 2e-5", "end_time = 1.0").replace("frames = 3", "frames = 0")
 
 
-def _start_long_run(tmp_path):
+def _start_long_run(tmp_path, *extra, launch=(), env=None, ready=20000):
+    """Start the long run (on ``launch``'s ranks, if given) into ``tmp_path/out``; return
+    once energy.csv holds ``ready`` bytes."""
     (tmp_path / "scene.toml").write_text(LONG)
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    if env is None:
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
     process = subprocess.Popen(
-        [sys.executable, "-m", "rwall_fem", "run", "scene.toml", "--out", "out", "--quiet"],
+        [*launch, sys.executable, "-m", "rwall_fem", "run", "scene.toml", "--out", "out",
+         "--quiet", *extra],
         cwd=tmp_path,
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-    )
+    )  # fmt: skip
     energy = tmp_path / "out" / "energy.csv"
     deadline = time.monotonic() + 120
-    while not (energy.exists() and energy.stat().st_size > 20000):
+    while not (energy.exists() and energy.stat().st_size > ready):
         assert process.poll() is None and time.monotonic() < deadline
         time.sleep(0.2)
     return process
+
+
+def _stopped_cleanly(out: Path, stderr: str, reason: str) -> dict:
+    """One line on stderr naming ``reason``; the summary says stopped, with the steps done
+    (those of the last row of energy.csv, fewer than planned); histories.png drawn."""
+    assert stderr.strip().startswith("rwall-fem: stopped: step ")
+    assert reason in stderr and len(stderr.strip().splitlines()) == 1, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "stopped" and reason in summary["reason"]
+    rows = complete_rows(out / "energy.csv", ENERGY_COLUMNS)
+    assert summary["energy"]["kinetic"] == rows[-1][1] and summary["time"] == rows[-1][0]
+    assert summary["steps"] == round(rows[-1][0] / summary["dt"]) < summary["planned_steps"]
+    complete_rows(out / "walls.csv", len(WALL_COLUMNS))
+    deadline = time.monotonic() + 60  # drawn by a process of its own, which may outlive mpirun
+    while not (out / "histories.png").exists():
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+    return summary
 
 
 @pytest.mark.serial
@@ -87,13 +113,50 @@ def test_sigterm_stops_cleanly_and_writes_the_summary(tmp_path):
     process.send_signal(signal.SIGTERM)
     _, stderr = process.communicate(timeout=120)
     assert process.returncode == 3
-    assert stderr.strip().startswith("rwall-fem: stopped: step ")
-    assert "terminated by SIGTERM" in stderr and len(stderr.strip().splitlines()) == 1
-    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    assert summary["status"] == "stopped" and "SIGTERM" in summary["reason"]
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
-    assert summary["energy"]["kinetic"] == rows[-1][1]
-    complete_rows(tmp_path / "out" / "walls.csv", len(WALL_COLUMNS))
+    _stopped_cleanly(tmp_path / "out", stderr, "terminated by SIGTERM")
+
+
+@pytest.mark.serial
+def test_ctrl_c_stops_cleanly_like_sigterm(tmp_path):
+    process = _start_long_run(tmp_path)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 3 and "Traceback" not in stderr
+    _stopped_cleanly(tmp_path / "out", stderr, "interrupted (SIGINT, Ctrl-C)")
+
+
+@pytest.mark.serial
+def test_a_stop_does_not_wait_for_the_next_history_sample(tmp_path):
+    """With a row every 10^6 steps, the run still stops within a fraction of a second of
+    SIGTERM: the step it stops at (fewer than 10^6) becomes the last row."""
+    process = _start_long_run(tmp_path, "--set", "output.history_interval=1000000", ready=100)
+    time.sleep(1.0)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 3
+    summary = _stopped_cleanly(tmp_path / "out", stderr, "terminated by SIGTERM")
+    assert 0 < summary["steps"] < 1000000
+
+
+@pytest.mark.serial
+def test_sigterm_to_the_mpi_launcher_stops_every_rank_cleanly(tmp_path):
+    """SIGTERM to ``mpirun`` (Open MPI: SIGCONT, then SIGTERM to the ranks one second
+    later, then SIGKILL one second after that) or ``mpiexec`` (MPICH forwards SIGTERM):
+    the message, the summary and histories.png all come. MPICH's ``mpiexec`` exits with
+    the ranks' 3; Open MPI's ``mpirun`` exits 1 after a signal whatever they return."""
+    launch, env = mpi_launch(2)
+    process = _start_long_run(tmp_path, launch=launch, env=env)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    ours = "\n".join(line for line in stderr.splitlines() if line.startswith("rwall-fem:"))
+    _stopped_cleanly(tmp_path / "out", ours, "terminated by SIGTERM")
+    assert process.returncode == (3 if launch[0].endswith("mpiexec") else 1)
+
+
+def test_a_simulation_runs_once(shared_dir):
+    sim = run(bar_scene(elements=4), shared_dir)
+    with pytest.raises(RuntimeError, match=r"already run \(done\); build a new one"):
+        sim.run()
 
 
 @pytest.mark.serial
@@ -101,7 +164,7 @@ def test_sigkill_leaves_complete_csv_lines(tmp_path):
     process = _start_long_run(tmp_path)
     process.kill()
     process.communicate(timeout=60)
-    rows = complete_rows(tmp_path / "out" / "energy.csv", 7)
+    rows = complete_rows(tmp_path / "out" / "energy.csv", ENERGY_COLUMNS)
     assert len(rows) > 100
     assert not (tmp_path / "out" / "summary.json").exists()
 
@@ -146,4 +209,4 @@ def test_pictures_that_fail_to_render_leave_the_other_outputs(shared_dir, monkey
                        "no display"]  # fmt: skip
         summary = json.loads((out / "run" / "summary.json").read_text())
         assert summary["status"] == "done"
-        complete_rows(out / "run" / "energy.csv", 7)
+        complete_rows(out / "run" / "energy.csv", ENERGY_COLUMNS)

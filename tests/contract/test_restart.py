@@ -21,6 +21,7 @@ from mpi4py import MPI
 
 import rwall_fem.checkpoint
 import rwall_fem.output.frames
+import rwall_fem.output.history
 from rwall_fem import build_simulation, parse_scene
 from rwall_fem.checkpoint import CheckpointError
 from rwall_fem.cli import main
@@ -79,7 +80,7 @@ class StopAt:
         return step == self.step
 
     def record(self, sim, s):
-        sim.terminate_requested = True
+        sim.stop_requests.add("SIGTERM")
 
     def close(self, sim):
         pass
@@ -112,6 +113,9 @@ def test_a_resumed_run_equals_an_uninterrupted_one(shared_dir, monkeypatch):
     out = root / "stopped"
     sim = build(SCENE_WITH_STATE, out)
     sim.recorders.append(StopAt(74))  # during the impact on wall[0], steps 69 to 83
+    # The ranks agree on stop signals at every sample and, between samples, about every
+    # POLL_SECONDS of wall time: none between these samples, 3 steps apart.
+    monkeypatch.setattr(rwall_fem.output.history, "POLL_SECONDS", 1e9)
     assert sim.run().startswith("stopped: step 75,")  # the next history sample
     comm.Barrier()
     assert checkpoints(out) == ["step_0000000075"]

@@ -37,9 +37,16 @@ def test_outputs_of_a_run(shared_dir):
             "mass",
             "initial_momentum",
             "final_momentum",
+            "version",
+            "git_hash",
+            "planned_steps",
+            "time",
+            "warnings",
         ):
             assert key in summary
         assert summary["ranks"] == MPI.COMM_WORLD.size
+        assert summary["steps"] == summary["planned_steps"] == sim.num_steps
+        assert summary["warnings"] == []
         assert set(summary["energy"]) == {
             "initial",
             "kinetic",
@@ -57,7 +64,14 @@ def test_outputs_of_a_run(shared_dir):
             "external_work",
             "wall_work",
             "balance_error",
+            "total_energy",
+            "energy_error_percent",
+            "dt",
         ]
+        for row in rows:  # GLSTAT's total energy, Radioss's energy error %, the step's dt
+            assert float(row["total_energy"]) == float(row["kinetic"]) + float(row["internal"])
+            assert float(row["energy_error_percent"]) == 100 * float(row["balance_error"])
+            assert float(row["dt"]) == sim.state.dt
         # every 5th step and the last one
         assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
         walls = list(csv.DictReader(open(out / "walls.csv")))
@@ -71,6 +85,7 @@ def test_outputs_of_a_run(shared_dir):
         if importlib.util.find_spec("imageio_ffmpeg"):  # `make test` installs it (extra mp4)
             assert (out / "animation.mp4").stat().st_size > 0
         assert (out / "histories.png").stat().st_size > 0
+        assert "rendering 3 frames after the time loop" in (out / "run.log").read_text()
         xdmf = (out / "fields.xdmf").read_text()
         for name in ("displacement", "velocity", "von_mises_stress"):
             assert xdmf.count(f'<Attribute Name="{name}"') == 2  # two snapshots of each

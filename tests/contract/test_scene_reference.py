@@ -73,7 +73,8 @@ def test_the_test_scenes_validate_against_the_json_schema(raw):
 
 
 # The bad scenes whose mistake is beyond a JSON Schema: a number compared with the stable
-# step, a file or node set looked up, points compared across keys; and JSON's numbers, where
+# step, a file or node set looked up, points or values compared across keys or rows (a
+# table's increasing strains, melting above room temperature); and JSON's numbers, where
 # 1.0 is the integer 1 and a 400-digit integer is a number like any other.
 BEYOND = {
     "09_dt_above_limit",
@@ -85,6 +86,24 @@ BEYOND = {
     "32_boundary_unknown_group",
     "44_refine_point_far_from_the_body",
     "45_noise_amplitude_not_small",
+    "56_hardening_curve_decreasing_strain",
+    "60_melting_below_room",
+    # What only the mesh file, the size estimates or the file system can tell.
+    "62_mesh_file_geo_syntax_error",
+    "63_mesh_file_garbage",
+    "64_mesh_file_empty",
+    "65_density_1e-300",
+    "66_output_directory_is_a_file",
+    "67_output_directory_unwritable",
+    "68_element_size_1e-7",
+    "69_cube_at_1_mm",
+    "70_plate_layers_100000",
+    "71_refine_size_1e-9",
+    "72_end_time_1e9",
+    "73_frames_1e8",
+    "74_wall_secondary_all_excluded",
+    "75_mesh_file_noise_not_small",
+    "76_mesh_file_above_max_cells",
 }
 
 

@@ -169,12 +169,17 @@ def test_rigid_motions_give_no_force(cell, technology):
 
 @pytest.mark.skipif(COMM.size > 1, reason="starts a Python process of its own")
 def test_a_compiler_failure_is_one_line(tmp_path):
-    """Without a working C compiler the kernels fail with one line naming what to install."""
-    code = "from rwall_fem.kernels import load\nload()\n"
+    """Without a working C compiler a run stops with one line naming what to install, and
+    exit code 2."""
+    from conftest import SCENE
+
+    (tmp_path / "scene.toml").write_text(SCENE)
     env = os.environ | {"CC": str(tmp_path / "no-such-cc"), "RWALL_FEM_CACHE": str(tmp_path)}
     result = subprocess.run(
-        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
-    )
-    assert result.returncode != 0
-    last = result.stderr.strip().splitlines()[-1]
-    assert "could not compile the element kernels" in last and "install gcc" in last
+        [sys.executable, "-m", "rwall_fem", "check", "scene.toml"],
+        env=env, cwd=tmp_path, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert result.returncode == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith("rwall-fem: error: could not compile the element kernels")
+    assert "install gcc" in line

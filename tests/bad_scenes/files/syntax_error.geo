@@ -1,0 +1,3 @@
+// A .geo with a syntax error on line 3.
+Point(1) = {0, 0, 0};
+Line(1) = {1, 2;

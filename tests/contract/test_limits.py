@@ -1,0 +1,125 @@
+"""Size limits: what a scene will cost is estimated before meshing (``check`` prints it)
+and ``run`` refuses a scene above ``run.max_cells``, ``run.max_steps`` or
+``run.max_frames`` in one line that gives the estimate and the way on; ``--lift-limits``
+lifts them. Before: a 1 m cube at 1 mm meshed for minutes at 3 GB, ``end_time = 1e9``
+planned 2.8e15 steps, ``frames = 1e8`` made ``check`` take a minute.
+
+The command runs in-process on every rank of the session (each rank gets the exit code,
+rank 0 prints).
+"""
+
+import re
+
+import pytest
+from conftest import SCENE
+from mpi4py import MPI
+
+from rwall_fem import parse_scene
+from rwall_fem.cli import main
+from rwall_fem.estimate import estimate
+from rwall_fem.meshing import body_mesh
+from rwall_fem.output.schedule import spread
+
+STEEL = {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.3}
+
+
+@pytest.fixture
+def scene_file(shared_dir):
+    path = shared_dir / "scene.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        path.write_text(SCENE)
+    MPI.COMM_WORLD.Barrier()
+    return path
+
+
+def one_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    if MPI.COMM_WORLD.rank != 0:
+        return ""
+    assert len(err) == 1, err
+    return err[0]
+
+
+def test_check_prints_the_estimate_before_meshing(scene_file, capsys):
+    assert main(["check", str(scene_file)]) == 0
+    out = capsys.readouterr().out
+    if MPI.COMM_WORLD.rank == 0:
+        # The bar is 4 x 4 x 20 mm at 2 mm: 2 x 2 x 10 hexahedra.
+        estimate_line = out.index("estimate before meshing: about 40 hexahedron cells")
+        assert estimate_line < out.index("mesh: 40 hexahedron cells")
+        assert "steps of" in out and "3 frames" in out
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (["run.max_cells=10"], "run.max_cells: the mesh would have about 40 hexahedron cells"),
+        (["run.max_steps=50"], "run.max_steps: run.end_time = 2e-05 s takes about "),
+        (["output.frames=1001"], "run.max_frames: output.frames = 1001 is more than"),
+        (["output.fields=5", "run.max_frames=4"], "run.max_frames: output.fields = 5 is more"),
+    ],
+)
+def test_run_refuses_a_scene_above_a_limit_before_meshing(
+    overrides, message, scene_file, shared_dir, capsys
+):
+    out = shared_dir / "out"
+    sets = [item for o in overrides for item in ("--set", o)]
+    assert main(["run", str(scene_file), "--out", str(out), *sets]) == 2
+    line = one_line(capsys)
+    if MPI.COMM_WORLD.rank == 0:
+        assert message in line and line.endswith("or pass --lift-limits to rwall-fem")
+        assert "mesh:" not in capsys.readouterr().out  # nothing was meshed
+        assert not out.exists()
+
+
+def test_the_count_after_meshing_is_checked_too(scene_file, shared_dir, capsys):
+    """The estimate (slightly fewer steps than the stable step gives) passes the limit;
+    the steps counted with the stable step do not."""
+    out = shared_dir / "out"
+    assert main(["run", str(scene_file), "--out", str(out), "--set", "run.max_steps=70"]) == 2
+    line = one_line(capsys)
+    if MPI.COMM_WORLD.rank == 0:
+        steps = int(re.search(r"takes (\d+) steps", line).group(1))
+        assert steps > 70 and "more than run.max_steps = 70" in line
+
+
+def test_lift_limits_runs_the_scene(scene_file, shared_dir):
+    out = shared_dir / "out"
+    args = ["run", str(scene_file), "--out", str(out), "--quiet", "--set", "run.max_cells=10"]
+    args += ["--set", "output.frames=0"]
+    assert main([*args, "--lift-limits"]) == 0
+
+
+@pytest.mark.parametrize(
+    "mesh",
+    [
+        {"shape": "bar", "size": [0.01, 0.01, 0.04], "element_size": 1e-3,
+         "refine_point": [0.005, 0.005, 0.0], "refine_size": 1e-4},
+        {"shape": "bar", "size": [0.01, 0.01, 0.04], "element_size": 1e-3,
+         "refine_point": [0.005, 0.005, 0.0], "refine_size": 1e-4, "cell": "tetrahedron"},
+        {"shape": "round_bar", "radius": 0.005, "length": 0.01, "element_size": 5e-4,
+         "refine_point": [0.0, 0.005, 0.0], "refine_size": 5e-5},
+        {"shape": "round_bar", "radius": 0.005, "length": 0.01, "element_size": 1e-3,
+         "cell": "tetrahedron"},
+        {"shape": "plate", "size": [0.05, 0.03, 0.002], "element_size": 1e-3, "layers": 3},
+        {"shape": "plate_with_hole", "size": [0.05, 0.03, 0.002], "hole_radius": 0.005,
+         "element_size": 1e-3, "refine_point": [0.03, 0.015, 0.002], "refine_size": 1e-4},
+    ],
+)  # fmt: skip
+def test_cell_estimates_hold_to_25_percent(mesh):
+    """Against the count of the mesh gmsh makes (the factors were measured on others)."""
+    scene = parse_scene({"run": {"end_time": 1e-5}, "mesh": mesh, "material": STEEL})
+    cells = body_mesh(MPI.COMM_WORLD, scene.mesh).num_cells
+    assert estimate(scene).cells == pytest.approx(cells, rel=0.25)
+
+
+def test_spread_samples_as_listed_whatever_their_number():
+    for count in range(6):
+        for last in range(12):
+            listed = {round(k * last / max(count - 1, 1)) for k in range(count)}
+            assert {s for s in range(-1, last + 2) if s in spread(count, last)} == listed
+    assert all(s in spread(10**8, 1000) for s in range(1001))  # nothing listed: no minute
+    frames, last = spread(1000, 3528582), 3528582
+    for k in (0, 1, 2, 499, 500, 997, 998, 999):  # 3532.1 steps apart: the neighbours are not
+        step = round(k * last / 999)
+        assert step in frames and step - 1 not in frames and step + 1 not in frames
