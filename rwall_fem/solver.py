@@ -137,6 +137,10 @@ class InternalForce(Force, Protocol):
 
     def energies(self, state: State) -> dict[str, float]: ...
 
+    def cell_fields(self, state: State) -> dict[str, np.ndarray]:
+        """Values per owned cell for the outputs (e.g. ``"plastic_strain"``); may be empty."""
+        ...
+
 
 class BodyForce(Force, Protocol):
     """An external force that adds to ``state.a``; :meth:`work` is its work (J) on this
