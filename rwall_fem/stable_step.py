@@ -24,8 +24,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from rwall_fem import _compat
-from rwall_fem.mechanics import EDGES, coordinate_pattern
+from rwall_fem.mechanics import coordinate_pattern, shortest_edge
 from rwall_fem.solver import RunStopped
 
 __all__ = ["ElementStepMonitor", "TangentStepMonitor"]
@@ -156,18 +155,9 @@ class ElementStepMonitor(_StepMonitor):
 
     def __init__(self, V, u, force, dt_stable: float, comm: MPI.Comm, every: int = 50):
         super().__init__(dt_stable, every)
-        self.comm, self.u, self.force = comm, u, force
-        cells = _compat.cell_nodes(V)[: V.mesh.topology.index_map(V.mesh.topology.dim).size_local]
-        pairs = np.array(EDGES[V.mesh.topology.cell_type.name])
-        self._ends = cells[:, pairs[:, 0]], cells[:, pairs[:, 1]]
+        self.comm, self.V, self.u, self.force = comm, V, u, force
         self.X = V.tabulate_dof_coordinates()
-        self.reference = self.shortest_edge(self.X)
-
-    def shortest_edge(self, x: np.ndarray) -> float:
-        """The shortest edge (m) of the owned cells of any rank, nodes at ``x``."""
-        first, second = self._ends
-        lengths = np.linalg.norm(x[first] - x[second], axis=-1)
-        return self.comm.allreduce(float(lengths.min(initial=np.inf)), op=MPI.MIN)
+        self.reference = shortest_edge(V, self.X)
 
     def estimate(self, s) -> float:
         inverted = self.comm.allreduce(self.force.inverted_cells)
@@ -178,4 +168,4 @@ class ElementStepMonitor(_StepMonitor):
                 "step; lower run.dt_scale or refine the mesh"
             )
         self.u.scatter_forward()
-        return self.dt_stable * self.shortest_edge(self.X + self.u.array) / self.reference
+        return self.dt_stable * shortest_edge(self.V, self.X + self.u.array) / self.reference
