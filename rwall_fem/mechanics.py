@@ -20,7 +20,6 @@ from rwall_fem import _compat
 from rwall_fem.scene import Material
 
 __all__ = [
-    "EDGES",
     "coordinate_pattern",
     "critical_time_step",
     "element_time_step",
@@ -32,7 +31,7 @@ __all__ = [
 ]
 
 # Vertices joined by an edge, in DOLFINx's reference-cell numbering.
-EDGES = {
+_EDGES = {
     "tetrahedron": [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)],
     "hexahedron": [
         (0, 1),
@@ -150,7 +149,7 @@ def shortest_edge(V, x: np.ndarray | None = None, chunk: int = 65536) -> float:
     if x is None:
         x = V.tabulate_dof_coordinates()
     cells = _compat.cell_nodes(V)[: V.mesh.topology.index_map(V.mesh.topology.dim).size_local]
-    first, second = np.array(EDGES[V.mesh.topology.cell_type.name]).T
+    first, second = np.array(_EDGES[V.mesh.topology.cell_type.name]).T
     shortest = np.inf
     for start in range(0, len(cells), chunk):
         block = cells[start : start + chunk]
