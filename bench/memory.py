@@ -3,11 +3,15 @@
 The bar scene of bench/case.py with its real start-up (gmsh, the lumped mass, the element
 kernels, the SLEPc stable step) and ``--steps`` steps, history every step. After each
 stage the resident set (VmRSS) and its peak so far (VmHWM, the getrusage maximum) are
-read from /proc/self/status, so that the stage that sets the peak can be named. Writes one
-JSON record (rank 0; figures summed over ranks).
+read from /proc/self/status, so that the stage that sets the peak can be named. With
+``--trim``, freed memory is handed back to the system (``malloc_trim``) before each reading,
+so that the resident set is the memory still in use. Writes one JSON record (rank 0;
+figures summed over ranks).
 """
 
 import argparse
+import ctypes
+import gc
 import json
 import resource
 import time
@@ -20,6 +24,7 @@ from rwall_fem import _compat, build_simulation
 
 comm = MPI.COMM_WORLD
 stages = []
+TRIM = False  # --trim: hand freed memory back to the system after each stage
 
 
 def status():
@@ -34,6 +39,9 @@ def status():
 
 
 def note(stage, seconds=0.0):
+    if TRIM:
+        gc.collect()
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
     rss, peak = status()
     stages.append({"stage": stage, "rss": rss, "peak": peak, "seconds": seconds})
 
@@ -60,8 +68,15 @@ def main():
     p.add_argument("--technology", default="physical")
     p.add_argument("--steps", type=int, default=10)
     p.add_argument("--fixed-step", action="store_true", help="no SLEPc stable step")
+    p.add_argument(
+        "--trim",
+        action="store_true",
+        help="malloc_trim after each stage: the resident set is then the live memory",
+    )
     p.add_argument("--json", required=True)
     a = p.parse_args()
+    global TRIM
+    TRIM = a.trim
     note("imports")
     watched(_compat, "model_to_mesh", "meshing: distributed by DOLFINx", "meshing: gmsh model")
     watched(build, "body_mesh", "meshing: gmsh finalized")
@@ -88,6 +103,7 @@ def main():
         "cell": a.cell,
         "n": a.n,
         "technology": sim.info["element"],
+        "trim": a.trim,
         "ranks": comm.size,
         "cells": cells,
         "nodes": sim.info["nodes"],
