@@ -274,7 +274,10 @@ def report(data):
         f"{load[1][0]:.2f} (5-minute: {load[0][1]:.2f} / {load[1][1]:.2f}), after waiting "
         f"{data['waited']:.0f} s for a quiet machine. Whole run: {data['seconds']:.0f} s. "
         "Produced by `make bench` (bench/bench.py); raw figures in bench/results.json. Wall "
-        "times of the slowest rank; medians over alternating rounds within one process."
+        "times of the slowest rank; medians over alternating rounds within one process. "
+        "1-minute load average at the start of each section: "
+        + ", ".join(f"{k} {v:.2f}" for k, v in data.get("section_loads", {}).items())
+        + "."
     )
     w("")
     w("## Targets")
@@ -419,12 +422,17 @@ def _bar_section(w, data):
         "command)."
     )
     w("")
-    w("| code | element | ranks | loop (s), median | runs (s) | contact duration (us) | "
-      "impulse (N s) | rebound (m/s) | vs old: duration, impulse, rebound |")  # fmt: skip
-    w("|---|---|---|---|---|---|---|---|---|")
+    w("| code | element | ranks | loop (s), median | runs (s) | x faster than the old code "
+      "(same run) | contact duration (us) | impulse (N s) | rebound (m/s) | vs old (recorded): "
+      "duration, impulse, rebound |")  # fmt: skip
+    w("|---|---|---|---|---|---|---|---|---|---|")
+    old_loop = None
+    if "old" in bar:
+        old_loop = statistics.median(x["loop_seconds"] for x in bar["old"])
     for name, runs in bar.items():
         r = runs[0]
         loop = statistics.median(x["loop_seconds"] for x in runs)
+        faster = f"{old_loop / loop:.1f}" if old_loop else "-"
         diffs = ", ".join(
             f"{100 * (r[k] / old[k] - 1):+.4f} %" for k in ("contact_duration", "impulse", "rebound")
         )
@@ -432,12 +440,12 @@ def _bar_section(w, data):
         code = "old (c11ba60)" if name == "old" else "new"
         each = ", ".join(f"{x['loop_seconds']:.2f}" for x in runs)
         w(
-            f"| {code} | {r['element']} | {ranks} | {loop:.2f} | {each} | "
+            f"| {code} | {r['element']} | {ranks} | {loop:.2f} | {each} | {faster} | "
             f"{1e6 * r['contact_duration']:.4f} | {r['impulse']:.6f} | {r['rebound']:.5f} | "
             f"{diffs} |"
         )
     w(
-        f"| old, recorded | Q1 hexahedra, PETSc BAIJ K u | 1 | - | - | "
+        f"| old, recorded | Q1 hexahedra, PETSc BAIJ K u | 1 | - | - | - | "
         f"{1e6 * old['contact_duration']:.4f} | {old['impulse']:.6f} | {old['rebound']:.5f} | "
         "reference |"
     )
@@ -714,11 +722,25 @@ def main():
     p.add_argument("--quiet-wait", type=float, default=1800.0,
                    help="seconds to wait at most for the 1-minute load average to fall below 0.5")  # fmt: skip
     p.add_argument("--only", help="comma-separated sections, for development")
+    p.add_argument("--smoke", action="store_true", help="tiny sizes: checks the script, not the code")
+    p.add_argument("--from-json", help="write the report of an earlier run's results.json")
     a = p.parse_args()
+    if a.from_json:
+        data = json.loads(Path(a.from_json).read_text())
+        data["targets"] = targets(data)
+        Path(a.out).write_text(report(data))
+        return
+    if a.smoke:
+        global SCENE_80K
+        SCENE_80K = [x.replace("5e-4", "2e-3") for x in SCENE_80K]
+        a.sizes, a.rounds_80k = "10k", 1
     only = set(a.only.split(",")) if a.only else None
 
     def wanted(name):
-        return only is None or name in only
+        if only is None or name in only:
+            data.setdefault("section_loads", {})[name] = os.getloadavg()[0]
+            return True
+        return False
 
     waited = wait_for_quiet(a.quiet_wait)
     t_start = time.perf_counter()
@@ -738,23 +760,25 @@ def main():
     if wanted("costs"):
         log("material costs")
         data["costs"] = [
-            measure("costs.py", 1, "--cell", cell, "--n", SIZES[cell]["100k"],
+            measure("costs.py", 1, "--cell", cell, "--n", SIZES[cell]["10k" if a.smoke else "100k"],
                     "--step-technologies", techs)
             for cell, techs in (("hexahedron", "full,physical,stiffness"), ("tetrahedron", "tet"))
         ]  # fmt: skip
     if wanted("memory"):
         log("memory at 1M cells")
         data["memory"] = [
-            measure("memory.py", 1, "--cell", cell, "--n", SIZES[cell]["1M"])
+            measure("memory.py", 1, "--cell", cell, "--n", SIZES[cell]["10k" if a.smoke else "1M"])
             for cell in ("hexahedron", "tetrahedron")
         ]
-        data["memory_live"] = measure("memory.py", 1, "--n", SIZES["hexahedron"]["1M"], "--trim")
+        n = SIZES["hexahedron"]["10k" if a.smoke else "1M"]
+        data["memory_live"] = measure("memory.py", 1, "--n", n, "--trim")
     if wanted("startup"):
         log("start-up")
         data["startup"] = startup()
     if wanted("taylor"):
         log("Taylor rod")
-        data["taylor"] = measure("taylor.py", 1)
+        smoke = ["--element-size", "1.6e-3", "--dt-scale", "0.2"] if a.smoke else []
+        data["taylor"] = measure("taylor.py", 1, *smoke)
     data["load"].append(os.getloadavg())
     data["seconds"] = time.perf_counter() - t_start
     out = Path(a.out)
