@@ -4,12 +4,16 @@ The bar scene of bench/case.py at 10k cells, default technology, history every s
 each phase the loop calls (the internal force, with its compiled kernel timed apart;
 each wall; the update pass; the history sample) is wrapped by a timer, and what is left
 of the step is the loop itself (recorders' ``due``, the Python around the calls). The
-timers add well under a microsecond per call. Writes one JSON record of seconds per step.
+timers add well under a microsecond per call. Then a run under cProfile names the Python
+functions that take the time outside the kernel (its own overhead inflates them). Writes
+one JSON record of seconds per step.
 """
 
 import argparse
+import cProfile
 import functools
 import json
+import pstats
 import time
 
 from mpi4py import MPI
@@ -62,9 +66,21 @@ def main():
     best = {"kernel": best.pop("kernel"), "rest of the internal force (fill, -f/m)":
             best.pop("internal force"), **best}
     best["loop and recorders"] = best["step"] - sum(v for k, v in best.items() if k != "step")
+    sim = build_simulation(sc, comm, f"/tmp/rwall-bench-anatomy-{comm.size}")
+    profiler = cProfile.Profile()
+    profiler.enable()
+    sim.run()
+    profiler.disable()
+    steps = sim.history.summary["steps"] + 1
+    rows = [
+        {"function": f"{file.split('/')[-1]}:{line}({name})", "calls": calls,
+         "own_per_step": own / steps, "cumulative_per_step": cumulative / steps}
+        for (file, line, name), (_, calls, own, cumulative, _) in pstats.Stats(profiler).stats.items()
+    ]  # fmt: skip
+    record = {"phases": best, "profile": sorted(rows, key=lambda r: -r["own_per_step"])[:15]}
     if comm.rank == 0:
         with open(a.json, "w") as f:
-            json.dump(best, f, indent=1)
+            json.dump(record, f, indent=1)
 
 
 if __name__ == "__main__":

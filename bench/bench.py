@@ -397,7 +397,8 @@ def _outside_section(w, data):
                 f"{1 - k / hundred:.0%} |"
             )
     w("")
-    for cell, phases in data.get("anatomy", {}).items():
+    for cell, record in data.get("anatomy", {}).items():
+        phases = record["phases"]
         total = phases["step"]
         parts = ", ".join(
             f"{name} {1e6 * t:.0f} us ({t / total:.0%})"
@@ -406,6 +407,16 @@ def _outside_section(w, data):
         )
         w(f"- {cell}: a step of {1e6 * total:.0f} us = {parts}.")
     w("")
+    for cell, record in data.get("anatomy", {}).items():
+        w(f"cProfile of the loop, {cell} (own time per step; the profiler inflates Python "
+          "calls):")  # fmt: skip
+        w("")
+        w("| function | calls | own (us / step) | cumulative (us / step) |")
+        w("|---|---|---|---|")
+        for row in record["profile"][:10]:
+            w(f"| `{row['function']}` | {row['calls']} | {1e6 * row['own_per_step']:.1f} | "
+              f"{1e6 * row['cumulative_per_step']:.1f} |")  # fmt: skip
+        w("")
 
 
 def _bar_section(w, data):
