@@ -16,9 +16,9 @@ import json
 import pstats
 import time
 
+import case
 from mpi4py import MPI
 
-import case
 from rwall_fem import build_simulation
 
 
@@ -63,8 +63,11 @@ def main():
         if best is None or phases["step"] < best["step"]:
             best = phases
     best["internal force"] -= best["kernel"]
-    best = {"kernel": best.pop("kernel"), "rest of the internal force (fill, -f/m)":
-            best.pop("internal force"), **best}
+    best = {
+        "kernel": best.pop("kernel"),
+        "rest of the internal force (fill, -f/m)": best.pop("internal force"),
+        **best,
+    }
     best["loop and recorders"] = best["step"] - sum(v for k, v in best.items() if k != "step")
     sim = build_simulation(sc, comm, f"/tmp/rwall-bench-anatomy-{comm.size}")
     profiler = cProfile.Profile()
@@ -73,10 +76,16 @@ def main():
     profiler.disable()
     steps = sim.history.summary["steps"] + 1
     rows = [
-        {"function": f"{file.split('/')[-1]}:{line}({name})", "calls": calls,
-         "own_per_step": own / steps, "cumulative_per_step": cumulative / steps}
-        for (file, line, name), (_, calls, own, cumulative, _) in pstats.Stats(profiler).stats.items()
-    ]  # fmt: skip
+        {
+            "function": f"{file.split('/')[-1]}:{line}({name})",
+            "calls": calls,
+            "own_per_step": own / steps,
+            "cumulative_per_step": cumulative / steps,
+        }
+        for (file, line, name), (_, calls, own, cumulative, _) in pstats.Stats(
+            profiler
+        ).stats.items()
+    ]
     record = {"phases": best, "profile": sorted(rows, key=lambda r: -r["own_per_step"])[:15]}
     if comm.rank == 0:
         with open(a.json, "w") as f:

@@ -17,15 +17,16 @@ Each figure is the median over rounds of the slowest rank's time. Writes one JSO
 """
 
 import argparse
+import functools
 import json
 import resource
 import statistics
 import time
 
+import workarounds
 from mpi4py import MPI
 
 import rwall_fem.build as build
-import workarounds
 from rwall_fem import _compat, build_simulation, parse_scene
 from rwall_fem.mechanics import stiffness_form
 from rwall_fem.meshing import body_mesh
@@ -141,16 +142,16 @@ def main():
                 sim.run()
                 s = sim.history.summary
                 times[f"{tech}:step/{every}"].append(s["wall_seconds"] / (s["steps"] + 1))
-            force = sim.internal
+            force, state = sim.internal, sim.state
             times[f"{tech}:kernel"].append(block(force._kernel, repeats))
-            times[f"{tech}:accelerate"].append(block(lambda: force.accelerate(sim.state), repeats))
+            accelerate = functools.partial(force.accelerate, state)
+            times[f"{tech}:accelerate"].append(block(accelerate, repeats))
             summary[tech] = {
                 "element": s["element"],
                 "steps": s["steps"] + 1,
                 "status": s["status"],
                 "balance_error": s["energy"]["max_balance_error"],
             }
-            del sim, force
     record = {
         "cell": a.cell,
         "n": a.n,
@@ -165,7 +166,11 @@ def main():
         "peak_rss_bytes": peak_rss(),
     }
     if K is not None:
-        record |= {"nnz": info["nz_used"], "rows": K.getSize()[0], "assembly_seconds": assembly_seconds}
+        record |= {
+            "nnz": info["nz_used"],
+            "rows": K.getSize()[0],
+            "assembly_seconds": assembly_seconds,
+        }
     if comm.rank == 0:
         with open(a.json, "w") as f:
             json.dump(record, f, indent=1)

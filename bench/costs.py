@@ -21,10 +21,9 @@ import json
 import statistics
 import time
 
-import numpy as np
+import case
 from mpi4py import MPI
 
-import case
 from rwall_fem import _compat, build_simulation, parse_scene
 from rwall_fem.elements import ElementForce, GhostedField, Technology
 from rwall_fem.meshing import body_mesh
@@ -36,16 +35,24 @@ MATERIALS = {
     "saint_venant_kirchhoff": {"model": "saint_venant_kirchhoff"},
     "neo_hookean": {"model": "neo_hookean"},
     "elastic_plastic": {
-        "model": "elastic_plastic", "hardening": "linear",
-        "yield_stress": 250e6, "hardening_modulus": 1e9,
+        "model": "elastic_plastic",
+        "hardening": "linear",
+        "yield_stress": 250e6,
+        "hardening_modulus": 1e9,
     },
     "johnson_cook": {
-        "model": "johnson_cook", "yield_stress": 250e6, "hardening_coefficient": 500e6,
-        "hardening_exponent": 0.3, "strain_rate_coefficient": 0.02,
-        "heating": {"softening_exponent": 1.0, "melting_temperature": 1800.0,
-                    "specific_heat": 450.0},
+        "model": "johnson_cook",
+        "yield_stress": 250e6,
+        "hardening_coefficient": 500e6,
+        "hardening_exponent": 0.3,
+        "strain_rate_coefficient": 0.02,
+        "heating": {
+            "softening_exponent": 1.0,
+            "melting_temperature": 1800.0,
+            "specific_heat": 450.0,
+        },
     },
-}  # fmt: skip
+}
 CELL_TECHNOLOGIES = {
     "tetrahedron": ["tet"],
     "hexahedron": ["full", "physical", "stiffness", "viscous", "none"],

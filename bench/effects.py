@@ -2,8 +2,8 @@
 
 One scene (a soft block of 4,096 hexahedra resting on a plane), run with one effect
 switched on at a time, the variants alternating in rounds; the figure is the median over
-the rounds of the time loop's wall time per step (start-up excluded). What a scene does not ask for is not in its
-pipeline, so the base line is what every scene pays.
+the rounds of the time loop's wall time per step (start-up excluded). What a scene does
+not ask for is not in its pipeline, so the base line is what every scene pays.
 """
 
 import copy
@@ -80,8 +80,9 @@ def main():
             f"`python bench/effects.py` on {comm.size} rank(s); {rows[0][1]} hexahedra, "
             f"{rows[0][2]} steps, median of {ROUNDS} alternating runs of the time loop. 1-minute "
             "load average "
-            f"before / after: {load[0]:.2f} / {load[1]:.2f} (above about 1, another job "
-            "shares the cores and the ratios are noise).",
+            f"before / after: {load[0]:.2f} / {load[1]:.2f} (this measurement counts about 1 "
+            "per rank itself: well above that, another job shares the cores and the ratios "
+            "are noise).",
             "",
             "| scene | ms / step | x base |",
             "|---|---|---|",

@@ -16,9 +16,9 @@ import json
 import resource
 import time
 
+import case
 from mpi4py import MPI
 
-import case
 import rwall_fem.build as build
 from rwall_fem import _compat, build_simulation
 

@@ -11,29 +11,37 @@ import argparse
 import json
 import time
 
+import workarounds
 from mpi4py import MPI
 
-import workarounds
 from rwall_fem import build_simulation, parse_scene
 
 COPPER = {
-    "model": "elastic_plastic", "density": 8930.0, "young": 117e9, "poisson": 0.35,
-    "hardening": "linear", "yield_stress": 400e6, "hardening_modulus": 100e6,
-}  # fmt: skip
+    "model": "elastic_plastic",
+    "density": 8930.0,
+    "young": 117e9,
+    "poisson": 0.35,
+    "hardening": "linear",
+    "yield_stress": 400e6,
+    "hardening_modulus": 100e6,
+}
 
 
 def scene(element_size, dt_scale, history_interval):
     return {
         "run": {"end_time": 80e-6, "dt_scale": dt_scale},
         "mesh": {
-            "shape": "round_bar", "radius": 3.2e-3, "length": 32.4e-3,
-            "element_size": element_size, "cell": "hexahedron",
+            "shape": "round_bar",
+            "radius": 3.2e-3,
+            "length": 32.4e-3,
+            "element_size": element_size,
+            "cell": "hexahedron",
         },
         "material": COPPER,
         "initial": {"velocity": [0.0, 0.0, -227.0]},
         "wall": [{"kind": "plane", "point": [0.0, 0.0, 0.0], "normal_point": [0.0, 0.0, 1.0]}],
         "output": {"frames": 0, "plot": False, "history_interval": history_interval},
-    }  # fmt: skip
+    }
 
 
 def main():
