@@ -9,8 +9,9 @@
 #   make demos                 run every demo (scenes and Python scripts) into results/
 #   make docs                  the documentation site (Sphinx + MyST) into docs/_build/html,
 #                              warnings as errors; on the Debian leg, a few seconds, runs no demo
-#   make study / make bench    accuracy vs wall time (results/study, copied to docs/); throughput
-#                              benchmark (bench/results.md); both on the Debian leg, long runs
+#   make study / make bench    accuracy vs wall time per element technology (results/study, copied
+#                              to docs/); benchmark (bench/results.md, bench/effects.md); both on
+#                              the Debian leg, long runs
 #   make clean                 remove both venvs, test logs, Python caches and the built docs
 #                              (results/ is kept)
 #   make clean-wheels          remove the wheelhouses (see below; the next set-up refills them)
@@ -214,17 +215,23 @@ docs: venv-0.5
 	$(RUN_ENV) $(VENV)/bin/python -m sphinx -W --keep-going -E -q -b html docs $(DOCS_OUT)
 	@echo "    open $(DOCS_OUT)/index.html"
 
-# The full study takes 10-20 minutes; its table and plots are copied into docs/ for the README.
+# The full study (four element technologies) takes 15-30 minutes; its table and plots are
+# copied into docs/ for the README.
 study: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/rwall-fem study --out results/study
 	mkdir -p docs
 	cp results/study/study.md docs/study.md
 	cp results/study/study_*.png docs/
 
-# Throughput, memory bandwidth floor, Python share, start-up, 2-rank efficiency (~10 minutes).
+# The kernels against the old BAIJ product, whole steps, 2-rank efficiency, the 80k-hexahedron
+# scene, material costs, memory, start-up, the Taylor rod (bench/results.md, ~45 minutes), then
+# the cost of each effect (bench/effects.md). OLD_TREE: a worktree of the old code (commit
+# c11ba60, with its .venv) whose time loop on the 80k scene is run alternately with the new.
+OLD_TREE ?=
 bench: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
-	    $(VENV)/bin/python bench/bench.py --out bench/results.md
+	    $(VENV)/bin/python bench/bench.py --out bench/results.md $(if $(OLD_TREE),--old-tree $(OLD_TREE))
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/effects.py
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

@@ -1,18 +1,33 @@
-"""Throughput benchmark of the explicit step (not a test): ``make bench`` -> bench/results.md.
+"""Benchmark of the explicit step (not a test): ``make bench`` -> bench/results.md and .json.
 
-Measures, in one run on this machine: cell-steps per second of the linear elastic bar on a
-fixed wall at about 10k, 100k and 1M cells, tetrahedra and hexahedra, 1 and 2 MPI ranks;
-the memory bandwidth (numpy triad, 1 and 2 processes) and the floor it implies for the
-stiffness product; the share of a step spent around the K u kernel at 10k cells; peak
-memory per cell; start-up time to the first step with the form cache warm and cold; the
-2-rank parallel efficiency; and a cProfile of the step with side experiments for what
-does not belong in the hot loop. Every figure is a median (or STREAM's best-of) of this run.
+Every measurement runs in a fresh process (bench/*.py, under mpirun for 2 ranks); within
+a process the variants alternate in rounds and the figures are medians, so that ratios
+come from one run on one machine:
+
+- throughput (case.py): the old code's internal force, the PETSc BAIJ product K u, against
+  the element kernels and whole steps, ns per cell-step at about 10k, 100k and 1M cells,
+  tetrahedra and hexahedra (one point with physical hourglass control, and 2x2x2), 1 and
+  2 ranks; the 2-rank efficiency; the time outside the kernels at 10k cells;
+- the 80k-hexahedron bar scene (``rwall-fem run``): time loop and answers of the default
+  and of full integration, against the old code's answers (bench/old_code.json) and, with
+  ``--old-tree``, against the old code's time loop run alternately;
+- cost of each material relative to linear elasticity per technology (costs.py);
+- peak memory per cell of a process that builds and runs about 1M cells (memory.py);
+- start-up of ``rwall-fem run`` at 10k cells by stage, cold and warm caches (startup.py);
+- the Taylor rod at the demo's resolution (taylor.py);
+- memory bandwidth (stream.py), for the floor of the BAIJ product.
+
+The machine's load average is recorded before and after; the run waits (``--quiet-wait``)
+for the 1-minute load average to fall below 0.5 first.
 """
+
+from __future__ import annotations
 
 import argparse
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -20,22 +35,41 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
 PY = sys.executable
+CLI = str(Path(PY).with_name("rwall-fem"))
 MPIRUN = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n"]
 # Bricks per side n (bar n x n x 10 n mm, 1 mm bricks): 10 n^3 hexahedra, 60 n^3 tetrahedra.
 SIZES = {
     "hexahedron": {"10k": 10, "100k": 22, "1M": 46},
     "tetrahedron": {"10k": 6, "100k": 12, "1M": 26},
 }
-CELL_STEPS = 1.5e7  # per measurement: a few seconds of loop at any size
+CELL_STEPS = 1.5e7  # per whole-step run: about a second of loop at any size
+ROUNDS = {"10k": 5, "100k": 5, "1M": 3}
+TARGETS = {"physical": 80.0, "tet": 15.0}  # ns per cell-step on 1 rank
+SCENE_80K = [
+    "--set",
+    "mesh.element_size=5e-4",
+    "--set",
+    "run.end_time=1e-4",
+    "--set",
+    "output.frames=0",
+    "--set",
+    "output.plot=false",
+]
+TECH_80K = {"physical": [], "full": ["--set", 'element.integration="full"']}
 
 
-def sh(cmd, env=None, timeout=1800):
+def log(*args):
+    print("bench:", *args, flush=True)
+
+
+def sh(cmd, env=None, timeout=3600, cwd=None):
     started = time.perf_counter()
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, cwd=cwd)
     if done.returncode != 0:
         sys.stderr.write(done.stdout[-2000:] + done.stderr[-4000:])
-        raise RuntimeError(f"failed: {' '.join(cmd)}")
+        raise RuntimeError(f"failed ({done.returncode}): {' '.join(cmd)}")
     return done.stdout, time.perf_counter() - started
 
 
@@ -44,43 +78,27 @@ def launch(ranks, args, env=None):
     return sh([*prefix, *args], env=env)
 
 
-def case(cell, n, ranks, steps, *extra, env=None):
+def measure(script, ranks, *args, env=None):
+    """Run bench/<script> with ``--json`` into a temporary file; returns the record."""
     with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as f:
         path = f.name
-    launch(
-        ranks,
-        [
-            str(HERE / "case.py"),
-            "--cell",
-            cell,
-            "--n",
-            str(n),
-            "--steps",
-            str(steps),
-            "--json",
-            path,
-            *extra,
-        ],
-        env=env,
-    )
-    record = json.loads(Path(path).read_text())
-    os.unlink(path)
-    return record
+    try:
+        launch(ranks, [str(HERE / script), *map(str, args), "--json", path], env=env)
+        return json.loads(Path(path).read_text())
+    finally:
+        os.unlink(path)
 
 
 def machine():
     cpu = next(
         (
-            line.split(":", 1)[1].strip()
-            for line in open("/proc/cpuinfo")
-            if line.startswith("model name")
+            ln.split(":", 1)[1].strip()
+            for ln in open("/proc/cpuinfo")
+            if ln.startswith("model name")
         ),
         "?",
     )
-    mem = (
-        next(int(line.split()[1]) for line in open("/proc/meminfo") if line.startswith("MemTotal"))
-        / 2**20
-    )
+    mem = next(int(ln.split()[1]) for ln in open("/proc/meminfo") if ln.startswith("MemTotal"))
     # In a child: importing petsc4py here would make this process an MPI singleton, and
     # Open MPI's mpirun refuses to start from inside one.
     versions, _ = sh(
@@ -92,305 +110,854 @@ def machine():
         ]
     )
     dolfinx_version, petsc_version = versions.split()
+    commit = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
     return {
         "nproc": os.cpu_count(),
         "cpu": cpu,
-        "memory_gib": mem,
+        "memory_gib": mem / 2**20,
         "python": platform.python_version(),
         "dolfinx": dolfinx_version,
         "petsc": petsc_version,
+        "commit": commit,
     }
 
 
 def wait_for_quiet(limit):
-    """Wait (at most ``limit`` s) until no other job loads the machine; returns seconds waited.
-
-    Two ranks on two cores beside another job measure the other job, not the solver.
-    """
+    """Wait (at most ``limit`` s) until the 1-minute load average is below 0.5."""
     started = time.perf_counter()
     while os.getloadavg()[0] > 0.5 and time.perf_counter() - started < limit:
-        time.sleep(10)
+        time.sleep(15)
     return time.perf_counter() - started
 
 
-def floor_bytes(r):
-    """Bytes that must move for one K u per cell: values (8 per entry), one column index
-    per 3 x 3 block, block row pointers, u read and K u written (8 per row each)."""
+# ---- the measurements -------------------------------------------------------------------
+
+
+def throughput(labels):
+    results = []
+    for label in labels:
+        for cell in ("tetrahedron", "hexahedron"):
+            n = SIZES[cell][label]
+            cells = (10 if cell == "hexahedron" else 60) * n**3
+            steps = max(10, int(CELL_STEPS / cells))
+            intervals = "1,100" if label == "10k" else "1"
+            for ranks in (1, 2):
+                log(f"throughput: {cell} {label} ({cells:,} cells, {steps} steps), {ranks} rank(s)")
+                try:
+                    r = measure(
+                        "case.py",
+                        ranks,
+                        "--cell",
+                        cell,
+                        "--n",
+                        n,
+                        "--steps",
+                        steps,
+                        "--rounds",
+                        ROUNDS[label],
+                        "--intervals",
+                        intervals,
+                        "--technologies",
+                        "physical,full",
+                    )
+                except (RuntimeError, subprocess.TimeoutExpired) as err:
+                    r = {"cell": cell, "n": n, "ranks": ranks, "cells": cells, "failed": str(err)}
+                r["label"] = label
+                results.append(r)
+    return results
+
+
+def answers(summary):
+    """Contact duration (s; the last contact step counts whole), wall impulse (N s) and
+    rebound velocity (m/s) of a bar that fell along -z onto the plane of wall 0."""
+    wall = summary["walls"][0]
+    return {
+        "contact_duration": wall["last_contact"] - wall["first_contact"] + summary["dt"],
+        "impulse": -wall["normal_impulse"][2],
+        "rebound": summary["final_momentum"][2] / summary["mass"],
+    }
+
+
+def run_80k(cli, scene, extra, ranks=1):
+    """One run of the 80k scene by ``rwall-fem run`` (``cli``); on 2 ranks the new code's
+    entry point with the fixes of bench/workarounds.py."""
+    with tempfile.TemporaryDirectory() as out:
+        args = [scene, *SCENE_80K, *extra, "--out", out, "--quiet"]
+        if ranks == 1:
+            sh([cli, "run", *args], cwd=out)
+        else:
+            sh([*MPIRUN, str(ranks), PY, str(HERE / "run_scene.py"), *args], cwd=out)
+        summary = json.loads((Path(out) / "summary.json").read_text())
+    return {
+        "loop_seconds": summary["wall_seconds"],
+        "steps": summary["steps"] + 1,
+        "cells": summary["cells"],
+        "element": summary.get("element", "Q1 hexahedra, PETSc BAIJ K u (old code)"),
+        "balance_error": summary["energy"]["max_balance_error"],
+        **answers(summary),
+    }
+
+
+def bar_80k(old_tree, rounds):
+    """The 80k-hexahedron scene: old code (if given), default and full integration,
+    alternating; then the default on 2 ranks once."""
+    scene = str(ROOT / "demos" / "bar_impact.toml")
+    runs = {}
+    for i in range(rounds):
+        if old_tree:
+            log(f"80k scene, round {i + 1}: old code ({old_tree})")
+            old_cli = str(Path(old_tree) / ".venv" / "bin" / "rwall-fem")
+            old_scene = str(Path(old_tree) / "demos" / "bar_impact.toml")
+            runs.setdefault("old", []).append(run_80k(old_cli, old_scene, []))
+        for tech, extra in TECH_80K.items():
+            log(f"80k scene, round {i + 1}: {tech}")
+            runs.setdefault(tech, []).append(run_80k(CLI, scene, extra))
+    log("80k scene: physical on 2 ranks")
+    runs["physical, 2 ranks"] = [run_80k(CLI, scene, [], ranks=2)]
+    return runs
+
+
+# A start-up fix that changes no result: Open MPI's UCX transport layer, probed by MPI_Init
+# even in a single process, is not needed on one machine.
+OB1 = {"OMPI_MCA_pml": "ob1"}
+
+
+def staged_launch(scene, out, env):
+    """One launch of bench/startup.py: the stages of a start-up (s)."""
+    args = [str(scene), "--out", out, "--launched", repr(time.time())]
+    text, _ = sh([PY, str(HERE / "startup.py"), *args], env=env)
+    return json.loads(text.strip().splitlines()[-1])
+
+
+def command_launch(scene, out, env):
+    """One ``rwall-fem run`` process, start to exit (s)."""
+    return sh([CLI, "run", str(scene), "--out", out, "--quiet"], env=env)[1]
+
+
+def startup(repeats=3):
+    """Cold (fresh XDG_CACHE_HOME: no FFCx nor kernel cache) then warm launches, the warm
+    ones alternating with launches under OB1; Python may write its bytecode caches, as on
+    a user's machine."""
+    base = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    out = {}
+    for cell in ("hexahedron", "tetrahedron"):
+        scene = HERE / f"startup_{cell[:3]}.toml"
+        with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as res:
+            env = base | {"XDG_CACHE_HOME": cache}
+            cold = staged_launch(scene, res, env)
+            warm, ob1, whole, whole_ob1 = [], [], [], []
+            for _ in range(repeats):
+                warm.append(staged_launch(scene, res, env))
+                ob1.append(staged_launch(scene, res, env | OB1))
+                whole.append(command_launch(scene, res, env))
+                whole_ob1.append(command_launch(scene, res, env | OB1))
+        out[cell] = {
+            "cold": cold,
+            "warm": {k: statistics.median(w[k] for w in warm) for k in warm[0]},
+            "warm_ob1": {k: statistics.median(w[k] for w in ob1) for k in ob1[0]},
+            "warm_all": warm,
+            "command_seconds_warm": statistics.median(whole),
+            "command_seconds_warm_ob1": statistics.median(whole_ob1),
+        }
+    return out
+
+
+# ---- the report -------------------------------------------------------------------------
+
+
+def ns(seconds, cells):
+    return 1e9 * seconds / cells
+
+
+def floor_baij_bytes(r):
+    """Bytes one BAIJ K u must move per cell: values (8 per entry), one column index per
+    3 x 3 block, block row pointers, u read and K u written (8 per row each)."""
     nnz, rows = r["nnz"], r["rows"]
     return (8 * nnz + 4 * nnz / 9 + 4 * rows / 3 + 16 * rows) / r["cells"]
+
+
+def _pair(results, r1):
+    return next(
+        (
+            r
+            for r in results
+            if "failed" not in r
+            and r["ranks"] == 2
+            and r["cell"] == r1["cell"]
+            and r["n"] == r1["n"]
+        ),
+        None,
+    )
+
+
+def _techs(r):
+    return list(r["technologies"])
+
+
+TECH_LABEL = {
+    "tet": "P1 tet",
+    "full": "hex 2x2x2",
+    "physical": "hex 1-pt physical",
+    "stiffness": "hex 1-pt FB stiffness",
+    "viscous": "hex 1-pt FB viscous",
+    "none": "hex 1-pt no hourglass",
+}
+
+
+def report(data):
+    info, load = data["machine"], data["load"]
+    L = []
+    w = L.append
+    w("# rwall_fem benchmark")
+    w("")
+    w(
+        f"Machine: {info['nproc']} cores, {info['cpu']}, {info['memory_gib']:.1f} GiB; Python "
+        f"{info['python']}, DOLFINx {info['dolfinx']}, PETSc {info['petsc']}; commit "
+        f"{info['commit']}. 1-minute load average before / after: {load[0][0]:.2f} / "
+        f"{load[1][0]:.2f} (5-minute: {load[0][1]:.2f} / {load[1][1]:.2f}), after waiting "
+        f"{data['waited']:.0f} s for a quiet machine. Whole run: {data['seconds']:.0f} s. "
+        "Produced by `make bench` (bench/bench.py); raw figures in bench/results.json. Wall "
+        "times of the slowest rank; medians over alternating rounds within one process. "
+        "1-minute load average at the start of each section (the benchmark's own processes "
+        "count about 1 per rank): "
+        + ", ".join(f"{k} {v:.2f}" for k, v in data.get("section_loads", {}).items())
+        + "."
+    )
+    w("")
+    w("## Targets")
+    w("")
+    w("| target | measured | met |")
+    w("|---|---|---|")
+    for row in data["targets"]:
+        w(f"| {row[0]} | {row[1]} | {row[2]} |")
+    w("")
+    sections = {
+        "throughput": (_throughput_section, _outside_section),
+        "bar_80k": (_bar_section,),
+        "costs": (_cost_section,),
+        "memory": (_memory_section,),
+        "taylor": (_taylor_section,),
+        "startup": (_startup_section,),
+    }
+    for key, writers in sections.items():
+        if key in data:
+            for section in writers:
+                section(w, data)
+    return "\n".join(L) + "\n"
+
+
+def _throughput_section(w, data):
+    results, stream = data["throughput"], data["stream"]
+    w("## Throughput: ns per cell-step")
+    w("")
+    w(
+        "The linear elastic steel bar of n x n x 10n bricks of 1 mm (hexahedra, or 6 "
+        "tetrahedra per brick) on a fixed plane, 10 m/s, history sampled every step. "
+        "*BAIJ K u*: the old code's internal force, the PETSc product with the assembled "
+        "stiffness (3 x 3 blocks), the baseline; *kernel*: the compiled element kernel "
+        "alone; *step*: a whole step of the time loop (kernel, ghost exchange, -f/m, "
+        "wall, update, history); *x faster*: BAIJ K u over the kernel, and over the whole "
+        "step. Peak memory: sum over ranks of the peak resident set of that process (which "
+        "also holds the BAIJ matrix), per cell."
+    )
+    w("")
+    w(
+        "| cells | element | ranks | BAIJ K u | kernel | step | x faster (kernel) | "
+        "x faster (step) | BAIJ floor | peak memory (B/cell) |"
+    )
+    w("|---|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        if "failed" in r:
+            w(
+                f"| {r['cells']:,} | {r['cell'][:3]} | {r['ranks']} | failed: "
+                f"{r['failed'][:120]} |" + " |" * 6
+            )
+            continue
+        s, c = r["seconds"], r["cells"]
+        baij = ns(s["baij"], c) if "baij" in s else float("nan")
+        floor = 1e9 * floor_baij_bytes(r) / stream[str(r["ranks"])]["bandwidth_moved"]
+        for tech in _techs(r):
+            k, st = ns(s[f"{tech}:kernel"], c), ns(s[f"{tech}:step/1"], c)
+            w(
+                f"| {c:,} | {TECH_LABEL[tech]} | {r['ranks']} | {baij:.1f} | {k:.1f} | "
+                f"{st:.1f} | {baij / k:.1f} | {baij / st:.1f} | {floor:.1f} | "
+                f"{r['peak_rss_bytes'] / c:,.0f} |"
+            )
+    w("")
+    w(
+        "BAIJ floor: the bytes the BAIJ product must move (8 B per stored value, a 4 B "
+        "column index per 3 x 3 block, u read and K u written) over the memory bandwidth "
+        f"(numpy triad, bytes moved: {stream['1']['bandwidth_moved'] / 1e9:.1f} GB/s on 1 "
+        f"process, {stream['2']['bandwidth_moved'] / 1e9:.1f} GB/s on 2). The kernels "
+        "store no matrix: they read the cell's node indices, coordinates and displacements "
+        "and add into the forces, about 32 + 8 x 48 B per hexahedron from the caches, "
+        "and are bound by arithmetic rather than by memory."
+    )
+    w("")
+    w("### 2-rank parallel efficiency (T1 / (2 T2))")
+    w("")
+    w(
+        "| cells | element | step, 1 rank (ms) | step, 2 ranks (ms) | step efficiency | "
+        "kernel efficiency | BAIJ K u efficiency |"
+    )
+    w("|---|---|---|---|---|---|---|")
+    for r1 in results:
+        if "failed" in r1 or r1["ranks"] != 1:
+            continue
+        r2 = _pair(results, r1)
+        if r2 is None:
+            continue
+        s1, s2 = r1["seconds"], r2["seconds"]
+        for tech in _techs(r1):
+            a, b = s1[f"{tech}:step/1"], s2[f"{tech}:step/1"]
+            ka, kb = s1[f"{tech}:kernel"], s2[f"{tech}:kernel"]
+            baij = s1["baij"] / (2 * s2["baij"]) if "baij" in s1 else float("nan")
+            w(
+                f"| {r1['cells']:,} | {TECH_LABEL[tech]} | {1e3 * a:.3g} | {1e3 * b:.3g} | "
+                f"{a / (2 * b):.2f} | {ka / (2 * kb):.2f} | {baij:.2f} |"
+            )
+    w("")
+
+
+def _outside_section(w, data):
+    w("## Time outside the kernels (10k cells, 1 rank)")
+    w("")
+    w(
+        "Kernel alone and whole steps alternate in one process (medians). *Outside* = 1 - "
+        "kernel / step: the ghost exchange, -f/m, the wall, the update pass, the history "
+        "and the Python loop around them. The phases of the step (below the table) come "
+        "from a separate instrumented run of the same scene."
+    )
+    w("")
+    w(
+        "| element | cells | kernel (us) | -f/m and fill included (us) | step, history every "
+        "step (us) | outside | step, history every 100 (us) | outside |"
+    )
+    w("|---|---|---|---|---|---|---|---|")
+    for r in data["throughput"]:
+        if "failed" in r or r["label"] != "10k" or r["ranks"] != 1:
+            continue
+        s = r["seconds"]
+        for tech in _techs(r):
+            k, acc = s[f"{tech}:kernel"], s[f"{tech}:accelerate"]
+            one, hundred = s[f"{tech}:step/1"], s[f"{tech}:step/100"]
+            w(
+                f"| {TECH_LABEL[tech]} | {r['cells']:,} | {1e6 * k:.0f} | {1e6 * acc:.0f} | "
+                f"{1e6 * one:.0f} | {1 - k / one:.0%} | {1e6 * hundred:.0f} | "
+                f"{1 - k / hundred:.0%} |"
+            )
+    w("")
+    for cell, record in data.get("anatomy", {}).items():
+        phases = record["phases"]
+        total = phases["step"]
+        parts = ", ".join(
+            f"{name} {1e6 * t:.0f} us ({t / total:.0%})"
+            for name, t in phases.items()
+            if name != "step"
+        )
+        w(f"- {cell}: a step of {1e6 * total:.0f} us = {parts}.")
+    w("")
+    for cell, record in data.get("anatomy", {}).items():
+        w(f"cProfile of the loop, {cell} (own time per step; the profiler inflates Python calls):")
+        w("")
+        w("| function | calls | own (us / step) | cumulative (us / step) |")
+        w("|---|---|---|---|")
+        for row in record["profile"][:10]:
+            w(
+                f"| `{row['function']}` | {row['calls']} | {1e6 * row['own_per_step']:.1f} | "
+                f"{1e6 * row['cumulative_per_step']:.1f} |"
+            )
+        w("")
+
+
+def _bar_section(w, data):
+    bar, old = data["bar_80k"], data["old_code"]
+    w("## The 80k-hexahedron bar scene")
+    w("")
+    w(
+        "`rwall-fem run demos/bar_impact.toml --set mesh.element_size=5e-4 --set "
+        "run.end_time=1e-4 --set output.frames=0 --set output.plot=false` (10 x 10 x 100 mm "
+        "steel bar, 0.5 mm hexahedra, 10 m/s onto a fixed plane, 1385 steps, history every "
+        "step): time loop (the summary's wall_seconds) as the median of alternating runs, "
+        "and the answers against those of the old code (commit "
+        f"{old['commit']}, PETSc BAIJ K u; recorded in bench/old_code.json with its "
+        "command)."
+    )
+    w("")
+    w(
+        "| code | element | ranks | loop (s), median | runs (s) | x faster than the old code "
+        "(same run) | contact duration (us) | impulse (N s) | rebound (m/s) | vs old (recorded): "
+        "duration, impulse, rebound |"
+    )
+    w("|---|---|---|---|---|---|---|---|---|---|")
+    old_loop = None
+    if "old" in bar:
+        old_loop = statistics.median(x["loop_seconds"] for x in bar["old"])
+    for name, runs in bar.items():
+        r = runs[0]
+        loop = statistics.median(x["loop_seconds"] for x in runs)
+        faster = f"{old_loop / loop:.1f}" if old_loop else "-"
+        diffs = ", ".join(
+            f"{100 * (r[k] / old[k] - 1):+.4f} %"
+            for k in ("contact_duration", "impulse", "rebound")
+        )
+        ranks = 2 if "2 ranks" in name else 1
+        code = "old (c11ba60)" if name == "old" else "new"
+        each = ", ".join(f"{x['loop_seconds']:.2f}" for x in runs)
+        w(
+            f"| {code} | {r['element']} | {ranks} | {loop:.2f} | {each} | {faster} | "
+            f"{1e6 * r['contact_duration']:.4f} | {r['impulse']:.6f} | {r['rebound']:.5f} | "
+            f"{diffs} |"
+        )
+    w(
+        f"| old, recorded | Q1 hexahedra, PETSc BAIJ K u | 1 | - | - | - | "
+        f"{1e6 * old['contact_duration']:.4f} | {old['impulse']:.6f} | {old['rebound']:.5f} | "
+        "reference |"
+    )
+    w("")
+    w(
+        "Earlier sessions on this machine: the old code's loop took 40-47 s on this scene, "
+        "OpenRadioss with a one-point hexahedron 88-98 s (measured then, not re-run here)."
+    )
+    w("")
+
+
+def _cost_section(w, data):
+    w("## Cost of each material relative to linear elasticity")
+    w("")
+    costs = data["costs"]
+    w(
+        "Per technology, ns per cell-step and the ratio to the linear elastic figure of the "
+        "same technology. *Kernel*: the element kernel alone, the combinations alternating "
+        "in rounds; elasto-plastic kernels in two states, every point elastic and every "
+        "point in plastic flow (radial return at every point, every call). *Step*: whole "
+        "steps of the bar scene (10 m/s onto a plane; the elasto-plastic bar yields at the "
+        "front) with the stable-step monitors of the nonlinear materials; runs of "
+        f"{costs[0]['steps']} steps, where the monitors check more often than later in a "
+        "long run. Materials: steel (7850, 210 GPa, 0.3); J2 with linear hardening "
+        "(250 MPa, H 1 GPa); Johnson-Cook (A 250 MPa, B 500 MPa, n 0.3, C 0.02, heating)."
+    )
+    w("")
+    materials = list(costs[0]["materials"])
+    short = {
+        "linear_elastic": "linear",
+        "saint_venant_kirchhoff": "SVK",
+        "neo_hookean": "neo-Hookean",
+        "elastic_plastic": "J2",
+        "johnson_cook": "Johnson-Cook",
+    }
+    head = ["element", "cells", "what"] + [short[m] for m in materials]
+    head += ["J2, plastic flow", "J-C, plastic flow"]
+    w("| " + " | ".join(head) + " |")
+    w("|" + "---|" * len(head))
+    for rec in costs:
+        c = rec["cells"]
+        ks, ss = rec["kernel_seconds"], rec["step_seconds"]
+        techs = list(dict.fromkeys(k.split(":")[0] for k in ks))
+        for tech in techs:
+            base = ks[f"{tech}:linear_elastic:elastic"]
+            figures = [ks[f"{tech}:{m}:elastic"] for m in materials]
+            figures += [ks[f"{tech}:{m}:plastic"] for m in ("elastic_plastic", "johnson_cook")]
+            cells = [f"{ns(x, c):.0f} ({x / base:.2f}x)" for x in figures]
+            w(f"| {TECH_LABEL[tech]} | {c:,} | kernel | " + " | ".join(cells) + " |")
+            if f"{tech}:linear_elastic" in ss:
+                sbase = ss[f"{tech}:linear_elastic"]
+                figures = [ss[f"{tech}:{m}"] for m in materials]
+                cells = [f"{ns(x, c):.0f} ({x / sbase:.2f}x)" for x in figures]
+                w(f"| {TECH_LABEL[tech]} | {c:,} | step | " + " | ".join(cells) + " | | |")
+    w("")
+
+
+def _memory_section(w, data):
+    w("## Memory per cell")
+    w("")
+    w(
+        "Peak resident set (getrusage) of a process that builds a body of about 1M cells "
+        "(gmsh, the mass, the kernels, the SLEPc stable step) and runs it for a few steps "
+        "with the history every step, divided by the cells; then, after each stage, the "
+        "resident set and its peak so far. *In use*: the resident set of a second run of "
+        "the hexahedra that hands freed memory back to the system (malloc_trim) before "
+        "each reading; the difference to *resident* is memory freed but kept by malloc."
+    )
+    w("")
+    live = {s["stage"]: s["rss"] for s in data.get("memory_live", {}).get("stages", [])}
+    for rec in data["memory"]:
+        c = rec["cells"]
+        w(
+            f"**{rec['technology']}**, {c:,} cells, {rec['nodes']:,} nodes, {rec['ranks']} "
+            f"rank(s): peak {rec['peak_rss_bytes'] / c:,.0f} B per cell "
+            f"({rec['peak_rss_bytes'] / 2**20:,.0f} MiB)."
+        )
+        w("")
+        hexes = rec["cell"] == "hexahedron" and live
+        w(
+            "| after | resident (MiB) | peak so far (MiB) | peak so far (B/cell) | stage (s) |"
+            + (" in use (MiB) | in use (B/cell) |" if hexes else "")
+        )
+        w("|---|---|---|---|---|" + ("---|---|" if hexes else ""))
+        for s in rec["stages"]:
+            extra = ""
+            if hexes and s["stage"] in live:
+                extra = f" {live[s['stage']] / 2**20:,.0f} | {live[s['stage']] / c:,.0f} |"
+            w(
+                f"| {s['stage']} | {s['rss'] / 2**20:,.0f} | {s['peak'] / 2**20:,.0f} | "
+                f"{s['peak'] / c:,.0f} | {s['seconds']:.2f} |{extra}"
+            )
+        w("")
+
+
+def _taylor_section(w, data):
+    t = data["taylor"]
+    w("## The Taylor rod at the demo's resolution")
+    w("")
+    w(
+        f"Copper rod (radius 3.2 mm, length 32.4 mm, 227 m/s onto a plane, J2 with linear "
+        f"hardening, 80 us), element_size {1e3 * t['element_size']:g} mm, run.dt_scale "
+        f"{t['dt_scale']:g}, history every {t['history_interval']} steps, {t['ranks']} rank: "
+        f"{t['element']}, {t['cells']:,} cells, {t['steps']:,} steps; "
+        f"**time loop {t['loop_seconds']:.1f} s** "
+        f"({ns(t['loop_seconds'], t['cells'] * t['steps']):.0f} ns per cell-step), set-up "
+        f"{t['setup_seconds']:.1f} s; status {t['status']}. Final length "
+        f"{t['final_length_mm']:.2f} mm, mushroom radius {t['mushroom_radius_mm']:.2f} mm "
+        "(published: 21.42-21.66 mm, 7.0-7.22 mm); largest plastic strain "
+        f"{t['max_plastic_strain']:.2f}."
+    )
+    w("")
+
+
+STAGES = [
+    "python",
+    "import mpi4py",
+    "import petsc4py",
+    "import dolfinx",
+    "import rwall_fem",
+    "scene",
+    "meshing",
+    "space and mass",
+    "kernels",
+    "stable step: SLEPc",
+    "stable step: edges",
+    "rest of set-up",
+    "first step",
+]
+
+
+def _startup_section(w, data):
+    w("## Start-up: from the launch to the end of the first step (10k cells)")
+    w("")
+    w(
+        "`rwall-fem run` (its entry point, `rwall_fem.cli.main`) on the bar of 10 x 10 x "
+        "100 1 mm hexahedra (or 12,960 tetrahedra), the stable step from SLEPc. *Cold*: a "
+        "fresh `XDG_CACHE_HOME`, so FFCx compiles the lumped-mass form and gcc the element "
+        "kernels; *warm*: the next launches (median of 3); *warm, ob1*: the same with "
+        "`OMPI_MCA_pml=ob1` in the environment (Open MPI then skips the UCX transport that "
+        "a single machine does not use; no result changes), alternating with them. "
+        "*Python*: interpreter start to the script's first line; *meshing* (gmsh) includes "
+        "the distribution by DOLFINx (given beside it). *Command*: the whole `rwall-fem run` "
+        "process, start to exit."
+    )
+    w("")
+    st = data["startup"]
+    kinds = [k for k in ("cold", "warm", "warm_ob1") if k in next(iter(st.values()))]
+    head = ["stage"] + [f"{cell[:3]} {kind.replace('_', ', ')}" for cell in st for kind in kinds]
+    w("| " + " | ".join(head) + " |")
+    w("|" + "---|" * len(head))
+    rows = STAGES + ["meshing: distribution (DOLFINx)", "launch to first step"]
+    for stage in rows:
+        cells = [f"{st[cell][kind].get(stage, 0.0):.3f}" for cell in st for kind in kinds]
+        name = f"**{stage}**" if stage == "launch to first step" else stage
+        w(f"| {name} | " + " | ".join(cells) + " |")
+    command = {"cold": "-", "warm": "command_seconds_warm", "warm_ob1": "command_seconds_warm_ob1"}
+    cells = [
+        "-" if kind == "cold" else f"{st[cell][command[kind]]:.3f}" for cell in st for kind in kinds
+    ]
+    w("| command, start to exit | " + " | ".join(cells) + " |")
+    w("")
+
+
+def targets(data):
+    """(target, measured, met) rows from the figures of the sections that were run."""
+    rows = []
+    for check in (
+        _target_throughput,
+        _target_bar,
+        _target_parallel,
+        _target_outside,
+        _target_memory,
+        _target_costs,
+        _target_startup,
+    ):
+        try:
+            rows += check(data)
+        except KeyError:  # a section not run (bench.py --only)
+            pass
+    return rows
+
+
+def _target_throughput(data):
+    rows = []
+    by = {(r["cell"], r["label"], r["ranks"]): r for r in data["throughput"] if "failed" not in r}
+    for tech, cell, limit in (("physical", "hexahedron", 80.0), ("tet", "tetrahedron", 15.0)):
+        figures = []
+        for label in ("10k", "100k", "1M"):
+            r = by.get((cell, label, 1))
+            if r:
+                figures.append(
+                    (
+                        label,
+                        ns(r["seconds"][f"{tech}:kernel"], r["cells"]),
+                        ns(r["seconds"][f"{tech}:step/1"], r["cells"]),
+                    )
+                )
+        text = "; ".join(f"{lb}: kernel {k:.0f}, step {s:.0f}" for lb, k, s in figures)
+        met_k = all(k <= limit for _, k, _ in figures)
+        met_s = all(s <= limit for _, _, s in figures)
+        rows.append(
+            (
+                f"{TECH_LABEL[tech]}: <= {limit:g} ns per cell-step, 1 rank",
+                text,
+                f"kernel: {'yes' if met_k else 'no'}; step: {'yes' if met_s else 'no'}",
+            )
+        )
+    return rows
+
+
+def _target_bar(data):
+    rows = []
+    bar = data["bar_80k"]
+    loop = statistics.median(x["loop_seconds"] for x in bar["physical"])
+    old = data["old_code"]
+    if "old" in bar:
+        old_loop = statistics.median(x["loop_seconds"] for x in bar["old"])
+        speed = f", old code {old_loop:.1f} s in the same run: {old_loop / loop:.1f}x"
+        fast = old_loop / loop >= 4
+    else:
+        speed, fast = " (old code not re-run)", loop <= 10
+    rows.append(
+        (
+            "80k-hexahedron scene: <= 10 s of time loop on 1 rank, >= 4x faster",
+            f"{loop:.2f} s{speed}",
+            "yes" if loop <= 10 and fast else "no",
+        )
+    )
+    worst = max(
+        abs(r[k] / old[k] - 1)
+        for name in ("physical", "full")
+        for r in bar[name]
+        for k in ("contact_duration", "impulse", "rebound")
+    )
+    rows.append(
+        (
+            "80k scene answers within 0.5 % of the old code's (default and full)",
+            f"largest difference {100 * worst:.2g} %",
+            "yes" if worst <= 0.005 else "no",
+        )
+    )
+    return rows
+
+
+def _target_parallel(data):
+    effs = []
+    for r1 in data["throughput"]:
+        if "failed" in r1 or r1["ranks"] != 1 or r1["label"] == "10k":
+            continue
+        r2 = _pair(data["throughput"], r1)
+        if r2:
+            for tech in _techs(r1):
+                a, b = r1["seconds"][f"{tech}:step/1"], r2["seconds"][f"{tech}:step/1"]
+                effs.append((f"{r1['label']} {TECH_LABEL[tech]}", a / (2 * b)))
+    return [
+        (
+            "2-rank efficiency >= 80 % at >= 100k cells (whole step)",
+            "; ".join(f"{n}: {e:.0%}" for n, e in effs),
+            "yes" if effs and min(e for _, e in effs) >= 0.8 else "no",
+        )
+    ]
+
+
+def _target_outside(data):
+    outs = []
+    for r in data["throughput"]:
+        if "failed" in r or r["label"] != "10k" or r["ranks"] != 1:
+            continue
+        for tech in _techs(r):
+            s = r["seconds"]
+            outs.append((TECH_LABEL[tech], 1 - s[f"{tech}:kernel"] / s[f"{tech}:step/1"]))
+    return [
+        (
+            "time outside the kernels < 10 % at 10k cells, history every step",
+            "; ".join(f"{n}: {o:.0%}" for n, o in outs),
+            "yes" if outs and max(o for _, o in outs) < 0.1 else "no",
+        )
+    ]
+
+
+def _target_costs(data):
+    hyper, plastic = [], []
+    for rec in data["costs"]:
+        ks = rec["kernel_seconds"]
+        for tech in dict.fromkeys(k.split(":")[0] for k in ks):
+            base = ks[f"{tech}:linear_elastic:elastic"]
+            hyper.append(
+                (
+                    tech,
+                    max(
+                        ks[f"{tech}:{m}:elastic"] / base
+                        for m in ("saint_venant_kirchhoff", "neo_hookean")
+                    ),
+                )
+            )
+            plastic.append((tech, ks[f"{tech}:elastic_plastic:plastic"] / base))
+    rows = [
+        (
+            "hyperelastic (SVK, neo-Hookean) <= 2x linear, same technology (kernel)",
+            "; ".join(f"{TECH_LABEL[t]} {x:.2f}x" for t, x in hyper),
+            "yes"
+            if max(x for _, x in hyper) <= 2
+            else "all but " + ", ".join(TECH_LABEL[t] for t, x in hyper if x > 2),
+        )
+    ]
+    default = dict(plastic).get("physical")
+    rows.append(
+        (
+            "J2 <= 2x linear with one-point hexahedra (kernel, every point in plastic "
+            "flow; default hourglass form)",
+            "; ".join(f"{TECH_LABEL[t]} {x:.3f}x" for t, x in plastic),
+            "yes (default)" if default is not None and default <= 2 else "no",
+        )
+    )
+    return rows
+
+
+def _target_memory(data):
+    hexes = [m for m in data["memory"] if m["cell"] == "hexahedron"]
+    per = hexes[0]["peak_rss_bytes"] / hexes[0]["cells"]
+    text = f"peak {per:,.0f} B"
+    live = data.get("memory_live")
+    if live:
+        used = live["stages"][-1]["rss"] / live["cells"]
+        text += f"; in use during the time loop {used:,.0f} B"
+    return [
+        (
+            "memory <= 1 kB per hexahedron (~1M cells)",
+            text,
+            "peak: "
+            + ("yes" if per <= 1000 else "no")
+            + (f"; in use: {'yes' if used <= 1000 else 'no'}" if live else ""),
+        )
+    ]
+
+
+def _target_startup(data):
+    st = data["startup"]
+    figures = [
+        (cell, kind, st[cell][kind]["launch to first step"])
+        for cell in st
+        for kind in ("warm", "warm_ob1")
+        if kind in st[cell]
+    ]
+    text = "; ".join(f"{cell[:3]} {kind.replace('_', ', ')} {t:.2f} s" for cell, kind, t in figures)
+    plain = max(t for _, kind, t in figures if kind == "warm")
+    return [
+        (
+            "start-up <= 1 s at 10k cells, warm caches (launch to first step)",
+            text,
+            "yes" if plain <= 1 else "no",
+        )
+    ]
 
 
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--out", default=str(HERE / "results.md"))
     p.add_argument("--sizes", default="10k,100k,1M")
+    p.add_argument("--old-tree", help="a worktree of the old code (c11ba60) with its .venv")
+    p.add_argument("--rounds-80k", type=int, default=3)
     p.add_argument(
         "--quiet-wait",
         type=float,
-        default=300.0,
+        default=1800.0,
         help="seconds to wait at most for the 1-minute load average to fall below 0.5",
     )
+    p.add_argument("--only", help="comma-separated sections, for development")
+    p.add_argument(
+        "--smoke", action="store_true", help="tiny sizes: checks the script, not the code"
+    )
+    p.add_argument("--from-json", help="write the report of an earlier run's results.json")
     a = p.parse_args()
+    if a.from_json:
+        data = json.loads(Path(a.from_json).read_text())
+        data["targets"] = targets(data)
+        Path(a.out).write_text(report(data))
+        return
+    if a.smoke:
+        global SCENE_80K
+        SCENE_80K = [x.replace("5e-4", "2e-3") for x in SCENE_80K]
+        a.sizes, a.rounds_80k = "10k", 1
+    only = set(a.only.split(",")) if a.only else None
+
+    def wanted(name):
+        if only is None or name in only:
+            data.setdefault("section_loads", {})[name] = os.getloadavg()[0]
+            return True
+        return False
+
     waited = wait_for_quiet(a.quiet_wait)
     t_start = time.perf_counter()
-    load0 = os.getloadavg()
-    info = machine()
-    log = print
-
-    log("bench: memory bandwidth")
-    stream = {r: json.loads(launch(r, [str(HERE / "stream.py")])[0]) for r in (1, 2)}
-
-    results = []
-    for label in a.sizes.split(","):
-        for cell in ("tetrahedron", "hexahedron"):
-            n = SIZES[cell][label]
-            cells = (10 if cell == "hexahedron" else 60) * n**3
-            steps = max(10, int(CELL_STEPS / cells))
-            for ranks in (1, 2):
-                log(f"bench: {cell} {label} ({cells} cells, {steps} steps) on {ranks} rank(s)")
-                try:
-                    r = case(cell, n, ranks, steps)
-                except (RuntimeError, subprocess.TimeoutExpired) as err:
-                    results.append(
-                        {
-                            "cell": cell,
-                            "label": label,
-                            "ranks": ranks,
-                            "cells": cells,
-                            "failed": str(err)[:200],
-                        }
-                    )
-                    continue
-                r["label"] = label
-                results.append(r)
-
-    log("bench: profile and side experiments at 10k cells (history every step)")
-    profiles = {
-        cell: case(
-            cell, SIZES[cell]["10k"], 1, 300, "--history-interval", "1", "--profile", "--extras"
-        )
-        for cell in ("tetrahedron", "hexahedron")
-    }
-
-    log("bench: start-up, form cache cold then warm (SLEPc stable step)")
-    startup = {}
-    for cell in ("tetrahedron", "hexahedron"):
-        with tempfile.TemporaryDirectory() as cache:
-            env = os.environ | {"XDG_CACHE_HOME": cache}
-            cold = case(cell, SIZES[cell]["10k"], 1, 20, "--real-dt", env=env)
-            warm = case(cell, SIZES[cell]["10k"], 1, 20, "--real-dt", env=env)
-        startup[cell] = (cold, warm)
-
-    load1 = os.getloadavg()
-    text = report(
-        info,
-        stream,
-        results,
-        profiles,
-        startup,
-        load0,
-        load1,
-        time.perf_counter() - t_start,
-        waited,
-    )
-    Path(a.out).write_text(text)
-    (Path(a.out).with_suffix(".json")).write_text(
-        json.dumps(
-            {
-                "machine": info,
-                "stream": stream,
-                "results": results,
-                "profiles": profiles,
-                "startup": startup,
-                "load": [load0, load1],
-            },
-            indent=1,
-        )
-    )
-    log(text)
-
-
-def _ns(r):
-    return 1e9 * r["step_seconds"] / r["cells"]
-
-
-def report(info, stream, results, profiles, startup, load0, load1, seconds, waited):
-    L = []
-    w = L.append
-    w("# rwall_fem step benchmark")
-    w("")
-    w(
-        f"Machine: {info['nproc']} cores, {info['cpu']}, {info['memory_gib']:.1f} GiB; "
-        f"Python {info['python']}, DOLFINx {info['dolfinx']}, PETSc {info['petsc']}. "
-        f"1-minute load average before / after: {load0[0]:.2f} / {load1[0]:.2f} after waiting "
-        f"{waited:.0f} s for a quiet machine (above about 0.5, another job shares the two cores "
-        f"and the 2-rank figures measure it too). Whole run: {seconds:.0f} s. Produced by "
-        "`make bench` (bench/bench.py); raw figures in bench/results.json."
-    )
-    w("")
-    w("## Memory bandwidth and the floor of one step")
-    w("")
-    w("| processes | numpy triad, bytes moved (40 B/element) | STREAM convention (24 B/element) |")
-    w("|---|---|---|")
-    for r in (1, 2):
-        s = stream[r]
-        moved, stream_bw = s["bandwidth_moved"] / 1e9, s["bandwidth_stream"] / 1e9
-        w(f"| {r} | {moved:.1f} GB/s | {stream_bw:.1f} GB/s |")
-    w("")
-    w(
-        "Floor of one step = bytes that must move for the stiffness product K u (matrix values, "
-        "8 B per entry; one 4 B column index per 3 x 3 block; block row pointers; u read and K u "
-        "written, 8 B per row each) divided by the measured bandwidth (bytes moved, with the "
-        "same number of processes). The solver's PETSc matrix is BAIJ with 3 x 3 blocks, so this "
-        "is the traffic it causes (AIJ would need a 4 B column index per entry, 12 B per entry "
-        "instead of about 8.4)."
-    )
-    w("")
-    w("## Throughput (linear elastic bar on a fixed wall, history every 100 steps)")
-    w("")
-    w(
-        "| cells | cell | ranks | nnz(K) | steps | step (ms) | K u (ms) | ns / cell-step | "
-        "cell-steps / s | floor (ns) | x floor | K u x floor | peak memory (B / cell) |"
-    )
-    w("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for r in results:
-        if "failed" in r:
-            w(
-                f"| {r['cells']:,} | {r['cell'][:3]} | {r['ranks']} | failed: {r['failed']} |"
-                + " |" * 9
+    data = {"machine": machine(), "waited": waited, "load": [os.getloadavg()]}
+    data["old_code"] = json.loads((HERE / "old_code.json").read_text())
+    log("memory bandwidth")
+    data["stream"] = {str(r): json.loads(launch(r, [str(HERE / "stream.py")])[0]) for r in (1, 2)}
+    if wanted("throughput"):
+        data["throughput"] = throughput(a.sizes.split(","))
+        log("anatomy of a step at 10k cells")
+        data["anatomy"] = {
+            cell: measure("anatomy.py", 1, "--cell", cell, "--n", SIZES[cell]["10k"])
+            for cell in ("hexahedron", "tetrahedron")
+        }
+    if wanted("bar"):
+        data["bar_80k"] = bar_80k(a.old_tree, a.rounds_80k)
+    if wanted("costs"):
+        log("material costs")
+        data["costs"] = [
+            measure(
+                "costs.py",
+                1,
+                "--cell",
+                cell,
+                "--n",
+                SIZES[cell]["10k" if a.smoke else "100k"],
+                "--step-technologies",
+                techs,
             )
-            continue
-        bw = stream[r["ranks"]]["bandwidth_moved"]
-        floor = 1e9 * floor_bytes(r) / bw
-        ns, ns_mult = _ns(r), 1e9 * r["mult_seconds"] / r["cells"]
-        w(
-            f"| {r['cells']:,} | {r['cell'][:3]} | {r['ranks']} | {r['nnz']:,.0f} | {r['steps']} | "
-            f"{1e3 * r['step_seconds']:.3g} | {1e3 * r['mult_seconds']:.3g} | {ns:.1f} | "
-            f"{1e9 / ns:.3g} | {floor:.2f} | {ns / floor:.1f} | {ns_mult / floor:.1f} | "
-            f"{r['peak_rss_bytes'] / r['cells']:,.0f} |"
-        )
-    w("")
-    w(
-        "Peak memory is the sum over ranks of the peak resident set (getrusage), start-up "
-        "(gmsh, assembly) included, divided by the cells. Reference points on this machine "
-        "class: a hand-written C kernel about 13 ns per tet-step on 2 cores, a PETSc block "
-        "matrix multiply about 12 ns."
-    )
-    w("")
-    w("### 2-rank parallel efficiency (step time, T1 / (2 T2))")
-    w("")
-    w("| cells | cell | step 1 rank (ms) | step 2 ranks (ms) | efficiency | K u efficiency |")
-    w("|---|---|---|---|---|---|")
-    ok = [r for r in results if "failed" not in r]
-    for r1 in ok:
-        if r1["ranks"] != 1:
-            continue
-        r2 = next(
-            (r for r in ok if r["ranks"] == 2 and r["cell"] == r1["cell"] and r["n"] == r1["n"]),
-            None,
-        )
-        if r2 is None:
-            continue
-        w(
-            f"| {r1['cells']:,} | {r1['cell'][:3]} | {1e3 * r1['step_seconds']:.3g} | "
-            f"{1e3 * r2['step_seconds']:.3g} | "
-            f"{r1['step_seconds'] / (2 * r2['step_seconds']):.2f} | "
-            f"{r1['mult_seconds'] / (2 * r2['mult_seconds']):.2f} |"
-        )
-    w("")
-    w("## Where a step goes at 10k cells (1 rank)")
-    w("")
-    w(
-        "| cell | step, history every 100 (ms) | step, history every step (ms) | K u (ms) | "
-        "Python share (every 100) | Python share (every step) |"
-    )
-    w("|---|---|---|---|---|---|")
-    for cell, prof in profiles.items():
-        x = prof["extras"]
-        coarse, every = x["step_seconds_every_100"], x["step_seconds_history_every_step"]
-        m = x["mult_baij_seconds"]
-        w(
-            f"| {cell[:3]} ({prof['cells']:,}) | {1e3 * coarse:.3g} | {1e3 * every:.3g} | "
-            f"{1e3 * m:.3g} | {1 - m / coarse:.0%} | {1 - m / every:.0%} |"
-        )
-    w("")
-    w(
-        "Python share = 1 - (K u alone) / (whole step): the time spent around the PETSc "
-        "kernel (numpy updates, the wall, recorders, interpreter). All three times come from "
-        "one process (the side experiments below): steps are medians of 3 runs of 301 steps "
-        "each, the two samplings alternating; K u is the median of the BAIJ blocks."
-    )
-    w("")
-    for cell, prof in profiles.items():
-        steps = prof["steps"]
-        w(
-            f"### cProfile of the time loop, {cell}, {prof['cells']:,} cells, {steps} steps, "
-            "history every step"
-        )
-        w("")
-        w("| function | calls | own time (ms) | per step (us) | cumulative (ms) |")
-        w("|---|---|---|---|---|")
-        for row in prof["profile"][:12]:
-            w(
-                f"| `{row['function']}` | {row['calls']} | {1e3 * row['tottime']:.1f} | "
-                f"{1e6 * row['tottime'] / steps:.0f} | {1e3 * row['cumtime']:.1f} |"
-            )
-        x = prof["extras"]
-        step = prof["step_seconds"]
-        w("")
-        w(f"Side experiments ({cell}):")
-        w("")
-        w(
-            f"- the wall treats {x['wall_nodes_default']:,} secondary nodes (every boundary node) "
-            f"for {x['wall_contacts']} in contact at the end; one `constrain` costs "
-            f"{1e6 * x['wall_seconds_default']:.0f} us; with the bottom face only "
-            f"({x['wall_nodes_bottom']:,} nodes) the step goes from "
-            f"{1e3 * x['step_seconds_every_100']:.3g} ms to "
-            f"{1e3 * x['step_seconds_bottom_only']:.3g} ms (both sampling every 100 steps, "
-            f"same process); sampling every step instead: "
-            f"{1e3 * x['step_seconds_history_every_step']:.3g} ms."
-        )
-        w(
-            f"- acceleration from K u: two passes (multiply, negate) "
-            f"{1e6 * x['accel_two_pass_seconds']:.0f} us, one pass with a stored -1/m "
-            f"{1e6 * x['accel_one_pass_seconds']:.0f} us; the velocity/position update "
-            f"(4 passes) {1e6 * x['update_seconds']:.0f} us."
-        )
-        w(
-            f"- K u with the solver's BAIJ matrix (3 x 3 blocks) "
-            f"{1e3 * x['mult_baij_seconds']:.3g} ms, with an AIJ copy "
-            f"{1e3 * x['mult_aij_seconds']:.3g} ms (medians, the two alternating in one process)."
-        )
-        w(
-            f"- the stable-step eigenvalue solve (SLEPc, tol 1e-8) takes "
-            f"{x['eigen_seconds_tol_1e-8']:.2f} s on this mesh; the whole step loop here takes "
-            f"{step * steps:.2f} s for {steps} steps."
-        )
-        w("")
-    w("## Start-up to the first step (10k cells, SLEPc stable step)")
-    w("")
-    w(
-        "| cell | form cache | to first step (s) | mesh (s) | mass (s) | stiffness (s) | "
-        "stable step (s) |"
-    )
-    w("|---|---|---|---|---|---|---|")
-    for cell, pair in startup.items():
-        for label, r in zip(("cold (empty XDG_CACHE_HOME)", "warm"), pair, strict=True):
-            s = r["setup"]
-            w(
-                f"| {cell[:3]} | {label} | {r['first_step_seconds']:.2f} | "
-                f"{s.get('body_mesh', 0):.2f} | {s.get('lumped_mass', 0):.2f} | "
-                f"{s.get('stiffness_matrix', 0):.2f} | {s.get('critical_time_step', 0):.2f} |"
-            )
-    w("")
-    w(
-        "From the start of the benchmark process (imports included) to the end of step 0. "
-        "DOLFINx 0.5 puts its FFCx/cffi cache in `$XDG_CACHE_HOME/fenics` (default "
-        "`~/.cache/fenics`), read when `dolfinx.jit` is imported: a fresh temporary "
-        "`XDG_CACHE_HOME` gives a cold cache, the second run in it a warm one."
-    )
-    w("")
-    return "\n".join(L) + "\n"
+            for cell, techs in (("hexahedron", "full,physical,stiffness"), ("tetrahedron", "tet"))
+        ]
+    if wanted("memory"):
+        log("memory at 1M cells")
+        data["memory"] = [
+            measure("memory.py", 1, "--cell", cell, "--n", SIZES[cell]["10k" if a.smoke else "1M"])
+            for cell in ("hexahedron", "tetrahedron")
+        ]
+        n = SIZES["hexahedron"]["10k" if a.smoke else "1M"]
+        data["memory_live"] = measure("memory.py", 1, "--n", n, "--trim")
+    if wanted("startup"):
+        log("start-up")
+        data["startup"] = startup()
+    if wanted("taylor"):
+        log("Taylor rod")
+        smoke = ["--element-size", "1.6e-3", "--dt-scale", "0.2"] if a.smoke else []
+        data["taylor"] = measure("taylor.py", 1, *smoke)
+    data["load"].append(os.getloadavg())
+    data["seconds"] = time.perf_counter() - t_start
+    out = Path(a.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.with_suffix(".json").write_text(json.dumps(data, indent=1))
+    data["targets"] = targets(data)
+    out.write_text(report(data))
+    out.with_suffix(".json").write_text(json.dumps(data, indent=1))
+    print(out.read_text())
 
 
 if __name__ == "__main__":

@@ -1,272 +1,179 @@
-"""One benchmark measurement in a fresh process (run by bench/bench.py, maybe under mpirun).
+"""Throughput of one mesh in a fresh process (run by bench/bench.py, maybe under mpirun).
 
 A linear elastic steel bar of n x n x 10 n bricks of 1 mm (hexahedra, or 6 tetrahedra per
 brick) moving at 10 m/s onto a fixed plane it touches at t = 0, so the wall acts from the
-first step. Writes one JSON record (rank 0) with sizes, start-up, loop and K u timings,
-peak memory, and optionally a cProfile of the time loop and side experiments.
+first step. The mesh is made once; then, in rounds, the variants alternate so that all of
+them see the same machine:
+
+- ``baij``: the old code's internal force, the PETSc BAIJ (3 x 3 blocks) product K u of the
+  small-strain stiffness (``mechanics.stiffness_form``), kept here as the baseline;
+- for each element technology asked for: a fresh simulation on the same mesh runs
+  ``--steps`` whole steps (``step``; each history interval asked for), then on its final
+  state the compiled element kernel alone (``kernel``: the C call, no Python around it)
+  and the internal-force effect (``accelerate``: kernel, ghost scatters and -f/m).
+
+Each figure is the median over rounds of the slowest rank's time. Writes one JSON record
+(rank 0).
 """
 
+import argparse
+import functools
+import json
+import resource
+import statistics
 import time
 
-STARTED = time.perf_counter()
+import workarounds
+from mpi4py import MPI
 
-import argparse  # noqa: E402
-import cProfile  # noqa: E402
-import json  # noqa: E402
-import pstats  # noqa: E402
-import resource  # noqa: E402
-import statistics  # noqa: E402
-
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-from petsc4py import PETSc  # noqa: E402
-
-import rwall_fem.build as build  # noqa: E402
-from rwall_fem import build_simulation, parse_scene  # noqa: E402
+import rwall_fem.build as build
+from rwall_fem import _compat, build_simulation, parse_scene
+from rwall_fem.mechanics import stiffness_form
+from rwall_fem.meshing import body_mesh
 
 comm = MPI.COMM_WORLD
+workarounds.apply()
+H = 1e-3  # brick edge, m
+# Throughput only: a fixed step safely below the stable one of either cell type (the
+# eigenvalue solve is measured with the start-up), 0.3 h / c_p. The stable step is said
+# to be twice that, so that the stable-step monitors of the nonlinear materials let it be.
+DT = 5.0e-8
+TECHNOLOGIES = {
+    "tet": {},
+    "full": {"integration": "full"},
+    "physical": {"integration": "reduced", "hourglass": "physical"},
+    "stiffness": {"integration": "reduced", "hourglass": "stiffness"},
+    "viscous": {"integration": "reduced", "hourglass": "viscous"},
+    "none": {"integration": "reduced", "hourglass": "none"},
+}
 
 
-def scene(cell, n, steps_hint, history_interval, secondary=None, wall=True):
-    h = 1e-3
+def scene(cell, n, steps, history_interval, technology="physical", material=None):
     raw = {
-        "run": {"end_time": 1.0, "dt_scale": 1.0},
+        "run": {"end_time": steps * DT, "dt_scale": 0.5},
         "mesh": {
             "shape": "bar",
-            "size": [n * h, n * h, 10 * n * h],
-            "element_size": h,
+            "size": [n * H, n * H, 10 * n * H],
+            "element_size": H,
             "cell": cell,
         },
-        "material": {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.3},
+        "material": material
+        or {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.3},
         "initial": {"velocity": [0.0, 0.0, -10.0]},
         "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1]}],
         "output": {"frames": 0, "plot": False, "history_interval": history_interval},
     }
-    if secondary:
-        raw["wall"][0]["secondary"] = secondary
-    if not wall:
-        del raw["wall"]
-    return raw
+    if cell == "hexahedron":
+        raw["element"] = TECHNOLOGIES[technology]
+    return parse_scene(raw, source="bench")
 
 
-class StopProfile:
-    """Recorder that stops the profiler at the last step, before the recorders close."""
-
-    def __init__(self, profiler, last):
-        self.profiler, self.last = profiler, last
-
-    def due(self, step):
-        return step == self.last
-
-    def record(self, sim, s):
-        self.profiler.disable()
-
-    def close(self, sim):
-        pass
+def fixed_step():
+    """Replace the stable-step eigenvalue solve (minutes at a million hexahedra): 2 DT."""
+    build.critical_time_step = lambda *args, **kwargs: 2 * DT
 
 
-class FirstStep:
-    """Recorder that notes the time when step 1 starts (the first step is done)."""
-
-    def __init__(self):
-        self.at = None
-
-    def due(self, step):
-        return step == 1
-
-    def record(self, sim, s):
-        self.at = time.perf_counter()
-
-    def close(self, sim):
-        pass
+def slowest(seconds):
+    return comm.allreduce(seconds, op=MPI.MAX)
 
 
-def timed(name, table):
-    """Wrap build.<name> to add its duration to table[name] (start-up breakdown)."""
-    inner = getattr(build, name)
-
-    def wrapper(*args, **kwargs):
-        t0 = time.perf_counter()
-        try:
-            return inner(*args, **kwargs)
-        finally:
-            table[name] = table.get(name, 0.0) + time.perf_counter() - t0
-
-    setattr(build, name, wrapper)
+def block(call, repeats):
+    """Time per call (s) of ``repeats`` calls, all ranks in step, the slowest rank's."""
+    comm.Barrier()
+    t0 = time.perf_counter()
+    for _ in range(repeats):
+        call()
+    return slowest((time.perf_counter() - t0) / repeats)
 
 
-def mult_seconds(K, x, y, repeats):
-    """Median over blocks of the time of one K x (all ranks in step, slowest rank)."""
-    blocks = []
-    per_block = max(1, repeats // 5)
-    for _ in range(5):
-        comm.Barrier()
-        t0 = time.perf_counter()
-        for _ in range(per_block):
-            K.mult(x, y)
-        blocks.append(comm.allreduce((time.perf_counter() - t0) / per_block, op=MPI.MAX))
-    return statistics.median(blocks)
+def peak_rss():
+    """Sum over ranks of the peak resident set (bytes)."""
+    return comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
 
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("--cell", default="tetrahedron")
-    p.add_argument("--n", type=int, default=6)
-    p.add_argument("--steps", type=int, default=200)
-    p.add_argument("--history-interval", type=int, default=100)
-    p.add_argument("--real-dt", action="store_true", help="SLEPc stable step (default: h/c)")
-    p.add_argument("--no-wall", action="store_true", help="the bar in free flight")
-    p.add_argument("--profile", action="store_true")
-    p.add_argument("--extras", action="store_true", help="side experiments (10k cells)")
+    p.add_argument("--cell", default="hexahedron")
+    p.add_argument("--n", type=int, default=10)
+    p.add_argument("--technologies", default="physical,full")
+    p.add_argument("--steps", type=int, default=100)
+    p.add_argument("--intervals", default="1", help="history intervals of the whole steps")
+    p.add_argument("--rounds", type=int, default=5)
+    p.add_argument("--no-baseline", action="store_true")
     p.add_argument("--json", required=True)
     a = p.parse_args()
+    fixed_step()
+    technologies = ["tet"] if a.cell == "tetrahedron" else a.technologies.split(",")
+    intervals = [int(i) for i in a.intervals.split(",")]
 
-    setup = {}
-    for name in ("body_mesh", "lumped_mass", "stiffness_matrix", "critical_time_step"):
-        timed(name, setup)
-    if not a.real_dt:
-        # Throughput only: a safe step from the element size instead of the eigenvalue
-        # solve (which takes minutes on large hexahedral meshes; its cost is measured
-        # with --real-dt at 10k cells).
-        build.critical_time_step = lambda K, mass, X: 0.3e-3 / 6000.0
-    raw = scene(a.cell, a.n, a.steps, a.history_interval, wall=not a.no_wall)
-    sc = parse_scene(raw, source="bench")
-    t_build = time.perf_counter()
-    # A fixed number of steps is timed, whatever end_time: no size limits.
-    sim = build_simulation(sc, comm, f"/tmp/rwall-bench-{a.cell}-{a.n}-{comm.size}", limits=False)
-    build_seconds = time.perf_counter() - t_build
-    # Exactly a.steps + 1 steps (the loop runs steps 0..num_steps).
-    sim.end_time = a.steps * sim.state.dt
-    first = FirstStep()
-    sim.recorders.append(first)
-    profiler = cProfile.Profile() if a.profile else None
-    if profiler:
-        sim.recorders.append(StopProfile(profiler, sim.num_steps))
-        profiler.enable()
-    sim.run()
-    s = sim.history.summary
-    K = sim.internal.K
-    info = K.getInfo(K.InfoType.GLOBAL_SUM)
-    x, y = K.createVecRight(), K.createVecLeft()
-    x.setRandom()
-    mult = mult_seconds(K, x, y, max(10, min(500, int(3e7 / max(info["nz_used"], 1)))))
+    t0 = time.perf_counter()
+    first = scene(a.cell, a.n, a.steps, intervals[0], technologies[0])
+    body = body_mesh(comm, first.mesh)
+    mesh_seconds = slowest(time.perf_counter() - t0)
+    out = f"/tmp/rwall-bench-{a.cell}-{a.n}-{comm.size}"
+    cells = body.num_cells
+
+    K = x = y = None
+    if not a.no_baseline:
+        sim = build_simulation(first, comm, out, body=body)
+        t0 = time.perf_counter()
+        K = _compat.assemble_matrix(stiffness_form(sim.internal.V, first.material), "baij")
+        assembly_seconds = slowest(time.perf_counter() - t0)
+        x, y = K.createVecRight(), K.createVecLeft()
+        x.setRandom()
+        info = K.getInfo(K.InfoType.GLOBAL_SUM)
+        del sim
+    # Calls per timed block: about 0.3 s of the slowest variant.
+    repeats = max(3, int(3e6 / cells))
+
+    times = {"baij": []}
+    for tech in technologies:
+        times |= {f"{tech}:kernel": [], f"{tech}:accelerate": []}
+        times |= {f"{tech}:step/{every}": [] for every in intervals}
+    summary = {}
+    for _ in range(a.rounds):
+        if K is not None:
+            times["baij"].append(block(lambda: K.mult(x, y), repeats))
+        for tech in technologies:
+            for every in intervals:
+                sim = build_simulation(
+                    scene(a.cell, a.n, a.steps, every, tech), comm, out, body=body
+                )
+                sim.run()
+                s = sim.history.summary
+                times[f"{tech}:step/{every}"].append(s["wall_seconds"] / (s["steps"] + 1))
+            force, state = sim.internal, sim.state
+            times[f"{tech}:kernel"].append(block(force._kernel, repeats))
+            accelerate = functools.partial(force.accelerate, state)
+            times[f"{tech}:accelerate"].append(block(accelerate, repeats))
+            summary[tech] = {
+                "element": s["element"],
+                "steps": s["steps"] + 1,
+                "status": s["status"],
+                "balance_error": s["energy"]["max_balance_error"],
+            }
     record = {
         "cell": a.cell,
         "n": a.n,
         "ranks": comm.size,
-        "cells": s["cells"],
-        "nodes": s["nodes"],
-        "rows": K.getSize()[0],
-        "nnz": info["nz_used"],
-        "mat_type": K.getType(),
-        "steps": s["steps"] + 1,
-        "status": s["status"],
-        "history_interval": a.history_interval,
-        "wall": not a.no_wall,
-        "loop_seconds": s["wall_seconds"],
-        "step_seconds": s["wall_seconds"] / (s["steps"] + 1),
-        "mult_seconds": mult,
-        "build_seconds": comm.allreduce(build_seconds, op=MPI.MAX),
-        "setup": {k: comm.allreduce(v, op=MPI.MAX) for k, v in setup.items()},
-        "first_step_seconds": comm.allreduce(first.at - STARTED, op=MPI.MAX),
-        "peak_rss_bytes": comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024,
-        "peak_rss_rank0_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
-        "real_dt": a.real_dt,
+        "cells": cells,
+        "rounds": a.rounds,
+        "repeats": repeats,
+        "mesh_seconds": mesh_seconds,
+        "technologies": summary,
+        "seconds": {k: statistics.median(v) for k, v in times.items() if v},
+        "all_seconds": {k: v for k, v in times.items() if v},
+        "peak_rss_bytes": peak_rss(),
     }
-    if a.profile and comm.rank == 0:
-        stats = pstats.Stats(profiler)
-        rows = []
-        for (file, line, func), (_, nc, tt, ct, _) in stats.stats.items():
-            rows.append(
-                {
-                    "function": f"{file.split('/')[-1]}:{line}({func})",
-                    "calls": nc,
-                    "tottime": tt,
-                    "cumtime": ct,
-                }
-            )
-        record["profile"] = sorted(rows, key=lambda r: -r["tottime"])[:18]
-    if a.extras:
-        record["extras"] = extras(sim, K, x, y, a)
+    if K is not None:
+        record |= {
+            "nnz": info["nz_used"],
+            "rows": K.getSize()[0],
+            "assembly_seconds": assembly_seconds,
+        }
     if comm.rank == 0:
         with open(a.json, "w") as f:
             json.dump(record, f, indent=1)
-
-
-def extras(sim, K, x, y, a):
-    """Side experiments for the optimisation proposals, on the same mesh."""
-    out = {}
-    # Matrix formats, alternating so that both see the same machine: the solver's BAIJ K
-    # (one column index per 3 x 3 block) and an AIJ copy (one per entry, DOLFINx's own).
-    A = K.convert("aij", PETSc.Mat())  # a copy: without `out`, convert works in place
-    times = {"baij": [], "aij": []}
-    for _ in range(5):
-        times["baij"].append(mult_seconds(K, x, y, 40))
-        times["aij"].append(mult_seconds(A, x, y, 40))
-    out["mult_baij_seconds"] = statistics.median(times["baij"])
-    out["mult_aij_seconds"] = statistics.median(times["aij"])
-    A.destroy()
-    # Acceleration from K u: two passes (multiply, negate) against one with -1/m.
-    s, ku = sim.state, sim.internal.ku
-    neg = -s.inv_mass
-
-    def best(f, n=200):
-        ts = []
-        for _ in range(n):
-            t0 = time.perf_counter()
-            f()
-            ts.append(time.perf_counter() - t0)
-        return statistics.median(ts)
-
-    def two_passes():
-        np.multiply(ku, s.inv_mass, out=s.a)
-        np.negative(s.a, out=s.a)
-
-    out["accel_two_pass_seconds"] = best(two_passes)
-    out["accel_one_pass_seconds"] = best(lambda: np.multiply(ku, neg, out=s.a))
-    scratch = np.empty_like(s.u)
-
-    def update_now():
-        np.multiply(s.a, s.dt, out=scratch)
-        s.v += scratch
-        np.multiply(s.v, s.dt, out=scratch)
-        s.u += scratch
-
-    out["update_seconds"] = best(update_now)
-    # The wall alone: all boundary nodes (the default) against the bottom face only.
-    wall = sim.walls[0]
-    out["wall_nodes_default"] = comm.allreduce(len(wall.nodes))
-    out["wall_seconds_default"] = best(lambda: wall.constrain(s), 100)
-    out["wall_contacts"] = comm.allreduce(wall.contacts)
-    # Whole loop with the wall on the bottom face only, and with history every step: the
-    # median of 3 runs of each, the variants alternating so that all see the same machine.
-    variants = {
-        "every_100": (None, 100),
-        "bottom_only": ({"add": ["bottom"]}, 100),
-        "history_every_step": (None, 1),
-    }
-    steps = {label: [] for label in variants}
-    for _ in range(3):
-        for label, (secondary, every) in variants.items():
-            sc = parse_scene(scene(a.cell, a.n, a.steps, every, secondary), source="bench")
-            other = build_simulation(
-                sc, comm, f"/tmp/rwall-bench-x-{a.cell}-{comm.size}", limits=False
-            )
-            other.end_time = a.steps * other.state.dt
-            other.run()
-            steps[label].append(other.history.summary["wall_seconds"] / (a.steps + 1))
-            if label == "bottom_only":
-                out["wall_nodes_bottom"] = comm.allreduce(len(other.walls[0].nodes))
-    for label, times in steps.items():
-        out[f"step_seconds_{label}"] = statistics.median(times)
-    # Stable step: SLEPc as the solver does it (tol 1e-8), against a looser tolerance.
-    from rwall_fem.mechanics import critical_time_step as exact_step
-
-    t0 = time.perf_counter()
-    dt8 = exact_step(K, s.mass, s.X)
-    out["eigen_seconds_tol_1e-8"] = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
-    out["dt_stable"] = dt8
-    return out
 
 
 if __name__ == "__main__":

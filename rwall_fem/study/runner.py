@@ -1,7 +1,10 @@
-"""Running the study: every case x cell type x dt_scale x element size.
+"""Running the study: every case x element technology x dt_scale x element size.
 
-Each case is run for every element size (halving), cell type (P1 tetrahedra, Q1 hexahedra)
-and ``dt_scale`` (0.5, 0.9). Every run records its cells, steps, dt, the wall time of the
+Each case is run for every element size (halving), element technology (:data:`TECHNOLOGIES`:
+P1 tetrahedra; hexahedra with one point and physical hourglass control, the default; with
+2 x 2 x 2 points; with one point and the Flanagan-Belytschko stiffness form) and
+``dt_scale`` (0.5, 0.9); the quick study keeps the two defaults (:data:`QUICK`). Every run
+records its cells, steps, dt, the wall time of the
 time loop (median of repeats for short runs), the ns per cell-step, the signed relative error
 of each quantity, the share of the energy the wall dissipated and the energy balance error.
 The runs use the communicator given (every rank takes part in every run and takes the same
@@ -23,16 +26,28 @@ from rwall_fem.scene import parse_scene
 from rwall_fem.study.cases import CASES, Case
 from rwall_fem.study.report import write_outputs
 
-__all__ = ["CELLS", "DT_SCALES", "run_case", "run_study"]
+__all__ = ["DT_SCALES", "QUICK", "TECHNOLOGIES", "run_case", "run_study"]
 
-CELLS = ("tetrahedron", "hexahedron")
+# Element technologies: name -> (cell type, the scene's [element] table).
+TECHNOLOGIES = {
+    "tet": ("tetrahedron", {}),
+    "hex": ("hexahedron", {}),  # one point, physical hourglass control: the default
+    "hex_full": ("hexahedron", {"integration": "full"}),
+    "hex_fb": ("hexahedron", {"integration": "reduced", "hourglass": "stiffness"}),
+}
+QUICK = ("tet", "hex")  # the technologies of the quick study
 DT_SCALES = (0.5, 0.9)
 
 
-def run_case(case: Case, h: float, cell: str, dt_scale: float, comm, directory: Path, *,
+def run_case(case: Case, h: float, element: str, dt_scale: float, comm, directory: Path, *,
              repeat_below: float, max_repeats: int) -> dict:  # fmt: skip
-    """One run (repeated while short) -> a row of ``study.csv``."""
-    scene = parse_scene(case.scene(h, cell, dt_scale), source=f"study:{case.name}")
+    """One run (repeated while short) of the technology ``element`` (a key of
+    :data:`TECHNOLOGIES`) -> a row of ``study.csv``."""
+    cell, table = TECHNOLOGIES[element]
+    raw = case.scene(h, cell, dt_scale)
+    if table:
+        raw["element"] = dict(table)
+    scene = parse_scene(raw, source=f"study:{case.name}")
     loops, setups = [], []
     while True:
         started = time.perf_counter()
@@ -55,6 +70,7 @@ def run_case(case: Case, h: float, cell: str, dt_scale: float, comm, directory: 
     row = {
         "case": case.name,
         "cell": cell,
+        "element": element,
         "dt_scale": dt_scale,
         "element_size": h,
         "ranks": comm.size,
@@ -75,7 +91,7 @@ def run_case(case: Case, h: float, cell: str, dt_scale: float, comm, directory: 
 
 def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
               cases=None, echo=print) -> list[dict]:  # fmt: skip
-    """Run every case x cell type x dt_scale x element size; write the outputs into ``out``.
+    """Run every case x technology x dt_scale x element size; write the outputs into ``out``.
 
     Returns the rows (the same on every rank).
     """
@@ -86,11 +102,11 @@ def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
     load = [os.getloadavg()[0]]
     rows = []
     for case in cases:
-        for cell in CELLS:
+        for element in QUICK if quick else TECHNOLOGIES:
             for dt_scale in DT_SCALES:
                 for h in case.quick_levels if quick else case.levels:
-                    run_dir = out / "runs" / f"{case.name}-{cell[:3]}-dt{dt_scale:g}-h{h * 1e3:g}mm"
-                    row = run_case(case, h, cell, dt_scale, comm, run_dir,
+                    run_dir = out / "runs" / f"{case.name}-{element}-dt{dt_scale:g}-h{h * 1e3:g}mm"
+                    row = run_case(case, h, element, dt_scale, comm, run_dir,
                                    repeat_below=repeat_below, max_repeats=max_repeats)  # fmt: skip
                     rows.append(row)
                     if comm.rank == 0 and echo:
@@ -98,7 +114,7 @@ def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
                             f"{k}={100 * row[f'error_{k}']:+.3f}%" for k in case.quantities
                         )
                         echo(
-                            f"study: {case.name} {cell[:3]} dt_scale={dt_scale:g} "
+                            f"study: {case.name} {element} dt_scale={dt_scale:g} "
                             f"h={h * 1e3:g}mm cells={row['cells']} steps={row['steps']} "
                             f"loop={row['wall_seconds']:.3g}s "
                             f"({row['ns_per_cell_step']:.0f} ns/cell-step) {errors}",
