@@ -181,14 +181,10 @@ def answers(summary):
 
 
 def run_80k(cli, scene, extra, ranks=1):
-    """One run of the 80k scene by ``rwall-fem run`` (``cli``); on 2 ranks the new code's
-    entry point with the fixes of bench/workarounds.py."""
+    """One run of the 80k scene by ``rwall-fem run`` (``cli``), on ``ranks`` MPI ranks."""
     with tempfile.TemporaryDirectory() as out:
         args = [scene, *SCENE_80K, *extra, "--out", out, "--quiet"]
-        if ranks == 1:
-            sh([cli, "run", *args], cwd=out)
-        else:
-            sh([*MPIRUN, str(ranks), PY, str(HERE / "run_scene.py"), *args], cwd=out)
+        sh([cli, "run", *args] if ranks == 1 else [*MPIRUN, str(ranks), cli, "run", *args], cwd=out)
         summary = json.loads((Path(out) / "summary.json").read_text())
     return {
         "loop_seconds": summary["wall_seconds"],

@@ -23,7 +23,6 @@ import resource
 import statistics
 import time
 
-import workarounds
 from mpi4py import MPI
 
 import rwall_fem.build as build
@@ -32,7 +31,6 @@ from rwall_fem.mechanics import stiffness_form
 from rwall_fem.meshing import body_mesh
 
 comm = MPI.COMM_WORLD
-workarounds.apply()
 H = 1e-3  # brick edge, m
 # Throughput only: a fixed step safely below the stable one of either cell type (the
 # eigenvalue solve is measured with the start-up), 0.3 h / c_p. The stable step is said

@@ -11,7 +11,6 @@ import argparse
 import json
 import time
 
-import workarounds
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
@@ -52,7 +51,6 @@ def main():
     p.add_argument("--json", required=True)
     a = p.parse_args()
     comm = MPI.COMM_WORLD
-    workarounds.apply()
     t0 = time.perf_counter()
     raw = scene(a.element_size, a.dt_scale, a.history_interval)
     sim = build_simulation(parse_scene(raw, source="bench:taylor"), comm, "/tmp/rwall-bench-taylor")

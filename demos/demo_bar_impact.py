@@ -11,13 +11,13 @@
 # Run it with `python demos/demo_bar_impact.py` (or under `mpirun -n 2`).
 
 # +
-from pathlib import Path  # noqa: I001  (rwall_fem must come before dolfinx, see below)
+from pathlib import Path  # noqa: I001  (mpi4py must come before dolfinx, see below)
 
 import numpy as np
 from mpi4py import MPI
 
-import rwall_fem  # import before dolfinx: it orders MPI first for the PyPI wheel
-from dolfinx import mesh
+import rwall_fem
+from dolfinx import mesh  # after mpi4py: the PyPI wheel of DOLFINx needs MPI loaded first
 
 # -
 

@@ -12,11 +12,11 @@
 # `demos/plate_on_cylinder.toml` is the same problem, finer, as a scene file.
 
 # +
-from pathlib import Path  # noqa: I001  (rwall_fem must come before dolfinx)
+from pathlib import Path  # noqa: I001  (mpi4py must come before DOLFINx)
 
 from mpi4py import MPI
 
-import rwall_fem  # import before dolfinx: it orders MPI first for the PyPI wheel
+import rwall_fem  # after mpi4py: the PyPI wheel of DOLFINx needs MPI loaded first
 from rwall_fem.meshing import plate_mesh
 
 # -

@@ -40,9 +40,9 @@ def library_versions() -> dict[str, str]:
     import gmsh
     import mpi4py
     import numpy
+    import slepc4py
     from mpi4py import MPI
     from petsc4py import PETSc
-    from slepc4py import SLEPc
 
     def dotted(version) -> str:
         return ".".join(map(str, version[:3]))
@@ -51,7 +51,10 @@ def library_versions() -> dict[str, str]:
         "python": platform.python_version(),
         "dolfinx": dolfinx.__version__,
         "petsc": dotted(PETSc.Sys.getVersion()),
-        "slepc": dotted(SLEPc.Sys.getVersion()),
+        # The package's version, which is SLEPc's: importing slepc4py.SLEPc would
+        # initialise SLEPc here, on rank 0 alone (the run log's rank), and its
+        # finalisation at exit is collective: the other ranks would never join it.
+        "slepc": slepc4py.__version__,
         "mpi": " ".join(MPI.Get_library_version().splitlines()[0].split(",")[0].split()),
         "mpi4py": mpi4py.__version__,
         "numpy": numpy.__version__,
