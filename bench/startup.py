@@ -106,8 +106,8 @@ class _FirstStep:
 
     at = None
 
-    def due(self, step):
-        return step == 1
+    def due(self, s):
+        return s.step == 1
 
     def record(self, sim, s):
         self.at = time.perf_counter()

@@ -48,16 +48,25 @@ class VelocityBoundary:
         self.work = float(arrays["work"])
         self._reaction = arrays["reaction"] if len(arrays["reaction"]) else None
 
+    def settle(self, state) -> None:
+        """Book the v^{n+1/2} half of the work of the latest step's reaction with the
+        velocities the nodes now have; before the masses change, and at every step."""
+        if self._reaction is not None:
+            v_now = state.v[self.nodes[:, None], self.axes[None, :]]
+            self.work += 0.5 * float(np.sum(self._reaction * v_now))
+            self._reaction = None
+
     def constrain(self, state) -> None:
-        """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n + dt/2)."""
+        """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n +
+        dt^{n+1/2}/2), the velocity update's step being dt^n (``state.dt_velocity``)."""
         rows, cols = self.nodes[:, None], self.axes[None, :]
         target = self.prescribed.predict(state.t, state.dt)[self.axes]
+        self.settle(state)
         v_old = state.v[rows, cols]
-        if self._reaction is not None:
-            self.work += 0.5 * float(np.sum(self._reaction * v_old))
         m = state.mass[self.nodes][:, None]
-        reaction = m * (target - v_old - state.dt * state.a[rows, cols])  # N s
-        state.a[rows, cols] = (target - v_old) / state.dt
+        dt_v = state.dt_velocity
+        reaction = m * (target - v_old - dt_v * state.a[rows, cols])  # N s
+        state.a[rows, cols] = (target - v_old) / dt_v
         self.work += 0.5 * float(np.sum(reaction * v_old))
         self._reaction = reaction
         self.impulse[self.axes] += reaction.sum(axis=0)

@@ -2,11 +2,11 @@
 
 Data flows one way: scene -> checks that need no mesh (the results folder, the size
 limits of :mod:`rwall_fem.estimate`) -> body (mesh, space, lumped mass, element
-technology) -> stable time step -> pipeline (internal force, body forces, walls, boundary
-conditions: only what the scene asks for) -> what the starter of Radioss would warn
-about (nodes starting behind a wall, walls without nodes, nodes both clamped and held by
-a wall) -> recorders (history, run log, stable-step monitor, fields, frames) and the
-checkpoints.
+technology, stable step at rest) -> pipeline (internal force, the step size of
+:mod:`rwall_fem.time_step`, body forces, walls, boundary conditions: only what the
+scene asks for) -> what the starter of Radioss would warn about (nodes starting behind a
+wall, walls without nodes, nodes both clamped and held by a wall) -> recorders (history,
+run log, fields, frames) and the checkpoints.
 
 Every check that can fail on one rank alone (gmsh runs on rank 0; the results folder is
 checked there) is agreed on by all ranks, so a refusal is the same everywhere.
@@ -36,12 +36,7 @@ from rwall_fem.estimate import (
     steps_above_limit,
     unphysical_material,
 )
-from rwall_fem.mechanics import (
-    critical_time_step,
-    element_time_step,
-    lumped_mass,
-    shortest_edge,
-)
+from rwall_fem.mechanics import critical_time_step, lumped_mass, shortest_edge
 from rwall_fem.meshing import (
     BodyMesh,
     MeshTooLarge,
@@ -54,10 +49,11 @@ from rwall_fem.meshing import (
 from rwall_fem.output.folder import ResultsFolder, check_folder
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.history import History
-from rwall_fem.output.run_log import RunLog, cycle_interval
+from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
+from rwall_fem.time_step import step_size
 from rwall_fem.walls import RigidWall
 from rwall_fem.walls.motion import MainNodeMotion, PrescribedMotion
 from rwall_fem.walls.shapes import SHAPES
@@ -141,14 +137,16 @@ def build_simulation(
     if limits:
         refuse_above_limits(scene, estimate(scene, comm.size))
     solid = _solid(scene, comm, body, scene.run.max_cells if limits else None)
-    dt = _time_step(scene, solid)
-    sim = _pipeline(scene, solid, dt)
+    sim = _pipeline(scene, solid, limits)
+    dt = sim.state.dt
     if limits:
-        steps_above_limit(scene, sim.num_steps, dt)
+        steps_above_limit(scene, sim.planned_steps, dt)
+    about = "" if sim.step_size.mode == "fixed" else "about "
     facts = [
-        _mesh_fact(solid, dt),
-        f"effects: {', '.join(sim.effects)}; {sim.num_steps} steps to t = "
-        f"{sim.num_steps * dt:.4g} s",
+        _mesh_fact(solid),
+        _step_fact(sim),
+        f"effects: {', '.join(sim.effects)}; {about}{sim.planned_steps} steps to t = "
+        f"{scene.run.end_time:.4g} s",
     ]
     for line in facts:
         log.info("%s", line)
@@ -179,8 +177,8 @@ class _Solid:
     """The discretised body: its communicator and mesh, the P1/Q1 vector space, the owned
     nodes' reference coordinates (m) and lumped masses (kg), its displacement and velocity
     fields, its element technology with the linear elastic force of that technology (the
-    tangent at rest of every material), the stable steps (s) from the largest
-    eigenvalue and from the shortest edge, and the diagonal of its box (m)."""
+    tangent at rest of every material), the stable step at rest (s) from the largest
+    eigenvalue, and the diagonal of its box (m)."""
 
     comm: MPI.Comm
     body: BodyMesh
@@ -192,7 +190,6 @@ class _Solid:
     technology: Technology
     elastic: ElementForce
     dt_stable: float
-    dt_element: float
     size: float
 
     @property
@@ -249,12 +246,11 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
     u, v = GhostedField(V), GhostedField(V)
     elastic = ElementForce(V, replace(scene.material, model="linear_elastic"), technology, u, v)
     dt_stable = _stable_step(scene, elastic, mass, X, comm)
-    dt_element = element_time_step(V, scene.material)
     low, high = np.empty(3), np.empty(3)
     comm.Allreduce(X.min(axis=0, initial=np.inf), low, op=MPI.MIN)
     comm.Allreduce(X.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
     size = float(np.linalg.norm(high - low))
-    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, dt_element, size)
+    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, size)
 
 
 def _noise_is_small(scene: Scene, edge: float) -> None:
@@ -286,42 +282,46 @@ def _stable_step(scene: Scene, elastic: ElementForce, mass, X, comm) -> float:
     return dt
 
 
-def _time_step(scene: Scene, solid: _Solid) -> float:
-    """The scene's ``run.dt`` if it is stable, else ``run.dt_scale`` of the stable step (s)."""
-    if scene.run.dt is not None:
-        if scene.run.dt > solid.dt_stable:
-            raise SceneError(
-                f"{scene.source}: run.dt: {scene.run.dt:g} s is above the stable limit "
-                f"{solid.dt_stable:.6g} s (2/omega_max); use a smaller dt or drop it to use "
-                "dt_scale"
-            )
-        return scene.run.dt
-    return _round_down(scene.run.dt_scale * solid.dt_stable)
-
-
-def _mesh_fact(solid: _Solid, dt: float) -> str:
+def _mesh_fact(solid: _Solid) -> str:
     return (
         f"mesh: {solid.body.num_cells} {solid.body.msh.topology.cell_type.name} cells, "
-        f"{solid.V.dofmap.index_map.size_global} nodes; {solid.technology.describe()}; stable "
-        f"dt {solid.dt_stable:.4g} s (eigenvalue), {solid.dt_element:.4g} s (shortest edge / "
-        f"c_p); dt = {dt:.4g} s"
+        f"{solid.V.dofmap.index_map.size_global} nodes; {solid.technology.describe()}"
     )
 
 
-def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
-    """The state at t = 0 and the effects the scene asks for, in the order they act."""
-    state = State(X=solid.X, mass=solid.mass, dt=dt, u=solid.u.owned, v=solid.v.owned)
-    state.v[:] = scene.initial.velocity
+def _step_fact(sim: Simulation) -> str:
+    """The step, and both stable steps at rest: the eigenvalue's and the elements'."""
+    info, step = sim.info, sim.step_size
+    how = (
+        f"adaptive, dt_scale x {step.calibration:.4g} x the smallest cell estimate"
+        if step.mode == "adaptive"
+        else "fixed"
+    )
+    return (
+        f"time step {how}; at rest: stable {info['dt_stable']:.4g} s (eigenvalue), smallest "
+        f"cell estimate {info['dt_element_estimate']:.4g} s (L/c); dt = {sim.state.dt:.4g} s"
+    )
+
+
+def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
+    """The state at t = 0, the step size and the effects the scene asks for, in the order
+    they act."""
     comm = solid.comm
     internal = solid.elastic
     if scene.material.model != "linear_elastic":
         internal = ElementForce(solid.V, scene.material, solid.technology, solid.u, solid.v)
+    body_mass = comm.allreduce(float(solid.mass.sum()))
+    steps = step_size(scene, internal, solid.dt_stable, V=solid.V, body_mass=body_mass,
+                      limits=limits)  # fmt: skip
+    state = State(X=solid.X, mass=solid.mass, dt=steps.initial, u=solid.u.owned, v=solid.v.owned)
+    state.v[:] = scene.initial.velocity
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
         internal=internal,
         comm=comm,
-        forces=[] if scene.gravity is None else [Gravity(scene.gravity, state)],
+        step_size=steps,
+        forces=[] if scene.gravity is None else [Gravity(scene.gravity)],
         walls=[_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))],
         boundaries=[_boundary(scene, i, solid) for i in range(len(scene.boundaries))],
         info={
@@ -333,9 +333,9 @@ def _pipeline(scene: Scene, solid: _Solid, dt: float) -> Simulation:
             "element": solid.technology.describe(),
             "cells": solid.body.num_cells,
             "nodes": solid.V.dofmap.index_map.size_global,
-            "mass": comm.allreduce(float(solid.mass.sum())),
+            "mass": body_mass,
             "dt_stable": solid.dt_stable,
-            "dt_element_estimate": solid.dt_element,
+            "dt_element_estimate": steps.at_rest,
         },
     )
 
@@ -352,7 +352,6 @@ def _add_recorders(
         sim.comm,
         solid.V.dofmap.index_map.local_to_global(owned),
         max_energy_error=scene.run.max_energy_error,
-        min_dt=scene.run.min_dt,
     )
     sim.history = History(
         sim,
@@ -361,29 +360,18 @@ def _add_recorders(
         guards=guards,
         plot=scene.output.plot,
     )
-    every = cycle_interval(sim.num_steps, scene.output.print_interval)
     run_log = RunLog(
-        directory, scene, facts, num_steps=sim.num_steps, every=every, comm=sim.comm,
-        frames=scene.output.frames,
+        directory, scene, facts, comm=sim.comm, frames=scene.output.frames,
+        schedule=cycle_schedule(scene.run.end_time, scene.output.print_interval),
     )  # fmt: skip
     sim.recorders.append(run_log)
-    if scene.material.plastic:
-        from rwall_fem.stable_step import ElementStepMonitor
-
-        monitor = ElementStepMonitor(solid.V, solid.u, sim.internal, solid.dt_stable, sim.comm)
-        sim.recorders.append(monitor)
-    elif scene.material.model != "linear_elastic":
-        from rwall_fem.stable_step import TangentStepMonitor
-
-        monitor = TangentStepMonitor(sim.internal, sim.state, solid.dt_stable, sim.comm)
-        sim.recorders.append(monitor)
     if scene.output.fields:
         from rwall_fem.output.fields import Fields
 
         fields = Fields(
             directory,
             count=scene.output.fields,
-            num_steps=sim.num_steps,
+            end_time=scene.run.end_time,
             V=solid.V,
             material=scene.material,
         )
@@ -402,7 +390,7 @@ def _add_recorders(
         frames = Frames(
             directory,
             count=scene.output.frames,
-            num_steps=sim.num_steps,
+            end_time=scene.run.end_time,
             V=solid.V,
             walls=sim.walls,
             speed=float(np.linalg.norm(scene.initial.velocity)),
@@ -434,23 +422,25 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
             motion = PrescribedMotion(spec.motion.velocity)
         else:
             motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity)
+    _filter_fits(spec, where, state.dt)
     return RigidWall(
         shape,
         _secondary_nodes(spec, where, shape, solid, state),
         f"wall[{i}]",
         slide=spec.slide,
         friction=spec.friction,
-        filter_alpha=_filter_alpha(spec, where, state.dt),
+        friction_filter=spec.friction_filter,
+        dt=state.dt,
         motion=motion,
         comm=comm,
     )
 
 
-def _filter_alpha(spec: WallSpec, where: str, dt: float) -> float:
-    """The friction filter's alpha in (0, 1] from its coefficient, steps or frequency (Hz)
-    at the step ``dt`` (s); 1 (no filter) when none is given."""
+def _filter_fits(spec: WallSpec, where: str, dt: float) -> None:
+    """A friction filter's alpha is in (0, 1] at the step of the start ``dt`` (s) (a
+    cut-off frequency gives 2 pi f dt: later steps are taken at most 1)."""
     if spec.friction_filter is None:
-        return 1.0
+        return
     how, value = spec.friction_filter
     alpha = {"coefficient": value, "steps": 2 * np.pi / max(value, 1e-300)}.get(
         how, 2 * np.pi * value * dt
@@ -460,7 +450,6 @@ def _filter_alpha(spec: WallSpec, where: str, dt: float) -> float:
             f"{where}.friction_filter.{how}: gives alpha = {alpha:.4g} with dt = "
             f"{dt:.4g} s; alpha must be in (0, 1]"
         )
-    return alpha
 
 
 def _boundary(scene: Scene, i: int, solid: _Solid) -> VelocityBoundary:
@@ -558,9 +547,3 @@ def _starter_warnings(sim: Simulation, solid: _Solid) -> list[str]:
 
 def _owned(nodes: np.ndarray, owned: int) -> np.ndarray:
     return nodes[nodes < owned]
-
-
-def _round_down(dt: float, digits: int = 4) -> float:
-    """``dt`` rounded down to ``digits`` significant figures, identical on every partitioning."""
-    unit = 10.0 ** (math.floor(math.log10(dt)) - digits + 1)
-    return math.floor(dt / unit) * unit

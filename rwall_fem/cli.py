@@ -170,7 +170,7 @@ class _WarningsOnly(logging.Filter):
 
 def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resume: bool) -> dict:
     from rwall_fem.build import build_simulation, run_in_folder
-    from rwall_fem.output.run_log import CycleLines, cycle_interval
+    from rwall_fem.output.run_log import CycleLines, cycle_schedule
     from rwall_fem.scene import load_scene
 
     scene = load_scene(scene_file, overrides)
@@ -179,10 +179,10 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
         if sys.stderr.isatty():
             from rwall_fem.output.progress import Progress
 
-            sim.recorders.append(Progress(sim.num_steps))
+            sim.recorders.append(Progress(scene.run.end_time))
         else:
-            every = cycle_interval(sim.num_steps, scene.output.print_interval)
-            sim.recorders.append(CycleLines(sys.stderr, sim.num_steps, every))
+            schedule = cycle_schedule(scene.run.end_time, scene.output.print_interval)
+            sim.recorders.append(CycleLines(sys.stderr, schedule))
     run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet), resume=resume)
     return sim.history.summary
 
@@ -196,8 +196,14 @@ def _say_how_it_ended(sim, quiet: bool) -> None:
         print(f"rwall-fem: stopped: {summary['reason']}", file=sys.stderr, flush=True)
     elif not quiet:
         e = summary["energy"]
+        step = summary["time_step"]
+        sizes = (
+            f"of {step['first']:.4g} s"
+            if step["smallest"] == step["largest"]
+            else f"of {step['smallest']:.4g} to {step['largest']:.4g} s"
+        )
         print(
-            f"rwall-fem: done: {summary['steps']} steps of {summary['dt']:.4g} s on "
+            f"rwall-fem: done: {summary['steps']} steps {sizes} on "
             f"{summary['ranks']} rank(s) in {summary['wall_seconds']:.2f} s; "
             f"max energy balance error {e['max_balance_error']:.2e}",
             flush=True,
@@ -232,10 +238,17 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
             f"  body: {info['cells']} {info['cell']} cells, {info['nodes']} nodes, "
             f"{info['mass']:.6g} kg, on {comm.size} rank(s)"
         )
+        adaptive = sim.step_size.mode == "adaptive"
+        steps = (
+            f"about {sim.planned_steps} steps to {scene.run.end_time:.4g} s if the step stays "
+            "at its value at rest (an adaptive step falls as cells are crushed)"
+            if adaptive
+            else f"{sim.planned_steps} steps to {scene.run.end_time:.4g} s"
+        )
         print(
-            f"  time step: {sim.state.dt:.4g} s (stable {info['dt_stable']:.4g} s; "
-            f"shortest edge / c_p {info['dt_element_estimate']:.4g} s); "
-            f"{sim.num_steps} steps to {sim.num_steps * sim.state.dt:.4g} s"
+            f"  time step: {sim.step_size.mode}, {sim.state.dt:.4g} s at rest (stable "
+            f"{info['dt_stable']:.4g} s from the eigenvalue, {info['dt_element_estimate']:.4g} "
+            f"s from the smallest cell L/c); {steps}"
         )
         print(f"  effects: {', '.join(sim.effects)}")
         for w, count in zip(sim.walls, walls, strict=True):
@@ -243,7 +256,7 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
         for b, count in zip(sim.boundaries, boundaries, strict=True):
             print(f"  {b.name}: {count} nodes, components {''.join('xyz'[i] for i in b.axes)}")
         print(
-            f"  estimated wall time: {1.2 * per_step * (sim.num_steps + 1):.3g} s "
+            f"  estimated wall time: {1.2 * per_step * (sim.planned_steps + 1):.3g} s "
             f"(internal force {per_step * 1e3:.3g} ms per step, + 20 % for the rest)"
         )
     return 0

@@ -31,7 +31,7 @@ import numpy as np
 from dolfinx import fem
 
 from rwall_fem import _compat
-from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, load
+from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
 
@@ -149,6 +149,12 @@ class ElementForce:
     ``plastic_work``, the plastic dissipation so far. An elasto-plastic body keeps its
     stress, equivalent plastic strain and temperature per integration point in
     ``history`` (rows of slots, columns of owned cells).
+
+    The same pass estimates each owned cell's stable step and finds the inverted ones
+    (``kernels/step.h``): :attr:`step` holds what it noted, :attr:`smallest_step` the
+    smallest estimate (s). The cells' volumes (m^3) and characteristic lengths (m) at rest
+    are :attr:`volume0` and :attr:`length0`. A small-strain body's estimate never
+    changes (its stiffness does not): it is made once, unless :attr:`estimate_every_step`.
     """
 
     def __init__(self, V, material, technology: Technology, u: GhostedField, v: GhostedField):
@@ -183,13 +189,57 @@ class ElementForce:
         self.history = None
         if self.plastic:
             self._set_plasticity(material)
-        # stored elastic, hourglass, plastic dissipation (J); inverted cells (plastic kernels)
-        self._energy = np.zeros(4)
-        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy)
-        self._inv_mass = None
-        self._started = False
-        # Without a stored energy, the update books the work of f at mid-step velocities.
-        self.booked_force = None if self.conservative else self.f.owned
+        self.volume0, self.length0 = self.cell_sizes(self.X)
+        self.params.length0 = ffi.cast("double *", self.length0.ctypes.data)
+        self.params.volume0 = ffi.cast("double *", self.volume0.ctypes.data)
+        self.estimate_every_step = model != "linear_elastic"
+        self.step = np.zeros(STEP_SLOTS)
+        self._estimated = False
+        # stored elastic, hourglass, plastic dissipation (J)
+        self._energy = np.zeros(3)
+        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
+        self._accelerate = None
+        self.nodal_force = self.f.owned  # N, owned nodes
+
+    def cell_sizes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The volume (m^3) and characteristic length (m) of every owned cell with its nodes
+        at ``x`` (rows of owned and ghost nodes, m): V / A_max of a hexahedron, 3 V / A_max
+        of a tetrahedron (``kernels/step.h``)."""
+        volume, length = np.empty(self.num_cells), np.empty(self.num_cells)
+        family = "tet4" if self.technology.cell == "tetrahedron" else "hex8"
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        getattr(self.lib, f"{family}_cell_sizes")(
+            self.num_cells, *(self.ffi.cast(kind, a.ctypes.data) for kind, a in (
+                ("int32_t *", self.cells), ("double *", x), ("double *", volume),
+                ("double *", length)))
+        )  # fmt: skip
+        return volume, length
+
+    def steps_at_rest(self) -> np.ndarray:
+        """Each owned cell's stable step estimate (s) at rest: L_0 / c_p, and with the
+        viscous hourglass form at most V_0^(1/3) / (8 QM c_p) (``kernels/step.h``)."""
+        c = self.params.wave_speed
+        steps = self.length0 / c
+        if self.technology.integration == "reduced" and self.technology.hourglass == "viscous":
+            coefficient = self.params.hourglass_coefficient
+            with np.errstate(divide="ignore"):
+                steps = np.minimum(steps, np.cbrt(self.volume0) / (8.0 * coefficient * c))
+        return steps
+
+    def list_cells_below(self, floor: float, factor: np.ndarray) -> None:
+        """From now on, scale each cell's step estimate by ``factor`` (per owned cell,
+        sqrt of its mass over its mass at rest), estimate it every step, and list the cells
+        whose scaled step is below ``floor`` (s) in :attr:`below` and :attr:`below_step`
+        (their steps before scaling), the first ``int(step[10])`` entries: mass scaling."""
+        self.estimate_every_step = True
+        self.below = np.zeros(self.num_cells, dtype=np.int32)
+        self.below_step = np.zeros(self.num_cells)
+        self._factor = factor
+        p, ffi = self.params, self.ffi
+        p.step_factor = ffi.cast("double *", factor.ctypes.data)
+        p.step_floor = floor
+        p.below = ffi.cast("int32_t *", self.below.ctypes.data)
+        p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
 
     def _set_plasticity(self, material) -> None:
         """The flow-stress law's constants, and the state per integration point: the stress
@@ -221,7 +271,7 @@ class ElementForce:
         self.history = np.zeros((slots, self.num_cells))
         self.history[POINT_SLOTS - 1 : self.points * POINT_SLOTS : POINT_SLOTS] = room
 
-    def _bind(self, u: np.ndarray, v: np.ndarray, f: np.ndarray, energy: np.ndarray):
+    def _bind(self, u: np.ndarray, v: np.ndarray, f: np.ndarray, energy: np.ndarray, step):
         """The kernel of the technology and material, with its arguments bound."""
         ffi, t, model = self.ffi, self.technology, self.name
 
@@ -229,7 +279,7 @@ class ElementForce:
             return ffi.cast(kind, array.ctypes.data)
 
         common = (self.num_cells, ptr(self.cells, "int32_t *"), ptr(self.X), ptr(u))
-        rest = (self.params, ptr(f), ptr(energy))
+        rest = (self.params, ptr(f), ptr(energy), ptr(step))
         family = "tet4" if t.cell == "tetrahedron" else "hex8"
         if self.plastic:
             name = (
@@ -239,7 +289,7 @@ class ElementForce:
             )
             state = (ptr(self.history), self.num_cells)
             return functools.partial(getattr(self.lib, name), *common, ptr(v), self.params, *state,
-                                     ptr(f), ptr(energy))  # fmt: skip
+                                     ptr(f), ptr(energy), ptr(step))  # fmt: skip
         if t.integration == "reduced":
             kernel = getattr(self.lib, f"hex8r_{model}_{t.hourglass}")
             return functools.partial(kernel, *common, ptr(v), *rest)
@@ -261,18 +311,45 @@ class ElementForce:
         return float(self._energy[2])
 
     @property
+    def smallest_step(self) -> float:
+        """The smallest stable step estimate (s) of this rank's cells at the latest force
+        computation (scaled by the mass-scaling factors), inf if it has no cell."""
+        return float(self.step[0])
+
+    @property
     def inverted_cells(self) -> int:
-        """How many times an owned cell was found inverted (volume <= 0) so far (the
-        elasto-plastic kernels, in the current configuration)."""
-        return int(self._energy[3])
+        """How many owned cells were found inverted (a volume <= 0 at an integration point)
+        by the latest force computation."""
+        return int(self.step[5])
+
+    def cell_position(self, cell: int) -> np.ndarray:
+        """The centroid (m) of the owned ``cell`` (local index) at X + u."""
+        nodes = self.cells[cell]
+        return (self.X[nodes] + self.u.array[nodes]).mean(axis=0)
+
+    def describe_cell(self, cell: int) -> str:
+        """The state of the owned ``cell`` in words: its volume against its volume at rest
+        and, when the law has them, its plastic strain and temperature."""
+        volume, _ = self.cell_sizes(self.X + self.u.array)
+        words = [f"volume {volume[cell] / self.volume0[cell]:.3g} of its initial"]
+        if self.plastic:
+            points = self.history[: self.points * POINT_SLOTS].reshape(self.points, POINT_SLOTS, -1)
+            words.append(f"plastic strain {points[:, 6, cell].mean():.3g}")
+            if self.params.thermal:
+                words.append(f"temperature {points[:, 7, cell].mean():.4g} K")
+        return ", ".join(words)
 
     def energies(self, state) -> dict[str, float]:
-        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
-        without a stored energy, the internal work less the hourglass energy), and
+        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy with
+        the correction of a varying step (or, without a stored energy, the internal work
+        less the hourglass energy), and
         ``"hourglass"`` when the elements have hourglass control; for an elasto-plastic
         body also the parts of the internal energy, ``"elastic"`` and ``"plastic_work"``."""
         hourglass = self.hourglass_energy
-        internal = self.stored_energy if self.conservative else state.internal_work - hourglass
+        if self.conservative:
+            internal = self.stored_energy + state.step_correction
+        else:
+            internal = state.internal_work - hourglass
         energies = {"internal": internal}
         if "hourglass" in self.energy_names:
             energies["hourglass"] = hourglass
@@ -301,26 +378,32 @@ class ElementForce:
         return self.history[POINT_SLOTS - 2 : self.points * POINT_SLOTS : POINT_SLOTS]
 
     def accelerate(self, state) -> None:
-        """Set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
+        """Set ``state.a = -f_int(u^n) / m`` on the owned nodes; estimate the cells' stable
+        steps and find the inverted cells on the way (:attr:`step`)."""
         self.u.scatter_forward()
+        # The step just taken, dt^{n-1/2}: the elasto-plastic increment u^n - u^{n-1} is
+        # dt^{n-1/2} v^{n-1/2} (0 at the first step: the state is the initial one).
+        self.params.dt = state.dt_previous
         if not self.conservative:
             self.v.scatter_forward()
-            # The elasto-plastic state is that of u^n: no increment before the first step.
-            self.params.dt = state.dt if self._started or not self.plastic else 0.0
         else:
             self._energy[1] = 0.0
-        self._started = True
         self._energy[0] = 0.0
+        estimate = self.estimate_every_step or not self._estimated
+        self.params.estimate = estimate
+        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0)
+        if estimate:
+            self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
+            self._estimated = True
         self.f.array.fill(0.0)
         self._kernel()
         self.f.scatter_reverse_add()
-        if self._inv_mass is None:
-            self._inv_mass = np.ascontiguousarray(state.inv_mass[:, 0])
+        if self._accelerate is None:
             self._accelerate = functools.partial(
                 self.lib.internal_acceleration,
-                len(self._inv_mass),
+                len(state.inv_mass),
                 self.ffi.cast("double *", self.f.array.ctypes.data),
-                self.ffi.cast("double *", self._inv_mass.ctypes.data),
+                self.ffi.cast("double *", state.inv_mass.ctypes.data),
                 self.ffi.cast("double *", state.a.ctypes.data),
             )
         self._accelerate()
@@ -336,14 +419,17 @@ class ElementForce:
             raise TypeError("an elasto-plastic force depends on the path, not on u alone")
         if self._probe is None:
             V = self.V
-            fields, energy = (GhostedField(V), GhostedField(V), GhostedField(V)), np.zeros(4)
-            self._probe = (*fields, self._bind(*(g.array for g in fields), energy), energy)
+            fields = (GhostedField(V), GhostedField(V), GhostedField(V))
+            energy, step = np.zeros(3), np.zeros(STEP_SLOTS)
+            self._probe = (*fields, self._bind(*(g.array for g in fields), energy, step), energy)
         u_probe, _, f_probe, kernel, energy = self._probe
         u_probe.owned[:] = u
         u_probe.scatter_forward()
         f_probe.array.fill(0.0)
         energy[:] = 0.0
+        estimate, self.params.estimate = self.params.estimate, False
         kernel()
+        self.params.estimate = estimate
         f_probe.scatter_reverse_add()
         return f_probe.owned.copy()
 
@@ -358,16 +444,17 @@ class ElementForce:
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """The energies of the latest force computation (J: the viscous hourglass form and
-        the elasto-plastic kernels accumulate theirs), whether the first step is done, and
-        the elasto-plastic state per integration point."""
-        arrays = {"energy": self._energy, "started": np.array(self._started)}
+        the elasto-plastic kernels accumulate theirs), what it noted of the cells' steps,
+        and the elasto-plastic state per integration point."""
+        arrays = {"energy": self._energy, "step": self.step}
         if self.plastic:
             arrays["history"] = self.history
         return arrays
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self._energy[:] = arrays["energy"]
-        self._started = bool(arrays["started"])
+        self.step[:] = arrays["step"]
+        self._estimated = True
         if self.plastic:
             self.history[...] = arrays["history"]
 

@@ -22,7 +22,6 @@ from rwall_fem.scene import Material
 __all__ = [
     "coordinate_pattern",
     "critical_time_step",
-    "element_time_step",
     "lumped_mass",
     "shortest_edge",
     "stiffness_form",
@@ -156,8 +155,3 @@ def shortest_edge(V, x: np.ndarray | None = None, chunk: int = 65536) -> float:
         d = x[block[:, first]] - x[block[:, second]]
         shortest = min(shortest, np.einsum("cei,cei->ce", d, d).min(initial=np.inf))
     return V.mesh.comm.allreduce(float(np.sqrt(shortest)), op=MPI.MIN)
-
-
-def element_time_step(V, material: Material) -> float:
-    """Element-size estimate of the stable step: shortest edge / p-wave speed (s)."""
-    return shortest_edge(V) / material.p_wave_speed

@@ -2,13 +2,19 @@
 
 One step, in the order of ``docs/theory.md`` (section "The step"):
 
-1. forces -> acceleration ``a^n``: the internal force *sets* ``a``, body forces add to it;
-2. constraints edit ``a^n``: the rigid walls, then the velocity boundary conditions;
-3. recorders sample the steps they are due (fields, frames: ``u^n``, ``v^{n-1/2}``);
-4. the update ``v^{n+1/2} = v^{n-1/2} + dt a^n``, ``u^{n+1} = u^n + dt v^{n+1/2}``, in one
-   compiled pass that also books the step's kinetic energy (:class:`CentralDifference`);
-5. bookkeeping: the history samples the energies of step n; a checkpoint is written when
-   one is due (:mod:`rwall_fem.checkpoint`).
+1. the internal force *sets* the acceleration ``a^n`` and estimates every cell's stable
+   step on the way;
+2. the step size chooses ``dt^{n+1/2}`` from those estimates (:mod:`rwall_fem.time_step`),
+   adding mass to the cells below ``run.dt_min`` when the scene asks for mass scaling;
+3. body forces add to ``a^n``, constraints edit it: the rigid walls, then the velocity
+   boundary conditions;
+4. recorders sample the steps they are due (fields, frames: ``u^n``, ``v^{n-1/2}``);
+5. the update ``v^{n+1/2} = v^{n-1/2} + dt^n a^n`` with ``dt^n = (dt^{n-1/2} +
+   dt^{n+1/2}) / 2``, ``u^{n+1} = u^n + dt^{n+1/2} v^{n+1/2}``, in one compiled pass that
+   also books the step's kinetic energy (:class:`CentralDifference`);
+6. bookkeeping: the history samples the energies of step n; the run stops if the step
+   size found a reason to (an inverted cell, ``run.dt_min``, ...); a checkpoint is written
+   when one is due (:mod:`rwall_fem.checkpoint`).
 
 Each effect is an object with a small interface (:class:`Force`, :class:`Constraint`,
 :class:`Recorder`), and only the effects a scene asks for are in the lists, so nothing
@@ -40,6 +46,7 @@ __all__ = [
     "Simulation",
     "State",
     "Stateful",
+    "StepSize",
 ]
 
 
@@ -72,45 +79,72 @@ class Stateful(Protocol):
 
 @dataclass
 class State:
-    """Nodal state of the rank's owned nodes; vectors have shape (n, 3), SI units."""
+    """Nodal state of the rank's owned nodes; vectors have shape (n, 3), SI units.
+
+    Steps vary: ``dt`` is dt^{n+1/2} = t^{n+1} - t^n, chosen at step n (before that, the
+    previous step's), ``dt_previous`` is dt^{n-1/2} (0 at the first step) and
+    :attr:`dt_velocity` the step of the velocity update. ``last`` is set at the step that
+    reaches the end time.
+    """
 
     X: np.ndarray  # reference coordinates, m
-    mass: np.ndarray  # lumped nodal mass, kg, shape (n,)
+    mass: np.ndarray  # lumped nodal mass, kg, shape (n,) (mass scaling adds to it)
     dt: float  # s
     u: np.ndarray = None  # displacement u^n, m
     v: np.ndarray = None  # velocity v^{n-1/2}, m/s
     a: np.ndarray = None  # acceleration a^n, m/s^2
     t: float = 0.0  # s
     step: int = 0
+    dt_previous: float = 0.0  # s
+    last: bool = False
     kinetic: float = 0.0  # K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} of the latest update, J
     internal_work: float = 0.0  # of an internal force without stored energy, up to step n, J
-    mass_moment: np.ndarray = None  # sum m u^n of the latest update, kg m
+    step_correction: float = 0.0  # of a stored energy for a varying step, up to step n, J
+    # The momentum booked at mid-step velocities up to step n, sum over steps of
+    # dt^k/2 (P^{k-1/2} + P^{k+1/2}) with P = sum m v (first half only of step n), kg m:
+    # what the work of uniform gravity needs.
+    momentum_integral: np.ndarray = None
 
     def __post_init__(self):
         for name in ("u", "v", "a"):
             if getattr(self, name) is None:
                 setattr(self, name, np.zeros_like(self.X))
-        self.mass_moment = np.zeros(3)
-        self.inv_mass = (1.0 / self.mass)[:, None]  # 1/kg, shape (n, 1)
+        self.momentum_integral = np.zeros(3)
+        self.inv_mass = 1.0 / self.mass  # 1/kg, shape (n,)
+
+    @property
+    def dt_velocity(self) -> float:
+        """dt^n = (dt^{n-1/2} + dt^{n+1/2}) / 2 (s), the step of v^{n-1/2} -> v^{n+1/2}; at
+        the first step dt^{1/2}: the initial velocity is taken as v^{-1/2}."""
+        return self.dt if self.dt_previous == 0.0 else 0.5 * (self.dt_previous + self.dt)
+
+    def set_mass(self, nodes: np.ndarray, mass: np.ndarray) -> None:
+        """Give the owned ``nodes`` the masses ``mass`` (kg), in place (the compiled passes
+        hold pointers to these arrays)."""
+        self.mass[nodes] = mass
+        self.inv_mass[nodes] = 1.0 / mass
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """u^{n+1} and v^{n+1/2} (``a`` is set again by the internal force), the step, and
-        what the update of step n booked."""
+        """u^{n+1} and v^{n+1/2} (``a`` is set again by the internal force), the step, its
+        time and size and the one before, whether it was the last, the masses, and what
+        the update of step n booked."""
         return {
             "u": self.u,
             "v": self.v,
-            "clock": np.array([self.step, self.t]),
-            "booked": np.array([self.kinetic, self.internal_work]),
-            "mass_moment": self.mass_moment,
+            "mass": self.mass,
+            "clock": np.array([self.step, self.t, self.dt, self.dt_previous, self.last]),
+            "booked": np.array([self.kinetic, self.internal_work, self.step_correction]),
+            "momentum_integral": self.momentum_integral,
         }
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self.u[:] = arrays["u"]
         self.v[:] = arrays["v"]
-        step, self.t = arrays["clock"].tolist()
-        self.step = int(step)
-        self.kinetic, self.internal_work = arrays["booked"].tolist()
-        self.mass_moment[:] = arrays["mass_moment"]
+        self.set_mass(slice(None), arrays["mass"])
+        step, self.t, self.dt, self.dt_previous, last = arrays["clock"].tolist()
+        self.step, self.last = int(step), bool(last)
+        self.kinetic, self.internal_work, self.step_correction = arrays["booked"].tolist()
+        self.momentum_integral[:] = arrays["momentum_integral"]
 
 
 class Force(Protocol):
@@ -127,13 +161,14 @@ class InternalForce(Force, Protocol):
     ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``),
     ``energy_parts`` parts of them reported beside them (e.g. ``"plastic_work"``);
     :meth:`energies` gives them all (J) on this rank's share of the body at step n.
-    ``booked_force`` is None for a force with a stored energy; otherwise it is the nodal
-    force (N, owned nodes) whose work the update books in ``state.internal_work``.
+    ``nodal_force`` is the latest force (N, owned nodes); ``conservative`` says whether it
+    has a stored energy: if not, the update books its work in ``state.internal_work``.
     """
 
     energy_names: tuple[str, ...]
     energy_parts: tuple[str, ...]
-    booked_force: np.ndarray | None
+    conservative: bool
+    nodal_force: np.ndarray
 
     def energies(self, state: State) -> dict[str, float]: ...
 
@@ -157,11 +192,27 @@ class Constraint(Protocol):
     def constrain(self, state: State) -> None: ...
 
 
+class StepSize(Protocol):
+    """Chooses dt^{n+1/2} after the internal force of step n (:mod:`rwall_fem.time_step`)."""
+
+    stop_reason: str | None  # a reason to stop the run after this step's history sample
+
+    varies: bool  # whether the step may change during the run
+
+    def choose(self, sim: Simulation, state: State) -> None:
+        """Set ``state.dt``; may add mass (then ``state.a`` and ``state.v`` follow)."""
+        ...
+
+    def advance(self, state: State) -> None:
+        """Go on to the next step: its number, time and previous step."""
+        ...
+
+
 class Recorder(Protocol):
     """Samples the run at the steps it is :meth:`due` (before the update of that step; the
     history samples after it) and is closed once when the run ends, however it ends."""
 
-    def due(self, step: int) -> bool: ...
+    def due(self, state: State) -> bool: ...
 
     def record(self, sim: Simulation, state: State) -> None: ...
 
@@ -170,19 +221,26 @@ class Recorder(Protocol):
 
 class CentralDifference:
     """The update of a step in one compiled pass (``kernels/update.c``):
-    v^{n+1/2} = v^{n-1/2} + dt a^n and u^{n+1} = u^n + dt v^{n+1/2}, booking on the way the
-    shadow kinetic energy K^n in ``state.kinetic``, sum m u^n in ``state.mass_moment`` and,
-    when ``booked`` is given, the work of that force at mid-step velocities in
-    ``state.internal_work`` (J, this rank: both halves of every step before n and the
-    first half of step n, as every work is booked).
+    v^{n+1/2} = v^{n-1/2} + dt^n a^n and u^{n+1} = u^n + dt^{n+1/2} v^{n+1/2}, booking on
+    the way the shadow kinetic energy K^n in ``state.kinetic`` and the momentum integral in
+    ``state.momentum_integral``, and what the internal ``force`` (N, owned nodes) needs:
+
+    - a force without a stored energy (``stored`` False): its work at mid-step velocities
+      in ``state.internal_work`` (J, this rank: both halves of every step before n and the
+      first half of step n, as every work is booked);
+    - a force with one: ``state.step_correction`` (J), what the stored energy misses when
+      the step varies, sum over steps of (dt^{k+1/2} - dt^{k-1/2})/4 f^k . (v^{k-1/2} -
+      v^{k+1/2}) (the v^{n+1/2} half of step n at step n + 1): with it, K^n + U(u^n)
+      is conserved exactly by a linear force whatever the steps (``docs/theory.md``).
     """
 
-    def __init__(self, state: State, booked: np.ndarray | None = None):
+    def __init__(self, state: State, force: np.ndarray | None = None, *, stored: bool = False):
         from rwall_fem.kernels import load
 
         ffi, lib = load()
-        self._out = np.zeros(6)
-        self._done = 0.0  # work of the finished steps, J
+        self._out = np.zeros(9)
+        self._done = 0.0  # work or correction of the finished steps, J
+        self._integral = np.zeros(3)  # momentum integral of the finished steps, kg m
 
         def ptr(array):
             return ffi.cast("double *", array.ctypes.data) if array is not None else ffi.NULL
@@ -190,27 +248,39 @@ class CentralDifference:
         for name in ("u", "v", "a"):
             if not getattr(state, name).flags.c_contiguous:
                 raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
-        self._booked = booked is not None
-        self._pass = functools.partial(
-            lib.central_difference, len(state.mass), state.dt, ptr(state.mass), ptr(state.a),
-            ptr(state.v), ptr(state.u), ptr(booked), ptr(self._out),
+        self._force = force is not None
+        self._stored = stored
+        self._pass = functools.partial(lib.central_difference, len(state.mass))
+        self._arrays = (
+            ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force), ptr(self._out)
         )  # fmt: skip
 
     def __call__(self, state: State) -> None:
-        self._pass()
-        kinetic, first, second = self._out[:3]
+        dt_v = state.dt_velocity
+        self._pass(dt_v, state.dt, *self._arrays)
+        kinetic, before, after = self._out[:3]
         state.kinetic = kinetic
-        state.mass_moment[:] = self._out[3:]
-        if self._booked:
-            state.internal_work = self._done + first
-            self._done += first + second
+        old, new = self._out[3:6], self._out[6:9]
+        state.momentum_integral[:] = self._integral + 0.5 * dt_v * old
+        self._integral += 0.5 * dt_v * (old + new)
+        if not self._force:
+            return
+        if self._stored:
+            change = 0.25 * (state.dt - (state.dt_previous or state.dt))
+            state.step_correction = self._done + change * before
+            self._done += change * (before - after)
+        else:
+            state.internal_work = self._done + 0.5 * dt_v * before
+            self._done += 0.5 * dt_v * (before + after)
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The booked work of the finished steps (J)."""
-        return {"done": np.array(self._done)}
+        """The booked work or correction (J) and momentum integral (kg m) of the finished
+        steps."""
+        return {"done": np.array(self._done), "integral": self._integral}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self._done = float(arrays["done"])
+        self._integral[:] = arrays["integral"]
 
 
 @dataclass
@@ -235,14 +305,26 @@ class Simulation:
     stop_requests: set[str] = field(default_factory=set)
     checkpoints: Any = None  # rwall_fem.checkpoint.Checkpoints: written after the history
     first_step: int = 0  # after a resume, the step after the checkpoint's
+    # Chooses dt^{n+1/2} (rwall_fem.time_step); by default state.dt for the whole run.
+    step_size: StepSize | None = None
 
     def __post_init__(self):
+        if self.step_size is None:
+            from rwall_fem.time_step import FixedStep
+
+            self.step_size = FixedStep(self.state.dt)
         if self.update is None:
-            self.update = CentralDifference(self.state, self.internal.booked_force)
+            # A stored energy needs the step's correction only where the step varies.
+            stored = self.internal.conservative
+            needed = not stored or self.step_size.varies
+            force = self.internal.nodal_force if needed else None
+            self.update = CentralDifference(self.state, force, stored=stored)
 
     @property
-    def num_steps(self) -> int:
-        return math.ceil(self.end_time / self.state.dt - 1e-9)
+    def planned_steps(self) -> int:
+        """The steps to ``end_time`` at the step of the start: all of them with a fixed
+        step, an estimate with an adaptive one (fewer than it takes when the step falls)."""
+        return math.ceil(self.end_time / self.step_size.initial - 1e-9)
 
     @property
     def constraints(self) -> list[Constraint]:
@@ -259,7 +341,9 @@ class Simulation:
         """Every object of the run that carries state from one step to the next, by a name
         that is the same in every run of the scene: what a checkpoint holds."""
         pieces = {"state": self.state, "update": self.update, "internal": self.internal}
-        pieces |= {f"force[{i}]": f for i, f in enumerate(self.forces)}
+        pieces["step_size"] = self.step_size
+        forces = [f for f in self.forces if hasattr(f, "checkpoint_state")]
+        pieces |= {f"force[{i}]": f for i, f in enumerate(forces)}
         pieces |= {f"wall[{i}]": w for i, w in enumerate(self.walls)}
         pieces |= {f"boundary[{i}]": b for i, b in enumerate(self.boundaries)}
         if self.history is not None:
@@ -284,34 +368,45 @@ class Simulation:
                 f"Simulation.run: this simulation has already run ({self.status.partition(':')[0]}"
                 "); build a new one (build_simulation) to run the scene again"
             )
-        s, last, update, history = self.state, self.num_steps, self.update, self.history
-        forces, constraints = [self.internal, *self.forces], self.constraints
-        first, checkpoints = self.first_step, self.checkpoints
+        s, update, history, step_size = self.state, self.update, self.history, self.step_size
+        internal, forces, constraints = self.internal, self.forces, self.constraints
+        checkpoints = self.checkpoints
+        # A resumed run goes on after its checkpoint's step, unless that step was the last.
+        going = not (self.first_step and s.last)
         with contextlib.ExitStack() as closing:
             outputs = [history, *self.recorders] if history is not None else self.recorders
             for recorder in reversed(outputs):  # closed in the order of the list
                 closing.push(_closer(recorder, self))
             closing.enter_context(_stop_signals(self))
             if checkpoints is not None:
-                checkpoints.start(first)
+                checkpoints.start(self.first_step)
             started = time.perf_counter()
-            updated = first - 1  # the latest step whose update is done
+            updated = s.step - 1 if not self.first_step else s.step  # the latest update done
             try:
-                for step in range(first, last + 1):
-                    s.step, s.t = step, step * s.dt
+                if self.first_step and going:
+                    step_size.advance(s)
+                while going:
+                    s.last = s.t >= self.end_time - 1e-9 * s.dt_previous
+                    internal.accelerate(s)
+                    step_size.choose(self, s)
                     for force in forces:
                         force.accelerate(s)
                     for constraint in constraints:
                         constraint.constrain(s)
                     for recorder in self.recorders:
-                        if recorder.due(step):
+                        if recorder.due(s):
                             recorder.record(self, s)
                     update(s)
-                    updated = step
-                    if history is not None and history.due(step):
+                    updated = s.step
+                    if history is not None and (history.due(s) or step_size.stop_reason):
                         history.record(self, s)
-                    if checkpoints is not None and checkpoints.due(step):
+                    if step_size.stop_reason:
+                        raise RunStopped(step_size.stop_reason)
+                    if checkpoints is not None and checkpoints.due(s.step):
                         checkpoints.save(self)
+                    if s.last:
+                        break
+                    step_size.advance(s)
                 self.status = "done"
             except RunStopped as stop:
                 self.status = f"stopped: {stop}"

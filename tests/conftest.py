@@ -154,7 +154,7 @@ class Probe:
         self.t, self.x, self.v, self.distances = [], [], [], []
         sim.recorders.append(self)
 
-    def due(self, step):
+    def due(self, s):
         return True
 
     def record(self, sim, s):

@@ -30,9 +30,9 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
-__all__ = ["HOURGLASS", "MODELS", "POINT_SLOTS", "KernelBuildError", "load"]
+__all__ = ["HOURGLASS", "MODELS", "POINT_SLOTS", "STEP_SLOTS", "KernelBuildError", "load"]
 
-SOURCES = ("batch.h", "materials.h", "plasticity.h", "tetrahedron.c", "hexahedron.c",
+SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "tetrahedron.c", "hexahedron.c",
            "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
@@ -42,6 +42,7 @@ FLAG_SETS = (
 )
 MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")  # the elastic laws
 POINT_SLOTS = 8  # state values per integration point of the plastic kernels (plasticity.h)
+STEP_SLOTS = 11  # what a kernel notes of the element steps and inverted cells (step.h)
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
 
 _CDEF = (
@@ -55,36 +56,48 @@ typedef struct {
   double thermal_exponent, melting_temperature, room_temperature, specific_heat, taylor_quinney;
   int table_size;
   double table_strain[64], table_stress[64];
+  int estimate;
+  const double *length0;
+  const double *volume0;
+  const double *step_factor;
+  double step_floor;
+  int32_t *below;
+  double *below_step;
 } element_params;
 double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);
 void tet4_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
                   const double *v, const element_params *p, double *state, int64_t stride,
-                  double *f, double *energy);
+                  double *f, double *energy, double *step);
 void hex8_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
                   const double *v, const element_params *p, double *state, int64_t stride,
-                  double *f, double *energy);
+                  double *f, double *energy, double *step);
+void tet4_cell_sizes(int64_t n, const int32_t *cells, const double *x, double *volume,
+                     double *length);
+void hex8_cell_sizes(int64_t n, const int32_t *cells, const double *x, double *volume,
+                     double *length);
 """
     + "".join(
         f"void hex8r_plastic_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
         " const double *u, const double *v, const element_params *p, double *state,"
-        " int64_t stride, double *f, double *energy);\n"
+        " int64_t stride, double *f, double *energy, double *step);\n"
         for hourglass in HOURGLASS
     )
     + """
 void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
-void central_difference(int64_t n, double dt, const double *mass, const double *a, double *v,
-                        double *u, const double *f, double out[6]);
+void central_difference(int64_t n, double dt_v, double dt, const double *mass, const double *a,
+                        double *v, double *u, const double *f, double out[9]);
 """
     + "".join(
         f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"
-        " const element_params *p, double *f, double *energy);\n"
+        " const element_params *p, double *f, double *energy, double *step);\n"
         for family in ("tet4", "hex8")
         for model in MODELS
     )
     + "".join(
         f"void hex8r_{model}_{hourglass}(int64_t n, const int32_t *cells, const double *X,"
-        " const double *u, const double *v, const element_params *p, double *f, double *energy);\n"
+        " const double *u, const double *v, const element_params *p, double *f, double *energy,"
+        " double *step);\n"
         for model in MODELS
         for hourglass in HOURGLASS
     )

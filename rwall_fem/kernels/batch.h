@@ -36,7 +36,7 @@ typedef struct
   double density;     /* kg/m^3 */
   double wave_speed;  /* dilatational wave speed sqrt((lambda + 2 mu)/density), m/s */
   double hourglass_coefficient; /* scales the hourglass forces (one-point hexahedra) */
-  double dt;          /* time step, s (viscous hourglass, plastic strain rates) */
+  double dt;          /* the step just taken, dt^{n-1/2}, s (0 at the first step) */
   /* plasticity (plasticity.h) */
   int hardening;                /* HARDENING_LINEAR, _POWER, _TABLE or JOHNSON_COOK */
   double yield_stress;          /* A, Pa */
@@ -53,6 +53,14 @@ typedef struct
   double taylor_quinney;        /* share of plastic work turned into heat */
   int table_size;               /* rows of the table */
   double table_strain[TABLE_ROWS], table_stress[TABLE_ROWS]; /* eps_p (increasing), Pa */
+  /* the element time step (step.h) */
+  int estimate;                 /* estimate each cell's stable step in this call */
+  const double *length0;        /* per cell: characteristic length at rest, m */
+  const double *volume0;        /* per cell: volume at rest, m^3 */
+  const double *step_factor;    /* NULL, or per cell sqrt(mass / mass at rest) (mass scaling) */
+  double step_floor;            /* s: the cells whose step is below it are listed in below */
+  int32_t *below;               /* NULL, or room for every cell's index */
+  double *below_step;           /* and for its step before mass scaling, s */
 } element_params;
 
 /* Gather the 3 components of the npe nodes of cells c0 .. c0 + LANES - 1 into
@@ -137,6 +145,43 @@ INLINE vec vsqrt(vec x)
   for (int k = 0; k < LANES; ++k)
     r[k] = sqrt(x[k]);
   return r;
+}
+
+INLINE vec vmax(vec a, vec b)
+{
+  const ivec m = a > b;
+  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
+}
+
+INLINE vec vmin(vec a, vec b)
+{
+  const ivec m = a < b;
+  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
+}
+
+INLINE vec vselect(ivec m, vec a, vec b)
+{
+  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
+}
+
+INLINE int any_lane(ivec m)
+{
+  int r = 0;
+  for (int k = 0; k < LANES; ++k)
+    r |= m[k] != 0;
+  return r;
+}
+
+/* The per-cell values a[c0 .. c0 + LANES - 1]; lanes from nb on repeat cell c0. */
+INLINE vec cell_values(const double *restrict a, int64_t c0, int nb)
+{
+  vec v;
+  if (nb == LANES)
+    __builtin_memcpy(&v, a + c0, sizeof v);
+  else
+    for (int k = 0; k < LANES; ++k)
+      v[k] = a[c0 + (k < nb ? k : 0)];
+  return v;
 }
 
 /* The sum of the first nb lanes. */

@@ -9,6 +9,7 @@
  */
 #include "materials.h"
 #include "plasticity.h"
+#include "step.h"
 
 static const double SIGN[8][3] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1},
                                   {-1, -1, 1},  {1, -1, 1},  {-1, 1, 1},  {1, 1, 1}};
@@ -65,11 +66,15 @@ INLINE void hex8_gradient(const vec *restrict w, vec g[8][3], vec L[9])
     }
 }
 
-/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell. */
+/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell, and in
+ * *jacobian the smallest det(I + grad u) of its points, in *modulus their largest
+ * rho_0 c^2 (Pa, when p->estimate). */
 INLINE vec hex8_cell(int model, const vec *restrict x, const vec *restrict u, vec *restrict f,
-                     const element_params *p)
+                     const element_params *p, vec *jacobian, vec *modulus)
 {
   vec energy = VZERO;
+  *jacobian = VZERO + INFINITY;
+  *modulus = VZERO;
   for (int I = 0; I < 24; ++I)
     f[I] = VZERO;
   for (int q = 0; q < 8; ++q)
@@ -82,24 +87,37 @@ INLINE vec hex8_cell(int model, const vec *restrict x, const vec *restrict u, ve
       for (int i = 0; i < 3; ++i)
         f[3 * I + i] += weight * (T[3 * i] * g[I][0] + T[3 * i + 1] * g[I][1]
                                   + T[3 * i + 2] * g[I][2]);
+    *jacobian = vmin(*jacobian, volume_ratio(L));
+    if (p->estimate)
+      *modulus = vmax(*modulus, wave_modulus(model, L, p->lmbda, p->mu));
   }
   return energy;
 }
 
+/* Total Lagrangian hexahedra: the stable step of a cell is L_0 / c with its length at
+ * rest and the largest wave speed of the law at its points (step.h). */
 INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cells,
                        const double *restrict X, const double *restrict u,
-                       const element_params *p, double *restrict f, double *restrict energy)
+                       const element_params *p, double *restrict f, double *restrict energy,
+                       double *restrict step)
 {
-  vec x[24], ue[24], fe[24];
+  vec x[24], ue[24], fe[24], jacobian, modulus;
   double total = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
     gather(cells, 8, c0, nb, X, x);
     gather(cells, 8, c0, nb, u, ue);
-    const vec w = hex8_cell(model, x, ue, fe, p);
+    const vec w = hex8_cell(model, x, ue, fe, p, &jacobian, &modulus);
     scatter_add(cells, 8, c0, nb, fe, f);
     total += lane_sum(w, nb);
+    const ivec inverted = jacobian <= 0.0;
+    note_inverted(inverted, c0, nb, x, ue, 8, step);
+    if (p->estimate)
+    {
+      const vec dte = cell_values(p->length0, c0, nb) * vsqrt(p->density / modulus);
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 8, step);
+    }
   }
   energy[0] += total;
 }
@@ -107,15 +125,16 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
 /* Elasto-plastic Q1 hexahedra, 2x2x2 points with mean dilatation (B-bar: every point
  * takes the element's mean volumetric increment, and the pressure acts through the mean
  * gradient), updated Lagrangian as tet4_plastic; the state holds POINT_SLOTS slots per
- * point.  energy[0] += stored elastic energy (J), energy[2] += plastic dissipation,
- * energy[3] += the number of cells with an inverted point (det J <= 0). */
+ * point.  energy[0] += stored elastic energy (J), energy[2] += plastic dissipation; a cell
+ * is inverted when det J <= 0 at a point, and its stable step is L / c in the current
+ * configuration (step.h). */
 void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
                   double *restrict state, int64_t stride, double *restrict f,
-                  double *restrict energy)
+                  double *restrict energy, double *restrict step)
 {
   vec Xe[24], ue[24], ve[24], fe[24];
-  double stored = 0.0, dissipated = 0.0, inverted = 0.0;
+  double stored = 0.0, dissipated = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
@@ -182,29 +201,27 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     scatter_add(cells, 8, c0, nb, fe, f);
     stored += lane_sum(elastic, nb);
     dissipated += lane_sum(dissipation, nb);
-    inverted += lane_sum(vselect(smallest <= 0.0, VZERO + 1.0, VZERO), nb);
+    const ivec inverted = smallest <= 0.0;
+    note_inverted(inverted, c0, nb, x, NULL, 8, step);
+    if (p->estimate)
+    {
+      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, c0, nb));
+      const vec dte = characteristic_length(8, x, volume) / speed;
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 8, step);
+    }
   }
   energy[0] += stored;
   energy[2] += dissipated;
-  energy[3] += inverted;
 }
 
-/* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */
-void hex8_linear_elastic(int64_t n, const int32_t *cells, const double *X, const double *u,
-                         const element_params *p, double *f, double *energy)
-{
-  hex8_force(LINEAR_ELASTIC, n, cells, X, u, p, f, energy);
-}
-
-void hex8_saint_venant_kirchhoff(int64_t n, const int32_t *cells, const double *X,
-                                 const double *u, const element_params *p, double *f,
-                                 double *energy)
-{
-  hex8_force(SAINT_VENANT_KIRCHHOFF, n, cells, X, u, p, f, energy);
-}
-
-void hex8_neo_hookean(int64_t n, const int32_t *cells, const double *X, const double *u,
-                      const element_params *p, double *f, double *energy)
-{
-  hex8_force(NEO_HOOKEAN, n, cells, X, u, p, f, energy);
-}
+/* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J);
+ * the element steps and inverted cells in step (step.h). */
+#define HEX8(MODEL, model_name)                                                                 \
+  void hex8_##model_name(int64_t n, const int32_t *cells, const double *X, const double *u,    \
+                         const element_params *p, double *f, double *energy, double *step)     \
+  {                                                                                             \
+    hex8_force(MODEL, n, cells, X, u, p, f, energy, step);                                      \
+  }
+HEX8(LINEAR_ELASTIC, linear_elastic)
+HEX8(SAINT_VENANT_KIRCHHOFF, saint_venant_kirchhoff)
+HEX8(NEO_HOOKEAN, neo_hookean)

@@ -36,6 +36,7 @@
  */
 #include "materials.h"
 #include "plasticity.h"
+#include "step.h"
 
 enum
 {
@@ -241,10 +242,13 @@ INLINE void hourglass_nodal_forces(const vec gamma[4][8], const vec Q[4][3], vec
 }
 
 /* The nodal forces f[3 I + i] of a batch; *stored = elastic energy, *hourglass_energy =
- * hourglass energy (stored) or dissipation in this step (viscous), per cell. */
+ * hourglass energy (stored) or dissipation in this step (viscous), per cell; *jacobian =
+ * det(I + grad u) at the centre, *modulus = rho_0 c^2 there (Pa, when p->estimate),
+ * *volume = the volume at rest (m^3). */
 INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const vec *restrict u,
                        const vec *restrict v, vec *restrict f, vec *restrict stored,
-                       vec *restrict hourglass_energy, const element_params *p)
+                       vec *restrict hourglass_energy, const element_params *p,
+                       vec *jacobian, vec *modulus, vec *volume)
 {
   hex8r_geometry_t geo;
   hex8r_geometry(x, &geo);
@@ -252,6 +256,10 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
   hex8r_gradient(u, &geo, L);
   *stored = geo.volume * stress(model, L, p->lmbda, p->mu, T);
   hex8r_nodal_forces(&geo, T, f);
+  *jacobian = volume_ratio(L);
+  *volume = geo.volume;
+  if (p->estimate)
+    *modulus = wave_modulus(model, L, p->lmbda, p->mu);
   *hourglass_energy = VZERO;
   if (hourglass == HOURGLASS_NONE)
     return;
@@ -265,12 +273,16 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
   hourglass_nodal_forces(gamma, Q, f);
 }
 
+/* Total Lagrangian one-point hexahedra: the stable step of a cell is L_0 / c with its
+ * length at rest and the wave speed of the law at its strain, and with the viscous form
+ * at most that of its damped hourglass modes (step.h). */
 INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
                         const int32_t *restrict cells, const double *restrict X,
                         const double *restrict u, const double *restrict v,
-                        const element_params *p, double *restrict f, double *restrict energy)
+                        const element_params *p, double *restrict f, double *restrict energy,
+                        double *restrict step)
 {
-  vec x[24], ue[24], ve[24], fe[24], stored, hourglass_energy;
+  vec x[24], ue[24], ve[24], fe[24], stored, hourglass_energy, jacobian, modulus, volume;
   double total = 0.0, hourglass_total = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
@@ -279,10 +291,20 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
     gather(cells, 8, c0, nb, u, ue);
     if (hourglass == HOURGLASS_VISCOUS)
       gather(cells, 8, c0, nb, v, ve);
-    hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p);
+    hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p, &jacobian,
+               &modulus, &volume);
     scatter_add(cells, 8, c0, nb, fe, f);
     total += lane_sum(stored, nb);
     hourglass_total += lane_sum(hourglass_energy, nb);
+    const ivec inverted = jacobian <= 0.0;
+    note_inverted(inverted, c0, nb, x, ue, 8, step);
+    if (p->estimate)
+    {
+      vec dte = cell_values(p->length0, c0, nb) * vsqrt(p->density / modulus);
+      if (hourglass == HOURGLASS_VISCOUS)
+        dte = vmin(dte, viscous_hourglass_step(p, volume, volume));
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 8, step);
+    }
   }
   energy[0] += total;
   energy[1] += hourglass_total;
@@ -295,16 +317,18 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
  * element's rotation R and dq the hourglass amplitudes of du in the current configuration
  * (the viscous form: Q = Q(dq / dt)); the state keeps Q after the point's slots.
  * energy[0] += stored elastic energy (J), energy[1] += hourglass work of the step,
- * energy[2] += plastic dissipation of the step, energy[3] += the number of inverted cells
- * (volume <= 0). */
+ * energy[2] += plastic dissipation of the step; a cell is inverted when its volume is not
+ * positive, and its stable step is L / c in the current configuration, c from the elastic
+ * moduli and the current density, with the viscous form at most that of its damped
+ * hourglass modes (step.h). */
 INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restrict cells,
                           const double *restrict X, const double *restrict u,
                           const double *restrict v, const element_params *p,
                           double *restrict state, int64_t stride, double *restrict f,
-                          double *restrict energy)
+                          double *restrict energy, double *restrict step)
 {
   vec Xe[24], ue[24], ve[24], fe[24];
-  double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0, inverted = 0.0;
+  double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
@@ -326,7 +350,17 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
     store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
     hex8r_geometry(x, &geo);
-    inverted += lane_sum(vselect(geo.V <= 0.0, VZERO + 1.0, VZERO), nb);
+    const ivec inverted = geo.V <= 0.0;
+    note_inverted(inverted, c0, nb, x, NULL, 8, step);
+    if (p->estimate)
+    {
+      const vec volume0 = cell_values(p->volume0, c0, nb);
+      const vec speed = p->wave_speed * vsqrt(geo.volume / volume0);
+      vec dte = characteristic_length(8, x, geo.volume) / speed;
+      if (hourglass == HOURGLASS_VISCOUS)
+        dte = vmin(dte, viscous_hourglass_step(p, geo.volume, volume0));
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 8, step);
+    }
     hex8r_nodal_forces(&geo, sigma, fe);
     stored += lane_sum(geo.volume * elastic_energy_density(p, sigma), nb);
     dissipated += lane_sum(mid_volume * dissipation, nb);
@@ -372,19 +406,18 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
   energy[0] += stored;
   energy[1] += hourglass_work;
   energy[2] += dissipated;
-  energy[3] += inverted;
 }
 
 /* One function per law and hourglass control: f += f_int(u) on the cells (N); energy[0] +=
- * stored elastic energy (J), energy[1] += hourglass energy or dissipation (J). v (m/s) is
- * read by the viscous form only. */
+ * stored elastic energy (J), energy[1] += hourglass energy or dissipation (J); the element
+ * steps and inverted cells in step (step.h). v (m/s) is read by the viscous form only. */
 #define HEX8R(MODEL, model_name, HOURGLASS, hourglass_name)                                    \
   void hex8r_##model_name##_##hourglass_name(int64_t n, const int32_t *cells, const double *X, \
                                              const double *u, const double *v,                 \
                                              const element_params *p, double *f,               \
-                                             double *energy)                                   \
+                                             double *energy, double *step)                     \
   {                                                                                            \
-    hex8r_force(MODEL, HOURGLASS, n, cells, X, u, v, p, f, energy);                            \
+    hex8r_force(MODEL, HOURGLASS, n, cells, X, u, v, p, f, energy, step);                      \
   }
 #define HEX8R_ALL_HOURGLASS(MODEL, model_name)                                                 \
   HEX8R(MODEL, model_name, HOURGLASS_NONE, none)                                               \
@@ -400,11 +433,33 @@ HEX8R_ALL_HOURGLASS(NEO_HOOKEAN, neo_hookean)
 #define HEX8R_PLASTIC(HOURGLASS, hourglass_name)                                                \
   void hex8r_plastic_##hourglass_name(int64_t n, const int32_t *cells, const double *X,        \
                                       const double *u, const double *v, const element_params *p, \
-                                      double *state, int64_t stride, double *f, double *energy)  \
+                                      double *state, int64_t stride, double *f, double *energy,  \
+                                      double *step)                                              \
   {                                                                                             \
-    hex8r_plastic(HOURGLASS, n, cells, X, u, v, p, state, stride, f, energy);                   \
+    hex8r_plastic(HOURGLASS, n, cells, X, u, v, p, state, stride, f, energy, step);             \
   }
 HEX8R_PLASTIC(HOURGLASS_NONE, none)
 HEX8R_PLASTIC(HOURGLASS_PHYSICAL, physical)
 HEX8R_PLASTIC(HOURGLASS_STIFFNESS, stiffness)
 HEX8R_PLASTIC(HOURGLASS_VISCOUS, viscous)
+
+/* The volume (m^3) and characteristic length (m, step.h) of each hexahedron at x: what the
+ * element step estimate of the kernels needs of the cells at rest. */
+void hex8_cell_sizes(int64_t num_cells, const int32_t *cells, const double *x, double *volume,
+                     double *length)
+{
+  vec xe[24];
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 8, c0, nb, x, xe);
+    hex8r_geometry_t geo;
+    hex8r_geometry(xe, &geo);
+    const vec l = characteristic_length(8, xe, geo.volume);
+    for (int k = 0; k < nb; ++k)
+    {
+      volume[c0 + k] = geo.volume[k];
+      length[c0 + k] = l[k];
+    }
+  }
+}

@@ -43,31 +43,6 @@ INLINE vec vpow(vec x, double n)
   return r;
 }
 
-INLINE vec vmax(vec a, vec b)
-{
-  const ivec m = a > b;
-  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
-}
-
-INLINE vec vmin(vec a, vec b)
-{
-  const ivec m = a < b;
-  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
-}
-
-INLINE vec vselect(ivec m, vec a, vec b)
-{
-  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
-}
-
-INLINE int any_lane(ivec m)
-{
-  int r = 0;
-  for (int k = 0; k < LANES; ++k)
-    r |= m[k] != 0;
-  return r;
-}
-
 /* Flow stress sigma_y (Pa) at plastic strain e, strain rate (1/s) and temperature T (K);
  * *slope = d sigma_y / d e. */
 INLINE vec flow_stress(const element_params *p, vec e, vec rate, vec T, vec *slope)

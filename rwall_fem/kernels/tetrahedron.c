@@ -10,6 +10,7 @@
  */
 #include "materials.h"
 #include "plasticity.h"
+#include "step.h"
 
 /* Shape function gradients g[I] (1/m) and volume (m^3) of the tetrahedra at x[3 I + i];
  * *det the signed 6 V (positive for the orientation of elasto-plastic cells). */
@@ -56,32 +57,46 @@ INLINE void tet4_nodal_forces(vec volume, const vec T[9], vec g[4][3], vec *rest
       f[3 * I + i] = volume * (T[3 * i] * g[I][0] + T[3 * i + 1] * g[I][1] + T[3 * i + 2] * g[I][2]);
 }
 
-/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell. */
+/* The nodal forces f[3 I + i] of a batch; returns the stored energy of each cell, and in
+ * *jacobian det(I + grad u), in *modulus rho_0 c^2 (Pa, when p->estimate). */
 INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, vec *restrict f,
-                     const element_params *p)
+                     const element_params *p, vec *jacobian, vec *modulus)
 {
   vec g[4][3], L[9], T[9];
   const vec volume = tet4_geometry(x, g);
   tet4_gradient(u, g, L);
   const vec w = volume * stress(model, L, p->lmbda, p->mu, T);
   tet4_nodal_forces(volume, T, g, f);
+  *jacobian = volume_ratio(L);
+  if (p->estimate)
+    *modulus = wave_modulus(model, L, p->lmbda, p->mu);
   return w;
 }
 
+/* Total Lagrangian tetrahedra: the stable step of a cell is L_0 / c with its length at
+ * rest and the wave speed of the law at its strain (step.h). */
 INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cells,
                        const double *restrict X, const double *restrict u,
-                       const element_params *p, double *restrict f, double *restrict energy)
+                       const element_params *p, double *restrict f, double *restrict energy,
+                       double *restrict step)
 {
-  vec x[12], ue[12], fe[12];
+  vec x[12], ue[12], fe[12], jacobian, modulus;
   double total = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
     gather(cells, 4, c0, nb, X, x);
     gather(cells, 4, c0, nb, u, ue);
-    const vec w = tet4_cell(model, x, ue, fe, p);
+    const vec w = tet4_cell(model, x, ue, fe, p, &jacobian, &modulus);
     scatter_add(cells, 4, c0, nb, fe, f);
     total += lane_sum(w, nb);
+    const ivec inverted = jacobian <= 0.0;
+    note_inverted(inverted, c0, nb, x, ue, 4, step);
+    if (p->estimate)
+    {
+      const vec dte = cell_values(p->length0, c0, nb) * vsqrt(p->density / modulus);
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 4, step);
+    }
   }
   energy[0] += total;
 }
@@ -90,15 +105,17 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
  * (dt = 0 at the first step: the state is the initial one) has its gradient taken in the
  * mid-step configuration; the force is that of the updated stress in the current one,
  * x = X + u.  energy[0] += stored elastic energy, energy[2] += plastic dissipation of the
- * step (J), energy[3] += the number of inverted cells (volume <= 0: the cells are
- * oriented positively at the start).  state: POINT_SLOTS rows of `stride` values. */
+ * step (J); a cell is inverted when its volume is not positive (the cells are oriented
+ * positively at the start), and its stable step is L / c in the current configuration,
+ * c from the elastic moduli and the current density (step.h).  state: POINT_SLOTS rows
+ * of `stride` values. */
 void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
                   double *restrict state, int64_t stride, double *restrict f,
-                  double *restrict energy)
+                  double *restrict energy, double *restrict step)
 {
   vec Xe[12], ue[12], ve[12], fe[12];
-  double stored = 0.0, dissipated = 0.0, inverted = 0.0;
+  double stored = 0.0, dissipated = 0.0;
   for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
   {
     const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
@@ -123,29 +140,46 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     scatter_add(cells, 4, c0, nb, fe, f);
     stored += lane_sum(volume * elastic_energy_density(p, sigma), nb);
     dissipated += lane_sum(mid_volume * dissipation, nb);
-    inverted += lane_sum(vselect(det <= 0.0, VZERO + 1.0, VZERO), nb);
+    const ivec inverted = det <= 0.0;
+    note_inverted(inverted, c0, nb, x, NULL, 4, step);
+    if (p->estimate)
+    {
+      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, c0, nb));
+      const vec dte = characteristic_length(4, x, volume) / speed;
+      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 4, step);
+    }
   }
   energy[0] += stored;
   energy[2] += dissipated;
-  energy[3] += inverted;
 }
 
-/* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J). */
-void tet4_linear_elastic(int64_t n, const int32_t *cells, const double *X, const double *u,
-                         const element_params *p, double *f, double *energy)
-{
-  tet4_force(LINEAR_ELASTIC, n, cells, X, u, p, f, energy);
-}
+/* One function per law: f += f_int(u) on the cells (N), energy[0] += stored energy (J);
+ * the element steps and inverted cells in step (step.h). */
+#define TET4(MODEL, model_name)                                                                 \
+  void tet4_##model_name(int64_t n, const int32_t *cells, const double *X, const double *u,    \
+                         const element_params *p, double *f, double *energy, double *step)     \
+  {                                                                                             \
+    tet4_force(MODEL, n, cells, X, u, p, f, energy, step);                                      \
+  }
+TET4(LINEAR_ELASTIC, linear_elastic)
+TET4(SAINT_VENANT_KIRCHHOFF, saint_venant_kirchhoff)
+TET4(NEO_HOOKEAN, neo_hookean)
 
-void tet4_saint_venant_kirchhoff(int64_t n, const int32_t *cells, const double *X,
-                                 const double *u, const element_params *p, double *f,
-                                 double *energy)
+/* The volume (m^3) and characteristic length (m, step.h) of each tetrahedron at x. */
+void tet4_cell_sizes(int64_t num_cells, const int32_t *cells, const double *x, double *volume,
+                     double *length)
 {
-  tet4_force(SAINT_VENANT_KIRCHHOFF, n, cells, X, u, p, f, energy);
-}
-
-void tet4_neo_hookean(int64_t n, const int32_t *cells, const double *X, const double *u,
-                      const element_params *p, double *f, double *energy)
-{
-  tet4_force(NEO_HOOKEAN, n, cells, X, u, p, f, energy);
+  vec xe[12], g[4][3];
+  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  {
+    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
+    gather(cells, 4, c0, nb, x, xe);
+    const vec v = tet4_geometry(xe, g);
+    const vec l = characteristic_length(4, xe, v);
+    for (int k = 0; k < nb; ++k)
+    {
+      volume[c0 + k] = v[k];
+      length[c0 + k] = l[k];
+    }
+  }
 }

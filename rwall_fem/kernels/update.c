@@ -3,14 +3,14 @@
  * internal_acceleration: a = -f / m, the acceleration from the internal force f, before
  * body forces and constraints add to it or edit it.
  *
- * central_difference: v^{n+1/2} = v^{n-1/2} + dt a^n, u^{n+1} = u^n + dt v^{n+1/2}, in one
- * pass that also returns what the energy books need of this step:
+ * central_difference: v^{n+1/2} = v^{n-1/2} + dt_v a^n, u^{n+1} = u^n + dt v^{n+1/2}, with
+ * dt = dt^{n+1/2} and dt_v = (dt^{n-1/2} + dt^{n+1/2}) / 2 (a variable step), in one pass
+ * that also returns what the energy books need of this step:
  *   out[0] = K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}   (the shadow kinetic energy)
- *   out[1] = dt/2 sum f . v^{n-1/2}                  (first half of the work of f)
- *   out[2] = dt/2 sum f . v^{n+1/2}                  (second half)
- *   out[3..5] = sum m u^n                            (the work of uniform gravity)
- * (out[1] and out[2] only when f is given; the mid-step booking of the internal
- * work for materials without a stored energy).
+ *   out[1] = sum f . v^{n-1/2}, out[2] = sum f . v^{n+1/2}   (when f is given)
+ *   out[3..5] = sum m v^{n-1/2}, out[6..8] = sum m v^{n+1/2}   (the work of uniform gravity)
+ * (out[1] and out[2]: the mid-step booking of the internal work of materials without a
+ * stored energy, and the energy correction of a varying step for the others).
  */
 #include "batch.h"
 
@@ -29,42 +29,47 @@ void internal_acceleration(int64_t n, const double *restrict f, const double *re
 
 /* One node of the update (f: NULL or the booked force); kept inline so that each loop
  * below is compiled for its case. */
-INLINE void advance_node(int64_t i, double dt, const double *restrict mass,
+INLINE void advance_node(int64_t i, double dt_v, double dt, const double *restrict mass,
                          const double *restrict a, double *restrict v, double *restrict u,
                          const double *restrict f, double *kinetic, double *first,
-                         double *second, double moment[3])
+                         double *second, double before[3], double after[3])
 {
   const double m = mass[i];
   for (int c = 0; c < 3; ++c)
   {
     const int64_t j = 3 * i + c;
-    const double old = v[j], next = old + dt * a[j];
+    const double old = v[j], next = old + dt_v * a[j];
     *kinetic += m * old * next;
     if (f)
     {
       *first += f[j] * old;
       *second += f[j] * next;
     }
-    moment[c] += m * u[j];
+    before[c] += m * old;
+    after[c] += m * next;
     v[j] = next;
     u[j] += dt * next;
   }
 }
 
-void central_difference(int64_t n, double dt, const double *restrict mass, const double *restrict a,
-             double *restrict v, double *restrict u, const double *restrict f, double out[6])
+void central_difference(int64_t n, double dt_v, double dt, const double *restrict mass,
+                        const double *restrict a, double *restrict v, double *restrict u,
+                        const double *restrict f, double out[9])
 {
-  double kinetic = 0.0, first = 0.0, second = 0.0, moment[3] = {0.0, 0.0, 0.0};
+  double kinetic = 0.0, first = 0.0, second = 0.0, before[3] = {0.0, 0.0, 0.0},
+         after[3] = {0.0, 0.0, 0.0};
   if (f)
     for (int64_t i = 0; i < n; ++i)
-      advance_node(i, dt, mass, a, v, u, f, &kinetic, &first, &second, moment);
+      advance_node(i, dt_v, dt, mass, a, v, u, f, &kinetic, &first, &second, before, after);
   else
     for (int64_t i = 0; i < n; ++i)
-      advance_node(i, dt, mass, a, v, u, NULL, &kinetic, &first, &second, moment);
+      advance_node(i, dt_v, dt, mass, a, v, u, NULL, &kinetic, &first, &second, before, after);
   out[0] = 0.5 * kinetic;
-  out[1] = 0.5 * dt * first;
-  out[2] = 0.5 * dt * second;
-  out[3] = moment[0];
-  out[4] = moment[1];
-  out[5] = moment[2];
+  out[1] = first;
+  out[2] = second;
+  for (int c = 0; c < 3; ++c)
+  {
+    out[3 + c] = before[c];
+    out[6 + c] = after[c];
+  }
 }

@@ -18,7 +18,9 @@
 
 Each row of ``energy.csv`` also carries what LS-DYNA's GLSTAT and Radioss's energy
 report print: the total energy (the sum of the stored energies), the balance error in
-percent, and the time step of that step (s).
+percent, and the time step of that step (s); with mass scaling also the mass added so
+far (kg and % of the body's), and its work (``mass_scaling_work``: the kinetic energy
+the added masses cost when they joined their nodes at rest).
 """
 
 from __future__ import annotations
@@ -43,8 +45,9 @@ class EnergyBalance:
     ``stored`` names the energies the body holds (kinetic first, then those of the
     internal force), ``works`` the works done on it, ``parts`` parts of a stored energy
     reported beside it (the elastic energy and plastic work within the internal energy of
-    an elasto-plastic body), not added again; :attr:`columns` are those of ``energy.csv``:
-    time, stored..., parts..., works..., balance error, total energy, error in %, dt.
+    an elasto-plastic body), not added again, ``extras`` other columns of the row;
+    :attr:`columns` are those of ``energy.csv``: time, stored..., parts..., works...,
+    balance error, total energy, error in %, dt, extras....
     """
 
     def __init__(
@@ -53,11 +56,13 @@ class EnergyBalance:
         stored: Sequence[str] = ("kinetic", "internal"),
         works: Sequence[str] = ("external_work", "wall_work"),
         parts: Sequence[str] = (),
+        extras: Sequence[str] = (),
     ):
         self.stored, self.works, self.parts = tuple(stored), tuple(works), tuple(parts)
+        self.extras = tuple(extras)
         self.columns = (
             "time", *self.stored, *self.parts, *self.works, "balance_error", "total_energy",
-            "energy_error_percent", "dt",
+            "energy_error_percent", "dt", *self.extras,
         )  # fmt: skip
         self.initial = initial  # E0, J
         self.reference = initial  # E_ref so far, J
@@ -82,9 +87,11 @@ class EnergyBalance:
         latest = arrays["latest"].tolist()
         self.latest = dict(zip(self.columns, latest, strict=True)) if latest else None
 
-    def sample(self, t: float, energies: Mapping[str, float], dt: float) -> tuple:
-        """Book the energies (J, summed over ranks) of time ``t`` (s), reached with the
-        step ``dt`` (s); returns the row."""
+    def sample(
+        self, t: float, energies: Mapping[str, float], dt: float, extras: Mapping | None = None
+    ) -> tuple:
+        """Book the energies (J, summed over ranks) of time ``t`` (s), whose step is ``dt``
+        (s), with the values of the ``extras`` columns; returns the row."""
         stored = sum(energies[name] for name in self.stored)
         self.reference = max(self.reference, stored, *(abs(energies[name]) for name in self.works))
         balance = stored
@@ -94,7 +101,7 @@ class EnergyBalance:
         self.max_error = max(self.max_error, abs(error))
         row = (
             t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error,
-            stored, 100.0 * error, dt,
+            stored, 100.0 * error, dt, *((extras or {})[name] for name in self.extras),
         )  # fmt: skip
         self.latest = dict(zip(self.columns, row, strict=True))
         return row

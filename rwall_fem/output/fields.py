@@ -32,7 +32,7 @@ from dolfinx import fem, io
 
 from rwall_fem import _compat
 from rwall_fem.mechanics import stress
-from rwall_fem.output.schedule import spread
+from rwall_fem.output.schedule import Times
 
 __all__ = ["Fields", "one_time_series", "series_per_field"]
 
@@ -46,11 +46,11 @@ DOLFINX_POINTER = (
 
 
 class Fields:
-    """Recorder that writes ``count`` field snapshots of the displacement ``u`` in the space
-    ``V`` spread evenly over the ``num_steps`` steps of the run, into ``directory``."""
+    """Recorder that writes ``count`` field snapshots of the body (space ``V``) at times
+    spread evenly over [0, ``end_time``] (s), into ``directory``."""
 
-    def __init__(self, directory: Path, *, count: int, num_steps: int, V, material):
-        self.steps = spread(count, num_steps)
+    def __init__(self, directory: Path, *, count: int, end_time: float, V, material):
+        self.steps = Times(count, end_time)
         self.path = Path(directory) / "fields.xdmf"
         msh = V.mesh
         self.u, self.v = fem.Function(V), fem.Function(V)
@@ -64,10 +64,11 @@ class Fields:
         self._count = 0  # snapshots recorded
         self._present = 0  # snapshots in the file when the run resumed
 
-    def due(self, step: int) -> bool:
-        return step in self.steps
+    def due(self, s) -> bool:
+        return self.steps.due(s)
 
     def record(self, sim, s) -> None:
+        self.steps.taken(s)
         index, self._count = self._count, self._count + 1
         if index < self._present:
             return  # written before a resume, after the checkpoint: the same snapshot
@@ -118,13 +119,15 @@ class Fields:
         comm.barrier()
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """How many snapshots are written; the file is closed, so they are on disk."""
+        """How many snapshots are written (the file is closed, so they are on disk), and
+        the next time to write."""
         self.close(None)
-        return {"snapshots": np.array(self._count)}
+        return {"snapshots": np.array(self._count), "next": np.array(self.steps.next)}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Continue the file: it must hold the checkpoint's snapshots, whole."""
         comm = self.u.function_space.mesh.comm
+        self.steps.next = int(arrays["next"])
         self._count, counts, error = int(arrays["snapshots"]), set(), None
         if comm.rank == 0 and self._count:
             try:

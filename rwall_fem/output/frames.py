@@ -24,14 +24,14 @@ from dolfinx import fem
 
 from rwall_fem import _compat
 from rwall_fem.output import OutputError
-from rwall_fem.output.schedule import spread
+from rwall_fem.output.schedule import Times
 
 __all__ = ["Frames"]
 
 
 class Frames:
     """Recorder that stores ``count`` frames of the body (space ``V``) and its ``walls``,
-    spread evenly over the ``num_steps`` steps of the run, in ``directory/frames``.
+    at times spread evenly over [0, ``end_time``] (s), in ``directory/frames``.
 
     ``speed`` (m/s), the initial speed, is the least colour range of the velocity
     colourings; ``gravity`` (m/s^2, or None) says where up is; ``color`` is one of
@@ -43,14 +43,14 @@ class Frames:
         directory: Path,
         *,
         count: int,
-        num_steps: int,
+        end_time: float,
         V,
         walls,
         speed: float,
         gravity=None,
         color: str = "normal_velocity",
     ):
-        self.steps = spread(count, num_steps)
+        self.steps = Times(count, end_time)
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
@@ -90,8 +90,8 @@ class Frames:
         gathered = self.comm.gather(np.asarray(values, dtype=float), root=0)
         return None if gathered is None else np.concatenate(gathered)
 
-    def due(self, step: int) -> bool:
-        return step in self.steps
+    def due(self, s) -> bool:
+        return self.steps.due(s)
 
     def _save_mesh(self) -> None:
         self.data.mkdir(parents=True, exist_ok=True)
@@ -110,6 +110,7 @@ class Frames:
         )
 
     def record(self, sim, s) -> None:
+        self.steps.taken(s)
         u, v = self._nodal(s.u), self._nodal(s.v)
         cells = {f"cell_{k}": self._cells(a) for k, a in sim.internal.cell_fields(s).items()}
         if self.comm.rank == 0:
@@ -121,12 +122,13 @@ class Frames:
         self._count += 1
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """How many frames are stored."""
-        return {"frames": np.array(self._count)}
+        """How many frames are stored, and the next time to store one."""
+        return {"frames": np.array(self._count), "next": np.array(self.steps.next)}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         """Continue the numbering; frames stored after the checkpoint are removed."""
         self._count, error = int(arrays["frames"]), None
+        self.steps.next = int(arrays["next"])
         if self.comm.rank == 0:
             if self._count and not (self.data / "mesh.npz").is_file():
                 error = f"{self.data / 'mesh.npz'}: missing, and the checkpoint has frames"

@@ -2,10 +2,11 @@
 
 The guards act at every history sample, on values already summed over ranks, so every
 rank takes the same decision at the same step: a NaN or Inf in a nodal array (seen as a
-non-finite sum), an energy balance error above ``max_energy_error``, a time step below
-``min_dt``, or a SIGTERM or SIGINT (Ctrl-C) received by any rank stop the run with one
+non-finite sum), an energy balance error above ``max_energy_error``, or a SIGTERM or
+SIGINT (Ctrl-C) received by any rank stop the run with one
 :class:`~rwall_fem.solver.RunStopped` message naming the step, the time, the quantity
-and the worst node.
+and the worst node. (What the time step stops a run for, :mod:`rwall_fem.time_step`
+decides.)
 """
 
 from __future__ import annotations
@@ -19,14 +20,11 @@ __all__ = ["Guards"]
 
 class Guards:
     """The checks of a sample. ``node_ids`` are the global indices of the rank's owned
-    nodes (for the messages); ``max_energy_error`` bounds |balance error|, ``min_dt`` (s)
-    the time step."""
+    nodes (for the messages); ``max_energy_error`` bounds |balance error|."""
 
-    def __init__(
-        self, comm, node_ids: np.ndarray, *, max_energy_error: float = 0.05, min_dt: float = 0.0
-    ):
+    def __init__(self, comm, node_ids: np.ndarray, *, max_energy_error: float = 0.05):
         self.comm, self.node_ids = comm, node_ids
-        self.max_energy_error, self.min_dt = max_energy_error, min_dt
+        self.max_energy_error = max_energy_error
 
     def check(self, s, error: float, *, finite: bool, signals: tuple[str, ...] = ()) -> None:
         """Raise :class:`RunStopped` (on every rank alike) if a guard trips at the sample of
@@ -43,10 +41,6 @@ class Guards:
             raise RunStopped(
                 f"{where}: energy balance error {error:.3g} exceeds run.max_energy_error = "
                 f"{self.max_energy_error:g}; fastest node {node}"
-            )
-        if s.dt < self.min_dt:
-            raise RunStopped(
-                f"{where}: time step {s.dt:.4g} s is below run.min_dt = {self.min_dt:g} s"
             )
         if "SIGTERM" in signals:
             raise RunStopped(f"{where}: terminated by SIGTERM")

@@ -54,15 +54,19 @@ class History:
 
     def __init__(self, sim, directory: Path, *, every: int, guards: Guards, plot: bool = False):
         self.directory = Path(directory)
-        self.steps = Every(every, sim.num_steps)
+        self.steps = Every(every)
         self.guards = guards
         self.plot = plot  # draw histories.png at the end
         comm, walls = sim.comm, sim.walls
         self.initial_momentum = momentum(sim.state, walls, comm)
+        self.mass_scaling = getattr(sim.step_size, "mass_scaling", None)
+        scaled = self.mass_scaling is not None
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
             parts=sim.internal.energy_parts,
+            works=("external_work", "wall_work", *(("mass_scaling_work",) if scaled else ())),
+            extras=("added_mass", "added_mass_percent") if scaled else (),
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -73,7 +77,7 @@ class History:
         self._sums = _Sums(
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
-            | {"external_work": (), "wall_work": (len(walls), 2)}
+            | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
             | {"signals": (len(SIGNALS),), "seconds": ()}
             | self.wall_table.sums,
         )
@@ -84,16 +88,18 @@ class History:
         self._built = time.perf_counter()
         self._drawing: subprocess.Popen | None = None
 
-    def due(self, step: int) -> bool:
-        return step in self.steps or step >= self._next_poll
+    def due(self, s) -> bool:
+        return self.steps.due(s) or s.step >= self._next_poll
 
     def record(self, sim, s) -> None:
         """Sample step ``s.step`` after its update: the kinetic energy K^n is the update's,
         the works are booked up to step n. Between samples, only agree on stop signals;
-        the step becomes a sample if any rank received one."""
+        the step becomes a sample if any rank received one, or if the step size is about
+        to stop the run."""
         if time.monotonic() - self._written_at > FLUSH_SECONDS:
             self._flush()
-        if s.step not in self.steps and not self._stop_requested(sim, s):
+        stopping = sim.step_size.stop_reason is not None
+        if not (self.steps.due(s) or stopping) and not self._stop_requested(sim, s):
             return
         local = self._sums.local
         local["kinetic"][...] = s.kinetic
@@ -106,6 +112,8 @@ class History:
         )
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
+        if self.mass_scaling is not None:
+            local["mass_scaling_work"][...] = self.mass_scaling.work
         # Sent with the sums, so that every rank stops at the same step when any got a signal.
         self._fill_agreement(local, sim)
         self.wall_table.fill(local)
@@ -121,7 +129,14 @@ class History:
                 energies["kinetic"] += kinetic
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
-        self._energy_csv.append(self.balance.sample(s.t, energies, s.dt))
+        extras = {}
+        if self.mass_scaling is not None:
+            energies["mass_scaling_work"] = float(total["mass_scaling_work"])
+            extras = {
+                "added_mass": self.mass_scaling.added,
+                "added_mass_percent": self.mass_scaling.added_percent,
+            }
+        self._energy_csv.append(self.balance.sample(s.t, energies, s.dt, extras))
         for row in self.wall_table.rows(s, total):
             self._walls_csv.append(row)
         signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)

@@ -4,37 +4,41 @@ from __future__ import annotations
 
 import sys
 
-from rwall_fem.output.schedule import Every
-
 __all__ = ["Progress"]
 
 
 class Progress:
-    """Recorder that shows simulated time, step, steps/s, ETA and the energy balance error."""
+    """Recorder that shows the share of ``end_time`` (s) simulated, step, dt, the energy
+    balance error and the time left at the present rate of simulated time (the step
+    varies, so the bar counts time, not steps); updated about ``updates`` times."""
 
-    def __init__(self, num_steps: int, updates: int = 500):
+    def __init__(self, end_time: float, updates: int = 500):
         from tqdm import tqdm
 
-        self.steps = Every(max(1, num_steps // updates), num_steps)
+        self.end_time, self.every = end_time, end_time / updates
         self._bar = tqdm(
-            total=num_steps + 1,
-            unit="step",
+            total=100.0,
+            unit="%",
             delay=1.0,
             file=sys.stderr,
             dynamic_ncols=True,
             leave=False,
+            bar_format="{l_bar}{bar}| {n:.1f}/100 % [{elapsed}<{remaining}{postfix}]",
         )
-        self._shown = 0
+        self._next = 0.0
 
-    def due(self, step: int) -> bool:
-        return step in self.steps
+    def due(self, s) -> bool:
+        return s.t >= self._next or s.last
 
     def record(self, sim, s) -> None:
+        self._next = s.t + self.every
         latest = sim.history.balance.error
         error = "-" if latest is None else f"{latest:.1e}"
-        self._bar.set_postfix_str(f"t = {s.t:.4g} s, energy error {error}", refresh=False)
-        self._bar.update(s.step + 1 - self._shown)
-        self._shown = s.step + 1
+        self._bar.set_postfix_str(
+            f"step {s.step}, t = {s.t:.4g} s, dt = {s.dt:.3g} s, energy error {error}",
+            refresh=False,
+        )
+        self._bar.update(min(100.0 * s.t / self.end_time, 100.0) - self._bar.n)
 
     def close(self, sim) -> None:
         self._bar.close()

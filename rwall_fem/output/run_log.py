@@ -3,8 +3,10 @@
 Written by rank 0 into the results folder: the code and library versions, the command,
 the ranks, the scene as it ran (every key, defaults and ``--set`` overrides applied),
 the mesh, the time step and the effects, the warnings of the build, then a cycle line
-every ``output.print_interval`` steps (cycle, time, dt, energy balance error in %,
-elapsed wall time) and the final figures. :class:`CycleLines` prints the same cycle
+every ``output.print_interval`` steps, or 21 times over the run (cycle, time, dt, energy
+balance error in %, elapsed wall time, and the cell that controls the step: its
+calibrated stable step and where it is, as Radioss's listing names the element) and the
+final figures. :class:`CycleLines` prints the same cycle
 lines to a stream (the command line's stderr when it is not a terminal), so batch and
 MPI logs show progress.
 """
@@ -14,7 +16,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import math
 import shlex
 import socket
 import sys
@@ -22,40 +23,48 @@ import time
 from pathlib import Path
 from typing import TextIO
 
-from rwall_fem.output.schedule import Every
+from rwall_fem.output.schedule import Every, Times
 
-__all__ = ["CycleLines", "RunLog", "cycle_interval", "scene_text"]
+__all__ = ["CycleLines", "RunLog", "cycle_schedule", "scene_text"]
 
 log = logging.getLogger("rwall_fem")
 
 _HEADER = (
     f"{'cycle':>10} {'time (s)':>12} {'dt (s)':>11} {'energy error %':>15} {'elapsed (s)':>12}"
+    f" {'limit (s)':>11}  controlling cell"
 )
 
 
-def cycle_interval(num_steps: int, every: int | None) -> int:
-    """Steps between cycle lines: ``every``, or about 20 lines over the run."""
-    return every or max(1, math.ceil(num_steps / 20))
+def cycle_schedule(end_time: float, every: int | None) -> Every | Times:
+    """When cycle lines are written: every ``every`` steps, or 21 times over the run (s)."""
+    return Every(every) if every else Times(21, end_time)
 
 
 def _cycle_line(sim, s, elapsed: float) -> str:
     error = sim.history.balance.error if sim.history is not None else None
     percent = "-" if error is None else f"{100.0 * error:.4g}"
-    return f"{s.step:>10d} {s.t:>12.5e} {s.dt:>11.4e} {percent:>15} {elapsed:>12.1f}"
+    line = f"{s.step:>10d} {s.t:>12.5e} {s.dt:>11.4e} {percent:>15} {elapsed:>12.1f}"
+    cell = sim.step_size.controlling_cell()
+    if cell is None:
+        return line
+    where = ", ".join(f"{c:.4g}" for c in cell[1])
+    return f"{line} {cell[0]:>11.4e}  at ({where}) m"
 
 
 class CycleLines:
-    """Recorder that prints a cycle line to ``stream`` every ``every`` steps (and at the
-    last of ``num_steps``), under a header line."""
+    """Recorder that prints a cycle line to ``stream`` when ``schedule`` (of
+    :func:`cycle_schedule`) says, under a header line. It runs on one rank, after the run
+    log at the same steps (which finds the controlling cell, a collective call)."""
 
-    def __init__(self, stream: TextIO, num_steps: int, every: int):
-        self.stream, self.steps = stream, Every(every, num_steps)
+    def __init__(self, stream: TextIO, schedule: Every | Times):
+        self.stream, self.steps = stream, schedule
         self._started = None
 
-    def due(self, step: int) -> bool:
-        return step in self.steps
+    def due(self, s) -> bool:
+        return self.steps.due(s)
 
     def record(self, sim, s) -> None:
+        self.steps.taken(s)
         if self._started is None:
             self._started = time.perf_counter()
             print(f"rwall-fem: {_HEADER}", file=self.stream, flush=True)
@@ -68,26 +77,26 @@ class CycleLines:
 
 class RunLog:
     """Recorder of ``directory/run.log`` (rank 0 of ``comm``): the header when the run
-    starts, a cycle line every ``every`` steps of ``num_steps``, the final figures when it
-    ends. ``facts`` are lines on what was built (mesh, step, walls, warnings); ``frames``
-    the number of frames rendered after the time loop (said, on the log and on the
-    logger, when it ends). :attr:`ended_at` is when it closed (``time.perf_counter``)."""
+    starts, a cycle line when ``schedule`` (of :func:`cycle_schedule`) says, the final
+    figures when it ends. ``facts`` are lines on what was built (mesh, step, walls,
+    warnings); ``frames`` the number of frames rendered after the time loop (said, on the
+    log and on the logger, when it ends). :attr:`ended_at` is when it closed
+    (``time.perf_counter``)."""
 
-    def __init__(
-        self, directory: Path, scene, facts: list[str], *, num_steps, every, comm, frames=0
-    ):
+    def __init__(self, directory: Path, scene, facts: list[str], *, schedule, comm, frames=0):
         self.path = Path(directory) / "run.log"
         self.scene, self.facts, self.comm = scene, facts, comm
-        self.steps = Every(every, num_steps)
-        self.every, self.frames = every, frames
+        self.steps, self.frames = schedule, frames
         self.ended_at = None
         self._file = None
         self._started = None
 
-    def due(self, step: int) -> bool:
-        return step in self.steps
+    def due(self, s) -> bool:
+        return self.steps.due(s)
 
     def record(self, sim, s) -> None:
+        self.steps.taken(s)
+        sim.step_size.controlling_cell()  # collective: on every rank, for the cycle lines
         if self.comm.rank != 0:
             return
         if self._file is None:
@@ -131,10 +140,16 @@ class RunLog:
             "",
             *self.facts,
             "",
-            f"cycles (a line every {self.every} steps; energy error of the latest sample):",
+            f"cycles ({self._when()}; energy error of the latest sample; limit: the "
+            "stable step of the controlling cell):",
             _HEADER,
         ]
         self._write("\n".join(lines))
+
+    def _when(self) -> str:
+        if isinstance(self.steps, Every):
+            return f"a line every {self.steps.k} steps"
+        return "21 lines over the run"
 
     def close(self, sim) -> None:
         """Write the final figures of the run (the history's summary) and close the file."""

@@ -1,35 +1,51 @@
-"""The steps at which a recorder samples: every k-th step, or a few spread over the run."""
+"""When a recorder samples: every k-th step, or at times spread over the run.
+
+The step varies, so outputs asked for at times are written at the first step at or after
+each time (Radioss's /ANIM/DT, LS-DYNA's *DATABASE intervals), the last one at the run's
+last step; outputs never change the steps.
+"""
 
 from __future__ import annotations
 
-__all__ = ["Every", "spread"]
+__all__ = ["Every", "Times"]
 
 
 class Every:
-    """Steps 0, k, 2k, ... and the last step ``last`` (``step in Every(k, last)``)."""
+    """Steps 0, k, 2k, ... and the run's last step."""
 
-    def __init__(self, k: int, last: int):
-        self.k, self.last = k, last
+    def __init__(self, k: int):
+        self.k = k
 
-    def __contains__(self, step: int) -> bool:
-        return step % self.k == 0 or step == self.last
+    def due(self, state) -> bool:
+        return state.step % self.k == 0 or state.last
+
+    def taken(self, state) -> None:
+        """Nothing to remember."""
 
 
-class spread:  # noqa: N801  (used like the function it replaces: ``step in spread(n, last)``)
-    """``count`` steps spread evenly over 0..``last``, both ends included: the steps
-    round(k last / (count - 1)), k = 0..count-1. Membership costs the same whatever
-    ``count`` is (nothing is listed)."""
+class Times:
+    """``count`` times spread evenly over [0, ``end_time``] (s), both ends included: a
+    recorder is due at the first step at or after each of them, and at the last step for
+    what is left. Several times passed in one step give one sample. :attr:`next` is the
+    index of the next time (what a checkpoint keeps)."""
 
-    def __init__(self, count: int, last: int):
-        self.count, self.last = count, last
+    def __init__(self, count: int, end_time: float):
+        self.count, self.end_time = count, end_time
+        self.next = 0
 
-    def __contains__(self, step: int) -> bool:
-        if self.count <= 0 or not 0 <= step <= self.last:
+    def time(self, k: int) -> float:
+        """The k-th time (s)."""
+        return 0.0 if self.count <= 1 else k * self.end_time / (self.count - 1)
+
+    def due(self, state) -> bool:
+        if self.next >= self.count:
             return False
-        if self.count == 1 or self.last == 0:
-            return step == 0
-        gaps = self.count - 1
-        k = step * gaps // self.last
-        return any(
-            0 <= j <= gaps and round(j * self.last / gaps) == step for j in (k - 1, k, k + 1, k + 2)
-        )
+        # A step that lands on a time up to round-off (a sum of steps) counts.
+        return state.last or state.t >= self.time(self.next) - 1e-9 * state.dt
+
+    def taken(self, state) -> None:
+        """A sample was taken at this step: go past every time it covers."""
+        if state.last:
+            self.next = self.count
+        while self.next < self.count and state.t >= self.time(self.next) - 1e-9 * state.dt:
+            self.next += 1

@@ -4,7 +4,10 @@ Every value is summed (or reduced) over ranks, so the summary is the same on eve
 rank; rank 0 writes it. Besides what was built (``Simulation.info``: the code's
 ``version`` and ``git_hash``, mesh, stable steps, ``warnings``), it holds the outcome
 (``status``: done, stopped or failed, and its ``reason``), ``steps`` done (the step of the
-last state) out of ``planned_steps``, the ``time`` reached (s) and ``end_time`` planned,
+last state; ``planned_steps``: as many as the step at the start would take), the ``time``
+reached (s) and ``end_time``, ``dt`` (the last step, s) and ``time_step``: the step's
+mode, calibration, first, smallest and largest steps (s), where and when the smallest
+was, and with mass scaling the mass added (kg and %) and its work (J),
 the energies of the last sample, and per wall its impulses, works, contacts and the
 secondary nodes that started behind it (``initially_penetrated``, ``deepest_penetration``
 in m: kept there by the wall, as Radioss's starter warns).
@@ -45,10 +48,11 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         "reason": reason or None,
         "ranks": comm.size,
         "steps": s.step,
-        "planned_steps": sim.num_steps,
+        "planned_steps": sim.planned_steps,
         "dt": s.dt,
         "time": s.t,
-        "end_time": sim.num_steps * s.dt,
+        "end_time": sim.end_time,
+        "time_step": {"mode": getattr(sim.step_size, "mode", "fixed")} | sim.step_size.summary(),
         "wall_seconds": comm.allreduce(sim.wall_seconds, MPI.MAX),
         "effects": sim.effects,
         "initial_momentum": initial_momentum.tolist(),

@@ -1,7 +1,8 @@
 """The rows of ``walls.csv``: per wall and sample, the push of the structure on the wall.
 
 Forces are the change of the cumulative impulses since the previous sample over the
-time between the two (N); impulses are cumulative (N s). Both are the push of the
+time between the two (N; at the first sample, over the velocity update's step);
+impulses are cumulative (N s). Both are the push of the
 structure on the wall: negative along the normal of a wall hit from its allowed side.
 """
 
@@ -38,20 +39,22 @@ class WallTable:
         self.sums = {"normal_impulse": (n, 3), "tangential_impulse": (n, 3), "contacts": (n,)}
         self.peak_contacts = np.zeros(n, dtype=int)  # most nodes treated in one step
         self._last_impulses = np.zeros((n, 6))  # normal and tangential, N s
-        self._last_step = -1
+        self._last_time = None  # s
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The impulses (N s) and step of the latest sample (forces are differences from
+        """The impulses (N s) and time (s) of the latest sample (forces are differences from
         them), and the peak contact counts."""
+        last = np.nan if self._last_time is None else self._last_time
         return {
             "last_impulses": self._last_impulses,
-            "last_step": np.array(self._last_step),
+            "last_time": np.array(last),
             "peak_contacts": self.peak_contacts,
         }
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self._last_impulses[:] = arrays["last_impulses"]
-        self._last_step = int(arrays["last_step"])
+        last = float(arrays["last_time"])
+        self._last_time = None if np.isnan(last) else last
         self.peak_contacts[:] = arrays["peak_contacts"]
 
     def fill(self, local: dict) -> None:
@@ -63,8 +66,11 @@ class WallTable:
 
     def rows(self, state, total: dict) -> list[tuple]:
         """The rows of step ``state.step`` from the sums over ranks ``total``."""
-        interval = (state.step - self._last_step) * state.dt  # s since the previous sample
-        self._last_step = state.step
+        if self._last_time is None:
+            interval = state.dt_velocity  # s: the first step's impulses act over it
+        else:
+            interval = state.t - self._last_time  # s since the previous sample
+        self._last_time = state.t
         rows = []
         for i, w in enumerate(self.walls):
             impulses = np.concatenate([total["normal_impulse"][i], total["tangential_impulse"][i]])

@@ -123,8 +123,17 @@ _WALL_KEYS = ("point", "slide", "friction", "friction_filter", "secondary", "mot
 @dataclass(frozen=True)
 class RunSettings:
     end_time: float = key(Real(low=0.0), unit="s", doc="simulated time")
+    time_step: str | None = key(
+        Choice(("adaptive", "fixed")),
+        None,
+        doc="adaptive: dt_scale x the stable step of the deformed cells, every step (Radioss, "
+        "LS-DYNA); fixed: dt_scale x the stable step at rest (or dt) for the whole run",
+        default_doc="adaptive; fixed when dt is given",
+    )
     dt_scale: float = key(
-        Real(low=0.0, high=1.0), 0.9, doc="the step as a fraction of the stable step 2/omega_max"
+        Real(low=0.0, high=1.0),
+        0.9,
+        doc="the step as a fraction of the stable step (Radioss's /DT scale, LS-DYNA's TSSFAC)",
     )
     dt: float | None = key(
         Real(low=0.0),
@@ -133,16 +142,29 @@ class RunSettings:
         doc="a fixed step instead; refused above the stable limit (checked with the body)",
         default_doc="from dt_scale",
     )
+    dt_min: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="s",
+        doc="adaptive step: the smallest step the run takes; below it, dt_min_action",
+        default_doc="0: none",
+    )
+    dt_min_action: str = key(
+        Choice(("stop", "mass_scaling")),
+        "stop",
+        doc="stop: the run stops (exit 3, with a checkpoint); mass_scaling: mass is added to "
+        "the cells that would go below dt_min, just enough to hold it (LS-DYNA's DT2MS)",
+    )
+    max_added_mass: float = key(
+        Real(low=0.0),
+        0.05,
+        doc="mass scaling: the run stops when the added mass passes this fraction of the "
+        "body's mass",
+    )
     max_energy_error: float = key(
         Real(low=0.0),
         0.05,
         doc="guard: the run stops (exit 3) when the energy balance error exceeds it",
-    )
-    min_dt: float = key(
-        Real(low=0.0, low_open=False),
-        0.0,
-        unit="s",
-        doc="guard: the run stops when the step falls below it",
     )
     max_cells: float = key(
         Real(low=0.0),
@@ -156,13 +178,32 @@ class RunSettings:
         1e7,
         unit="steps",
         doc="limit: a run of more steps (estimated before meshing, counted with the stable"
-        " step) is refused",
+        " step at rest) is refused; an adaptive run stops when it reaches it",
     )
     max_frames: int = key(
         Integer(low=0),
         1000,
         doc="limit: output.frames and output.fields above it are refused",
     )
+
+
+@rule(RunSettings)
+def _one_kind_of_step(v, raw, fail):
+    """A given dt is a fixed step: time_step is then 'fixed' (its default); dt_min and
+    mass scaling are for the adaptive step."""
+    if v["dt"] is not None:
+        if v["time_step"] == "adaptive":
+            fail("dt", "is a fixed step, and time_step is 'adaptive': drop dt (dt_scale sets the "
+                 "adaptive step) or set time_step = 'fixed'")  # fmt: skip
+        v["time_step"] = "fixed"
+    elif v["time_step"] is None:
+        v["time_step"] = "adaptive"
+    if v["time_step"] == "fixed":
+        for name in ("dt_min", "dt_min_action", "max_added_mass"):
+            if name in raw:
+                fail(name, "needs time_step = 'adaptive' (a fixed step never falls)")
+    elif v["dt_min_action"] == "mass_scaling" and not v["dt_min"] > 0.0:
+        fail("dt_min", "missing: mass scaling holds the step at dt_min, which must be above 0")
 
 
 # --- [mesh] ------------------------------------------------------------------------

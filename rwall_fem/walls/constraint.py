@@ -1,8 +1,9 @@
 """The kinematic rigid-wall condition, shared by all shapes (``docs/theory.md``, "Rigid walls").
 
 After the acceleration solve, each secondary node's velocity and position are
-predicted, ``v* = v^{n-1/2} + dt a^n`` and ``x* = x^n + dt v*``, and so is the
-wall's position. A node whose predicted position is on the forbidden side is
+predicted, ``v* = v^{n-1/2} + dt^n a^n`` and ``x* = x^n + dt^{n+1/2} v*`` (``dt^n``, the
+step of the velocity update, is the mean of the steps before and after t^n), and so is
+the wall's position. A node whose predicted position is on the forbidden side is
 in contact (on a parallelogram only inside it, and only if it is not more than
 two steps of normal travel, 2 dt |(v* - V) . n|, behind it). The wall then
 applies to the node the impulse ``I`` that
@@ -11,9 +12,11 @@ applies to the node the impulse ``I`` that
   parallelogram gets the velocity that brings it back onto it in one step);
 - leaves its tangential velocity free (``slide="free"``), removes it
   (``"tied"``), or removes it up to the Coulomb limit ``mu |I_N|``
-  (``"friction"``), optionally filtered: ``I_T = alpha I_T + (1 - alpha) I_T_prev``.
+  (``"friction"``), optionally filtered: ``I_T = alpha I_T + (1 - alpha) I_T_prev``
+  (alpha given, 2 pi / period in steps, or 2 pi f dt for a cut-off frequency f, then
+  taken again at every step, at most 1).
 
-``I`` is added to ``a^n`` as ``I / (m dt)``, which gives the same ``v^{n+1/2}``
+``I`` is added to ``a^n`` as ``I / (m dt^n)``, which gives the same ``v^{n+1/2}``
 as editing both ``v^{n-1/2}`` and ``a^n``. A node stops where it is, at most
 one step of travel short of the surface; it is never projected. A node
 already behind the surface stays there unless one step takes it out.
@@ -52,7 +55,7 @@ from mpi4py import MPI
 
 from rwall_fem.walls.motion import FixedMotion
 
-__all__ = ["RigidWall"]
+__all__ = ["RigidWall", "filter_alpha"]
 
 SLIDES = ("free", "tied", "friction")
 # The near set is selected for this many steps of travel at the speed bound of the moment.
@@ -60,6 +63,20 @@ _HORIZON = 16
 # sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
 # covers rounding (a float sum u + dt v moves u by at most twice the increment).
 _TRAVEL = 2.0 * math.sqrt(3.0)
+
+
+def filter_alpha(friction_filter: tuple[str, float] | None, dt: float) -> float:
+    """The friction filter's alpha from (how, value): a coefficient, a period in steps
+    (2 pi / steps) or a cut-off frequency in Hz (2 pi f dt at the step dt, s, at most 1);
+    1 (no filter) without one."""
+    if friction_filter is None:
+        return 1.0
+    how, value = friction_filter
+    if how == "coefficient":
+        return value
+    if how == "steps":
+        return 2 * math.pi / value
+    return min(2 * math.pi * value * dt, 1.0)
 
 
 def _largest(values: np.ndarray) -> float:
@@ -87,14 +104,18 @@ class RigidWall:
         *,
         slide: str = "free",
         friction: float = 0.0,
-        filter_alpha: float = 1.0,
+        friction_filter: tuple[str, float] | None = None,
+        dt: float = 0.0,
         motion=None,
         comm: MPI.Comm = MPI.COMM_WORLD,
     ):
         if slide not in SLIDES:
             raise ValueError(f"slide must be one of {SLIDES}")
         self.shape, self.name, self.slide = shape, name, slide
-        self.friction, self.filter_alpha = float(friction), float(filter_alpha)
+        self.friction = float(friction)
+        # The friction filter (how, value) of Radioss; alpha at the step dt (s) of the start.
+        self.friction_filter = friction_filter
+        self.filter_alpha = filter_alpha(friction_filter, dt)
         self.motion = motion if motion is not None else FixedMotion()
         self.comm = comm
         self.nodes = np.asarray(nodes, dtype=np.int64)
@@ -111,7 +132,7 @@ class RigidWall:
         # the nodes then have (whatever acted on them after the wall).
         self._latest = None
         self._pending_driving = 0.0  # J
-        filtered = slide == "friction" and self.filter_alpha < 1.0
+        filtered = slide == "friction" and friction_filter is not None
         self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
         self._filtered_rows = self.nodes[:0]  # rows of it written in the latest step
         # Near set: the secondary nodes (positions in ``nodes``) tested this step; selected
@@ -122,6 +143,10 @@ class RigidWall:
         self.initially_penetrated = 0
         self.deepest_penetration = 0.0  # m
         self.deepest_position = np.zeros(3)  # m
+
+    def masses_changed(self, state) -> None:
+        """Read again the masses of the nodes it tests (mass scaling added to them)."""
+        self._near_mass = state.mass[self._near_nodes][:, None]
 
     @property
     def work(self) -> float:
@@ -210,9 +235,23 @@ class RigidWall:
         motion = {k[7:]: v for k, v in arrays.items() if k.startswith("motion_")}
         self.motion.restore_state(motion)
 
+    def settle(self, state) -> None:
+        """Book the v^{n+1/2} halves of the work of the latest step's impulses with the
+        velocities the nodes now have (whatever acted on them after the wall); before the
+        masses change, and at the start of every step."""
+        if self._latest is not None:
+            nodes, normal, tangential, final = self._latest
+            w_new = state.v[nodes] - final
+            self.normal_work += 0.5 * (normal * w_new).sum()
+            if tangential is not None:
+                self.friction_work += 0.5 * (tangential * w_new).sum()
+            self._latest = None
+        self.driving_work += self._pending_driving
+        self._pending_driving = 0.0
+
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
-        dt, motion, shape = state.dt, self.motion, self.shape
+        dt, dt_v, motion, shape = state.dt, state.dt_velocity, self.motion, self.shape
         wall_velocity = motion.predict(state.t, dt)
         offset = motion.offset
         wall_next = offset + dt * wall_velocity
@@ -220,7 +259,7 @@ class RigidWall:
             self._follow(state, wall_velocity, wall_next)
         near = self._near_nodes
         v_old = state.v[near]
-        v_pred = v_old + dt * state.a[near]
+        v_pred = v_old + dt_v * state.a[near]
         x_now = self._near_X + state.u[near]
         x_pred = x_now + dt * v_pred
         crossing = shape.distance(x_pred, wall_next) < 0.0
@@ -235,15 +274,9 @@ class RigidWall:
             hits, d_now = hits[shallow], d_now[shallow]
             target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
 
-        if self._latest is not None:
-            nodes, normal, tangential, final = self._latest
-            w_new = state.v[nodes] - final
-            self.normal_work += 0.5 * (normal * w_new).sum()
-            if tangential is not None:
-                self.friction_work += 0.5 * (tangential * w_new).sum()
-            self._latest = None
-        self.driving_work += self._pending_driving
-        self._pending_driving = 0.0
+        self.settle(state)
+        if self.friction_filter is not None and self.friction_filter[0] == "frequency":
+            self.filter_alpha = filter_alpha(self.friction_filter, dt)
         self.contacts = len(hits)
         self.touching = near[hits]  # nodes treated in the latest step
         kept = None
@@ -273,7 +306,7 @@ class RigidWall:
         if self._previous_tangential is not None:
             self._previous_tangential[self._filtered_rows] = tangential
         impulse = normal if tangential is None else normal + tangential
-        state.a[self.touching] += impulse / (m * dt)
+        state.a[self.touching] += impulse / (m * dt_v)
 
         final = wall_velocity
         if motion.dynamic:
@@ -308,8 +341,8 @@ class RigidWall:
         """
         dt = state.dt
         speed = _largest(state.v)  # bounds the components of v^{n-1/2}, m/s
-        self._travel += dt * speed  # of x^n from where the set was selected
-        ahead = speed + dt * _largest(state.a)  # bounds the components of v*, m/s
+        self._travel += state.dt_previous * speed  # of x^n from where the set was selected
+        ahead = speed + state.dt_velocity * _largest(state.a)  # bounds those of v*, m/s
         wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster
         reach = _TRAVEL * (self._travel + dt * ahead) + wall_travel
         if not reach <= self._budget:  # also when NaN

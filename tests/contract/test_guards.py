@@ -51,15 +51,7 @@ def test_energy_error_guard(shared_dir):
     assert "energy balance error" in sim.status and "exceeds run.max_energy_error" in sim.status
     assert "fastest node" in sim.status and "|v| = " in sim.status
     assert sim.history.summary["status"] == "stopped"
-    assert len(sim.history.energy) < sim.num_steps + 1
-
-
-def test_min_dt_guard(shared_dir):
-    raw = bar_scene(elements=10)
-    raw["run"]["min_dt"] = 1.0
-    sim = run(raw, shared_dir)
-    assert sim.status.startswith("stopped: step 0, t = 0 s: time step")
-    assert "below run.min_dt = 1 s" in sim.status
+    assert len(sim.history.energy) < sim.planned_steps + 1
 
 
 # The same bar, run for a second of simulated time (about 10^7 steps): it is stopped first.

@@ -18,7 +18,7 @@ from rwall_fem import parse_scene
 from rwall_fem.cli import main
 from rwall_fem.estimate import estimate
 from rwall_fem.meshing import body_mesh
-from rwall_fem.output.schedule import spread
+from rwall_fem.output.schedule import Times
 
 STEEL = {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.3}
 
@@ -113,13 +113,30 @@ def test_cell_estimates_hold_to_25_percent(mesh):
     assert estimate(scene).cells == pytest.approx(cells, rel=0.25)
 
 
-def test_spread_samples_as_listed_whatever_their_number():
-    for count in range(6):
-        for last in range(12):
-            listed = {round(k * last / max(count - 1, 1)) for k in range(count)}
-            assert {s for s in range(-1, last + 2) if s in spread(count, last)} == listed
-    assert all(s in spread(10**8, 1000) for s in range(1001))  # nothing listed: no minute
-    frames, last = spread(1000, 3528582), 3528582
-    for k in (0, 1, 2, 499, 500, 997, 998, 999):  # 3532.1 steps apart: the neighbours are not
-        step = round(k * last / 999)
-        assert step in frames and step - 1 not in frames and step + 1 not in frames
+def test_times_sample_the_first_step_at_or_after_each_time():
+    """Outputs at times: due at the first step at or after each requested time, once per
+    step however many times it passes, the rest at the last step; an evenly stepped run
+    gets them exactly where they are asked."""
+
+    class Step:
+        def __init__(self, step, t, dt, last=False):
+            self.step, self.t, self.dt, self.last = step, t, dt, last
+
+    def sampled(times, steps):
+        taken = []
+        for s in steps:
+            if times.due(s):
+                times.taken(s)
+                taken.append(s.step)
+        return taken
+
+    dt = 1e-3
+    even = [Step(n, n * dt, dt, last=n == 10) for n in range(11)]
+    assert sampled(Times(6, 10 * dt), even) == [0, 2, 4, 6, 8, 10]
+    assert sampled(Times(1, 10 * dt), even) == [0]
+    growing = [Step(n, 0.5 * n * n * dt, n * dt, last=n == 5) for n in range(6)]  # t: 0..12.5
+    # times 0, 2.5, 5, 7.5, 10, 12.5 (x dt) -> steps 0, 3 (t = 4.5), 4 (8), 5 (12.5, last)
+    assert sampled(Times(6, 12.5 * dt), growing) == [0, 3, 4, 5]
+    short = [Step(n, n * dt, dt, last=n == 3) for n in range(4)]
+    times = Times(10**8, 3 * dt)
+    assert sampled(times, short) == [0, 1, 2, 3] and times.next == 10**8

@@ -45,7 +45,7 @@ def test_outputs_of_a_run(shared_dir):
         ):
             assert key in summary
         assert summary["ranks"] == MPI.COMM_WORLD.size
-        assert summary["steps"] == summary["planned_steps"] == sim.num_steps
+        assert summary["steps"] == summary["planned_steps"] == sim.planned_steps
         assert summary["warnings"] == []
         assert set(summary["energy"]) == {
             "initial",
@@ -73,7 +73,7 @@ def test_outputs_of_a_run(shared_dir):
             assert float(row["energy_error_percent"]) == 100 * float(row["balance_error"])
             assert float(row["dt"]) == sim.state.dt
         # every 5th step and the last one
-        assert len(rows) == sim.num_steps // 5 + 1 + (sim.num_steps % 5 > 0)
+        assert len(rows) == sim.planned_steps // 5 + 1 + (sim.planned_steps % 5 > 0)
         walls = list(csv.DictReader(open(out / "walls.csv")))
         columns = ["time", "wall", *(f"{q}_{c}" for q in ("force", "impulse") for c in "xyz")]
         assert list(walls[0])[:8] == columns

@@ -40,7 +40,7 @@ def test_every_key_carries_a_doc_and_numbers_a_unit():
     dimensionless = {
         "dt_scale", "max_energy_error", "poisson", "hourglass_coefficient", "axis", "friction",
         "coefficient", "steps", "hardening_exponent", "strain_rate_coefficient",
-        "softening_exponent", "taylor_quinney",
+        "softening_exponent", "taylor_quinney", "max_added_mass",
     }  # fmt: skip
     for where, _, cls in tables():
         assert cls.__table__.doc, where

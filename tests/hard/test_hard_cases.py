@@ -31,7 +31,7 @@ class StaysInFront:
         self.facing, self.deepest = None, 0.0
         sim.recorders.append(self)
 
-    def due(self, step):
+    def due(self, s):
         return True
 
     def record(self, sim, s):
@@ -57,7 +57,7 @@ def check_stable(sim, probe, *, balance=1e-10, inside=1e-12, dissipative=True):
     assert probe.distances.min() >= -inside
     name = os.environ.get("PYTEST_CURRENT_TEST", "").split("::")[-1].split(" ")[0]
     print(  # the figures quoted in the README: run with -s to see them
-        f"[hard] {name}: steps {sim.num_steps}, balance error "
+        f"[hard] {name}: steps {sim.state.step}, balance error "
         f"{summary['energy']['max_balance_error']:.1e}, deepest node {probe.distances.min():.1e} m,"
         f" wall work {sum(w['work'] for w in summary['walls']):.2e} J"
         f" (E0 {summary['energy']['initial']:.2e} J),"
@@ -240,7 +240,7 @@ def test_long_run_between_two_walls(refine, shared_dir):
     raw["run"]["end_time"] = 20000 * dt
     raw["output"]["history_interval"] = 10
     sim, probe = run_probed(raw, shared_dir)
-    assert sim.num_steps >= 20000
+    assert sim.state.step >= 20000
     summary = check_stable(sim, probe, balance=1e-9)
     energy = sim.history.energy
     assert (energy[:, 1] + energy[:, 2]).max() <= summary["energy"]["initial"] * (1 + 1e-9)

@@ -5,6 +5,7 @@ import pytest
 from mpi4py import MPI
 
 from rwall_fem.solver import RunStopped, Simulation, State
+from rwall_fem.time_step import FixedStep
 
 
 class Push:
@@ -13,10 +14,11 @@ class Push:
     name = "push"
     energy_names = ("internal",)
     energy_parts = ()
-    booked_force = None
+    conservative = True
 
     def __init__(self, a=1.0, fail=None):
         self.a, self.fail = a, fail
+        self.nodal_force = np.zeros((2, 3))
 
     def accelerate(self, state):
         if state.step == self.fail:
@@ -35,7 +37,7 @@ class Log:
         self.closed, self.name, self.error, self.stop = closed, name, error, stop
         self.steps = []
 
-    def due(self, step):
+    def due(self, s):
         return True
 
     def record(self, sim, s):
@@ -58,10 +60,37 @@ def simulation(force=None, recorders=()):
 
 def test_central_differences_of_a_constant_acceleration():
     sim = simulation(Push(a=2.0))
-    assert sim.run() == "done" and sim.num_steps == 3
+    assert sim.run() == "done" and sim.planned_steps == 3
     # v^{n+1/2} = (n + 1) a dt and u^{n+1} = sum of them times dt, after steps 0..3.
     assert sim.state.v == pytest.approx(np.full((2, 3), 4 * 2.0 * 0.1))
     assert sim.state.u == pytest.approx(np.full((2, 3), (1 + 2 + 3 + 4) * 2.0 * 0.01))
+
+
+class Alternating(FixedStep):
+    """Steps of 0.1 and 0.2 s in turn."""
+
+    varies = True
+
+    def choose(self, sim, s):
+        s.dt = 0.1 if s.step % 2 == 0 else 0.2
+
+    def advance(self, s):
+        s.dt_previous, s.step, s.t = s.dt, s.step + 1, s.t + s.dt
+
+
+def test_a_varying_step_updates_the_velocity_over_the_mean_of_the_steps_around_t():
+    """v^{n+1/2} = v^{n-1/2} + (dt^{n-1/2} + dt^{n+1/2})/2 a (dt^{1/2} at the first step:
+    the initial velocity is v^{-1/2}), u^{n+1} = u^n + dt^{n+1/2} v^{n+1/2}; the run ends at
+    the first step at or after end_time."""
+    sim = simulation(Push(a=2.0))
+    sim.step_size = Alternating(0.1)
+    assert sim.run() == "done"
+    # steps 0..2 at t = 0, 0.1, 0.3 (>= 0.3: the last); dt = 0.1, 0.2, 0.1
+    assert sim.state.step == 2 and sim.state.t == pytest.approx(0.3)
+    v = [2.0 * 0.1, 2.0 * (0.1 + 0.15), 2.0 * (0.1 + 0.15 + 0.15)]
+    u = 0.1 * v[0] + 0.2 * v[1] + 0.1 * v[2]
+    assert sim.state.v == pytest.approx(np.full((2, 3), v[2]))
+    assert sim.state.u == pytest.approx(np.full((2, 3), u))
 
 
 def test_every_recorder_closes_in_order_when_one_fails_to_close():

@@ -56,8 +56,8 @@ class HourglassProbe:
         self.energies = []
         sim.recorders.append(self)
 
-    def due(self, step):
-        return step % 10 == 0
+    def due(self, s):
+        return s.step % 10 == 0
 
     def record(self, sim, s):
         self.energies.append(self.force.stored_energy_at(s.u)[1])

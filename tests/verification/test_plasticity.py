@@ -89,6 +89,7 @@ def homogeneous(technology, rotate: bool, steps: int = 400):
             v.owned[:] = X @ ((now - before) / state.dt).T
             dL = (now - before) @ np.linalg.inv(0.5 * (now + before))
             lib.plastic_point(force.params, sigma, eps_p, T, ffi.new("double[9]", list(dL.flat)))
+        state.dt_previous = state.dt if k else 0.0  # the step that brought u here
         force.accelerate(state)
     return force.history[:6, 0], force.history[6, 0], np.array(list(sigma)), eps_p[0]
 
@@ -141,7 +142,7 @@ class TopVelocity:
         self.t, self.v = [], []
         sim.recorders.append(self)
 
-    def due(self, step):
+    def due(self, s):
         return True
 
     def record(self, sim, s):
