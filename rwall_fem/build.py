@@ -293,13 +293,14 @@ def _step_fact(sim: Simulation) -> str:
     """The step, and both stable steps at rest: the eigenvalue's and the elements'."""
     info, step = sim.info, sim.step_size
     how = (
-        f"adaptive, dt_scale x {step.calibration:.4g} x the smallest cell estimate"
+        "adaptive: dt_scale x the smallest estimate of the cells, calibration "
+        f"{step.calibration:.4g}"
         if step.mode == "adaptive"
         else "fixed"
     )
     return (
         f"time step {how}; at rest: stable {info['dt_stable']:.4g} s (eigenvalue), smallest "
-        f"cell estimate {info['dt_element_estimate']:.4g} s (L/c); dt = {sim.state.dt:.4g} s"
+        f"L/c of a cell {info['dt_element_estimate']:.4g} s; dt = {sim.state.dt:.4g} s"
     )
 
 

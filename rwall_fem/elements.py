@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem
+from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
@@ -183,6 +184,7 @@ class ElementForce:
         self.params.lmbda, self.params.mu = lmbda, mu
         self.params.density, self.params.wave_speed = material.density, material.p_wave_speed
         self.params.hourglass_coefficient = technology.hourglass_coefficient
+        self.params.calibration = 1.0
         self.points = (
             8 if technology.cell == "hexahedron" and technology.integration == "full" else 1
         )
@@ -216,15 +218,26 @@ class ElementForce:
         return volume, length
 
     def steps_at_rest(self) -> np.ndarray:
-        """Each owned cell's stable step estimate (s) at rest: L_0 / c_p, and with the
-        viscous hourglass form at most V_0^(1/3) / (8 QM c_p) (``kernels/step.h``)."""
+        """Each owned cell's stable step estimate (s) at rest as the kernels make it: the
+        calibration x L_0 / c_p, and with the viscous hourglass form at most
+        V_0^(1/3) / (8 QM c_p) (``kernels/step.h``)."""
         c = self.params.wave_speed
-        steps = self.length0 / c
+        steps = self.params.calibration * self.length0 / c
         if self.technology.integration == "reduced" and self.technology.hourglass == "viscous":
             coefficient = self.params.hourglass_coefficient
             with np.errstate(divide="ignore"):
                 steps = np.minimum(steps, np.cbrt(self.volume0) / (8.0 * coefficient * c))
         return steps
+
+    def calibrate(self, dt_exact: float) -> float:
+        """Scale the cells' estimates L / c by the exact stable step at rest ``dt_exact``
+        (s, of the stiffness: 2 / omega_max) over their smallest at rest (collective);
+        returns that ratio (the estimates follow it only up to 1)."""
+        comm = self.V.mesh.comm
+        smallest = float((self.length0 / self.params.wave_speed).min(initial=np.inf))
+        ratio = dt_exact / comm.allreduce(smallest, op=MPI.MIN)
+        self.params.calibration = min(1.0, ratio)
+        return ratio
 
     def list_cells_below(self, floor: float, factor: np.ndarray) -> None:
         """From now on, scale each cell's step estimate by ``factor`` (per owned cell,
@@ -340,16 +353,12 @@ class ElementForce:
         return ", ".join(words)
 
     def energies(self, state) -> dict[str, float]:
-        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy with
-        the correction of a varying step (or, without a stored energy, the internal work
-        less the hourglass energy), and
+        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
+        without a stored energy, the internal work less the hourglass energy), and
         ``"hourglass"`` when the elements have hourglass control; for an elasto-plastic
         body also the parts of the internal energy, ``"elastic"`` and ``"plastic_work"``."""
         hourglass = self.hourglass_energy
-        if self.conservative:
-            internal = self.stored_energy + state.step_correction
-        else:
-            internal = state.internal_work - hourglass
+        internal = self.stored_energy if self.conservative else state.internal_work - hourglass
         energies = {"internal": internal}
         if "hourglass" in self.energy_names:
             energies["hourglass"] = hourglass

@@ -99,7 +99,7 @@ class State:
     last: bool = False
     kinetic: float = 0.0  # K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} of the latest update, J
     internal_work: float = 0.0  # of an internal force without stored energy, up to step n, J
-    step_correction: float = 0.0  # of a stored energy for a varying step, up to step n, J
+    step_correction: float = 0.0  # what a varying step took out of K + U, up to step n, J
     # The momentum booked at mid-step velocities up to step n, sum over steps of
     # dt^k/2 (P^{k-1/2} + P^{k+1/2}) with P = sum m v (first half only of step n), kg m:
     # what the work of uniform gravity needs.
@@ -228,10 +228,11 @@ class CentralDifference:
     - a force without a stored energy (``stored`` False): its work at mid-step velocities
       in ``state.internal_work`` (J, this rank: both halves of every step before n and the
       first half of step n, as every work is booked);
-    - a force with one: ``state.step_correction`` (J), what the stored energy misses when
-      the step varies, sum over steps of (dt^{k+1/2} - dt^{k-1/2})/4 f^k . (v^{k-1/2} -
-      v^{k+1/2}) (the v^{n+1/2} half of step n at step n + 1): with it, K^n + U(u^n)
-      is conserved exactly by a linear force whatever the steps (``docs/theory.md``).
+    - a force with one, when the step varies (``corrects``): ``state.step_correction``
+      (J), sum over steps of (dt^{k+1/2} - dt^{k-1/2})/4 f^k . (v^{k-1/2} - v^{k+1/2})
+      (the v^{n+1/2} half of step n at step n + 1), the energy the step's changes take
+      out of K^n + U(u^n): with it, a linear force's books close exactly whatever the
+      steps (``docs/theory.md``), and its opposite is booked as the step change's work.
     """
 
     def __init__(self, state: State, force: np.ndarray | None = None, *, stored: bool = False):
@@ -250,6 +251,7 @@ class CentralDifference:
                 raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
         self._force = force is not None
         self._stored = stored
+        self.corrects = stored and force is not None
         self._pass = functools.partial(lib.central_difference, len(state.mass))
         self._arrays = (
             ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force), ptr(self._out)

@@ -4,11 +4,12 @@
 element kernels estimate each cell's stable step dt_e = L_e / c_e from its current shape
 and wave speed (``kernels/step.h``); the run's stable step at rest, 2 / omega_max from
 the largest eigenvalue (:func:`~rwall_fem.mechanics.critical_time_step`), calibrates
-them once: ``calibration`` = min(1, exact / min_e dt_e at rest), so that the estimate
-never exceeds the exact limit at rest and follows the body as it deforms.
+them once: ``calibration`` = min(1, exact / min_e L_e / c_e at rest), so that the estimate
+never exceeds the exact limit at rest and follows the body as it deforms (the kernels
+apply it; the limit of the damped hourglass modes of the viscous form stays as it is).
 
 - :class:`AdaptiveStep` (``run.time_step = "adaptive"``, the default, as in Radioss and
-  LS-DYNA): dt^{n+1/2} = dt_scale x calibration x min_e dt_e at step n, rounded down to 4
+  LS-DYNA): dt^{n+1/2} = dt_scale x min_e dt_e at step n (calibrated), rounded down to 4
   significant figures (the same step on any number of ranks), with the controls of
   ``run.dt_min``: stop there, or add mass to the cells that would go below it
   (:mod:`rwall_fem.mass_scaling`);
@@ -99,17 +100,17 @@ class _StepSize:
     the inverted-cell stop, the records, and going on to the next step.
 
     ``force`` is the body's :class:`~rwall_fem.elements.ElementForce` (None: no estimates,
-    a step given by the caller); ``calibration`` scales its estimates to the exact limit
-    at rest; ``initial`` (s) is the step at the start.
+    a step given by the caller), its estimates calibrated by ``calibration`` (what its
+    kernels apply); ``initial`` (s) is the step at the start.
     """
 
     def __init__(self, initial: float, force=None, calibration: float = 1.0, comm=None):
         self.initial, self.force, self.calibration = initial, force, calibration
-        self.at_rest = math.nan  # the smallest cell estimate at rest, s (step_size sets it)
+        self.at_rest = math.nan  # the smallest L / c of a cell at rest, s (step_size sets it)
         self.comm = comm if comm is not None else MPI.COMM_SELF
         self.records = StepRecords(self.comm)
         self.stop_reason: str | None = None
-        self.limit = math.inf  # calibration x the smallest estimate at the latest step, s
+        self.limit = math.inf  # the smallest (calibrated) estimate at the latest step, s
         self._local = np.zeros(3)
         self._total = np.zeros(3)
         self._reductions = 0  # steps reduced so far: the cache key of controlling_cell
@@ -123,7 +124,7 @@ class _StepSize:
         self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
         self._reductions += 1
         smallest, inverted, listed = self._total.tolist()
-        self.limit = self.calibration * smallest
+        self.limit = smallest
         if inverted:
             self.stop_reason = self._inverted(s)
         return smallest, int(-inverted), int(-listed)
@@ -158,7 +159,7 @@ class _StepSize:
             return None
         step = self.force.step
         held = None
-        if step[0] * self.calibration == self.limit:
+        if step[0] == self.limit:
             cell = int(step[1])
             text = self.force.describe_cell(cell) if describe else ""
             held = (self.force.cell_position(cell).tolist(), text)
@@ -221,8 +222,8 @@ class FixedStep(_StepSize):
 
 
 class AdaptiveStep(_StepSize):
-    """dt^{n+1/2} = ``dt_scale`` x ``calibration`` x the smallest estimate of the cells at
-    step n (s), rounded down to 4 significant figures.
+    """dt^{n+1/2} = ``dt_scale`` x the smallest (calibrated) estimate of the cells at step n
+    (s), rounded down to 4 significant figures.
 
     ``dt_min`` (s) and ``action`` are ``run.dt_min`` and ``run.dt_min_action``: below
     ``dt_min`` the run stops after the step ("stop"), or ``mass_scaling`` (a
@@ -257,7 +258,7 @@ class AdaptiveStep(_StepSize):
     @property
     def floor(self) -> float:
         """The estimate (s) of a cell below which the step would fall under ``dt_min``."""
-        return self.dt_min / (self.dt_scale * self.calibration)
+        return self.dt_min / self.dt_scale
 
     def choose(self, sim, s) -> None:
         smallest, _, listed = self._reduce(s)
@@ -267,7 +268,7 @@ class AdaptiveStep(_StepSize):
             reason = self.mass_scaling.add(sim, s, self.floor)
             self.stop_reason = self.stop_reason or reason
             smallest = max(smallest, self.floor)
-        dt = round_down(self.dt_scale * self.calibration * smallest)
+        dt = round_down(self.dt_scale * smallest)
         if scaled:
             dt = max(dt, self.dt_min)  # the cells below it were given the mass to hold it
         s.dt = dt
@@ -318,26 +319,37 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
     from rwall_fem.scene import SceneError
 
     run, comm = scene.run, V.mesh.comm
+    ratio = force.calibrate(dt_stable)  # the exact limit over the estimate L / c, at rest
+    fixed = run.time_step == "fixed"
+    if fixed:
+        force.params.calibration = ratio  # the limit at rest is the exact one
     at_rest = comm.allreduce(float(force.steps_at_rest().min(initial=math.inf)), op=MPI.MIN)
-    ratio = dt_stable / at_rest  # the exact limit over the element estimate, at rest
-    if run.time_step == "fixed":
+    if fixed:
         if run.dt is not None and run.dt > dt_stable:
             raise SceneError(
                 f"{scene.source}: run.dt: {run.dt:g} s is above the stable limit "
                 f"{dt_stable:.6g} s (2/omega_max); use a smaller dt or drop it to use dt_scale"
             )
         dt = run.dt if run.dt is not None else round_down(run.dt_scale * dt_stable)
-        fixed = FixedStep(dt, force, ratio, comm)
-        fixed.at_rest = at_rest
-        return fixed
-    calibration = min(1.0, ratio)
-    initial = round_down(run.dt_scale * calibration * at_rest)
+        if dt > at_rest:  # only the damped hourglass modes can be below the stiffness's limit
+            raise SceneError(
+                f"{scene.source}: element.hourglass_coefficient: the viscous hourglass form at "
+                f"{force.params.hourglass_coefficient:g} damps its modes so much that they "
+                f"need a step of at most {at_rest:.4g} s, below the fixed step {dt:.4g} s; "
+                "lower the coefficient (LS-DYNA's QM is 0.1 by default) or use "
+                "run.time_step = 'adaptive', which takes it into account"
+            )
+        step = FixedStep(dt, force, ratio, comm)
+        step.at_rest = dt_stable / ratio
+        return step
+    calibration = force.params.calibration
+    initial = round_down(run.dt_scale * at_rest)
     mass_scaling = None
     if run.dt_min_action == "mass_scaling":
-        floor = run.dt_min / (run.dt_scale * calibration)
         mass_scaling = MassScaling(
-            force, V, scene.material.density, body_mass, run.max_added_mass, floor
-        )
+            force, V, scene.material.density, body_mass, run.max_added_mass,
+            run.dt_min / run.dt_scale,
+        )  # fmt: skip
     elif run.dt_min > initial:
         raise SceneError(
             f"{scene.source}: run.dt_min: {run.dt_min:g} s is above the step at rest, "
@@ -354,5 +366,5 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
         mass_scaling=mass_scaling,
         max_steps=run.max_steps if limits else None,
     )
-    adaptive.at_rest = at_rest
+    adaptive.at_rest = dt_stable / ratio
     return adaptive

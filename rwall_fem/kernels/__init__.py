@@ -57,6 +57,7 @@ typedef struct {
   int table_size;
   double table_strain[64], table_stress[64];
   int estimate;
+  double calibration;
   const double *length0;
   const double *volume0;
   const double *step_factor;

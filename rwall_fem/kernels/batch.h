@@ -55,6 +55,7 @@ typedef struct
   double table_strain[TABLE_ROWS], table_stress[TABLE_ROWS]; /* eps_p (increasing), Pa */
   /* the element time step (step.h) */
   int estimate;                 /* estimate each cell's stable step in this call */
+  double calibration;           /* scales the estimates L / c to the exact limit at rest */
   const double *length0;        /* per cell: characteristic length at rest, m */
   const double *volume0;        /* per cell: volume at rest, m^3 */
   const double *step_factor;    /* NULL, or per cell sqrt(mass / mass at rest) (mass scaling) */

@@ -300,7 +300,8 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
     note_inverted(inverted, c0, nb, x, ue, 8, step);
     if (p->estimate)
     {
-      vec dte = cell_values(p->length0, c0, nb) * vsqrt(p->density / modulus);
+      vec dte = p->calibration * cell_values(p->length0, c0, nb)
+                * vsqrt(p->density / modulus);
       if (hourglass == HOURGLASS_VISCOUS)
         dte = vmin(dte, viscous_hourglass_step(p, volume, volume));
       note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 8, step);
@@ -356,7 +357,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     {
       const vec volume0 = cell_values(p->volume0, c0, nb);
       const vec speed = p->wave_speed * vsqrt(geo.volume / volume0);
-      vec dte = characteristic_length(8, x, geo.volume) / speed;
+      vec dte = p->calibration * characteristic_length(8, x, geo.volume) / speed;
       if (hourglass == HOURGLASS_VISCOUS)
         dte = vmin(dte, viscous_hourglass_step(p, geo.volume, volume0));
       note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 8, step);

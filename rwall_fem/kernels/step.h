@@ -1,10 +1,12 @@
 /* The element time step and the inversion check, in the kernels' pass over the cells.
  *
  * Each cell estimates its stable step (docs/theory.md, "Stable time step"): its
- * characteristic length over its wave speed, dt_e = L_e / c_e, with L_e = V / A_max for
- * hexahedra (the volume over the largest face area, LS-DYNA's length of solids) and
- * L_e = 3 V / A_max, the smallest altitude, for tetrahedra; with the viscous hourglass
- * form also the limit 2 / eta of its damped hourglass modes.  A kernel notes in `step`
+ * characteristic length over its wave speed, dt_e = k L_e / c_e, with L_e = V / A_max for
+ * hexahedra (the volume over the largest face area, LS-DYNA's and Radioss's length of
+ * solids) and L_e = 3 V / A_max, the smallest altitude, for tetrahedra, and k =
+ * p->calibration (the exact limit at rest over the estimate, at most 1); with the
+ * viscous hourglass form at most the limit 2 / eta of its damped hourglass modes, which
+ * the calibration (an eigenvalue of the stiffness alone) does not touch.  A kernel notes in `step`
  * (STEP_SLOTS values, accumulated over its calls):
  *   step[0]     the smallest dt_e of its cells (s; +inf: none estimated),
  *   step[1]     that cell (local index), step[2..4] its centroid (m, current position),

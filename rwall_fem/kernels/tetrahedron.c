@@ -94,7 +94,8 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
     note_inverted(inverted, c0, nb, x, ue, 4, step);
     if (p->estimate)
     {
-      const vec dte = cell_values(p->length0, c0, nb) * vsqrt(p->density / modulus);
+      const vec dte = p->calibration * cell_values(p->length0, c0, nb)
+                      * vsqrt(p->density / modulus);
       note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 4, step);
     }
   }
@@ -145,7 +146,7 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     if (p->estimate)
     {
       const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, c0, nb));
-      const vec dte = characteristic_length(4, x, volume) / speed;
+      const vec dte = p->calibration * characteristic_length(4, x, volume) / speed;
       note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 4, step);
     }
   }

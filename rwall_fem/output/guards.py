@@ -2,8 +2,9 @@
 
 The guards act at every history sample, on values already summed over ranks, so every
 rank takes the same decision at the same step: a NaN or Inf in a nodal array (seen as a
-non-finite sum), an energy balance error above ``max_energy_error``, or a SIGTERM or
-SIGINT (Ctrl-C) received by any rank stop the run with one
+non-finite sum), an energy balance error above ``max_energy_error``, as much energy put
+in by the changes of a varying step, or a SIGTERM or SIGINT (Ctrl-C) received by any rank
+stop the run with one
 :class:`~rwall_fem.solver.RunStopped` message naming the step, the time, the quantity
 and the worst node. (What the time step stops a run for, :mod:`rwall_fem.time_step`
 decides.)
@@ -26,11 +27,13 @@ class Guards:
         self.comm, self.node_ids = comm, node_ids
         self.max_energy_error = max_energy_error
 
-    def check(self, s, error: float, *, finite: bool, signals: tuple[str, ...] = ()) -> None:
+    def check(
+        self, s, error: float, *, finite: bool, signals: tuple[str, ...] = (), step_work=0.0
+    ) -> None:
         """Raise :class:`RunStopped` (on every rank alike) if a guard trips at the sample of
         the state ``s``: ``error`` is its balance error, ``finite`` whether every sum of
         the sample is finite, ``signals`` the stop signals any rank received ("SIGTERM",
-        "SIGINT")."""
+        "SIGINT"), ``step_work`` the work of the step's changes over the energy scale."""
         where = f"step {s.step}, t = {s.t:.6g} s"
         if not finite:
             bad = ~(np.isfinite(s.u).all(axis=1) & np.isfinite(s.v).all(axis=1))
@@ -41,6 +44,12 @@ class Guards:
             raise RunStopped(
                 f"{where}: energy balance error {error:.3g} exceeds run.max_energy_error = "
                 f"{self.max_energy_error:g}; fastest node {node}"
+            )
+        if abs(step_work) > self.max_energy_error:
+            raise RunStopped(
+                f"{where}: the changes of the time step have put {100 * step_work:.3g} % of the "
+                f"body's energy into it, more than run.max_energy_error = "
+                f"{self.max_energy_error:g}: the step varies too fast for the body"
             )
         if "SIGTERM" in signals:
             raise RunStopped(f"{where}: terminated by SIGTERM")

@@ -61,11 +61,15 @@ class History:
         self.initial_momentum = momentum(sim.state, walls, comm)
         self.mass_scaling = getattr(sim.step_size, "mass_scaling", None)
         scaled = self.mass_scaling is not None
+        self.step_changes = sim.update.corrects  # a stored energy with a varying step
+        works = ["external_work", "wall_work"]
+        works += ["mass_scaling_work"] if scaled else []
+        works += ["step_change_work"] if self.step_changes else []
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
             parts=sim.internal.energy_parts,
-            works=("external_work", "wall_work", *(("mass_scaling_work",) if scaled else ())),
+            works=works,
             extras=("added_mass", "added_mass_percent") if scaled else (),
         )
         self.wall_table = WallTable(walls)
@@ -78,6 +82,7 @@ class History:
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
+            | {"step_change_work": ()}
             | {"signals": (len(SIGNALS),), "seconds": ()}
             | self.wall_table.sums,
         )
@@ -114,6 +119,7 @@ class History:
             local["wall_work"][i] = w.normal_work, w.friction_work
         if self.mass_scaling is not None:
             local["mass_scaling_work"][...] = self.mass_scaling.work
+        local["step_change_work"][...] = -s.step_correction
         # Sent with the sums, so that every rank stops at the same step when any got a signal.
         self._fill_agreement(local, sim)
         self.wall_table.fill(local)
@@ -130,6 +136,8 @@ class History:
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
         extras = {}
+        if self.step_changes:
+            energies["step_change_work"] = float(total["step_change_work"])
         if self.mass_scaling is not None:
             energies["mass_scaling_work"] = float(total["mass_scaling_work"])
             extras = {
@@ -140,7 +148,14 @@ class History:
         for row in self.wall_table.rows(s, total):
             self._walls_csv.append(row)
         signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
-        self.guards.check(s, self.balance.error, finite=self._sums.finite(), signals=signals)
+        self.guards.check(
+            s,
+            self.balance.error,
+            finite=self._sums.finite(),
+            signals=signals,
+            step_work=energies.get("step_change_work", 0.0)
+            / max(self.balance.reference, np.finfo(float).tiny),
+        )
 
     def _fill_agreement(self, local: dict, sim) -> None:
         """This rank's stop signals and its wall time since the latest agreement (s)."""

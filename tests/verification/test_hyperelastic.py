@@ -70,7 +70,7 @@ def test_fixed_step_stops_when_the_limit_falls_below_it(shared_dir):
     raw = bar("neo_hookean")
     raw["run"]["time_step"] = "fixed"
     sim = build_simulation(parse_scene(raw, source="test"), MPI.COMM_WORLD, shared_dir)
-    sim.step_size.calibration *= 0.5  # as if the deformation had halved the limit
+    sim.internal.params.calibration *= 0.5  # as if the deformation had halved the limit
     status = sim.run()
     assert status.startswith("stopped: step 0, t = 0 s: the deformation lowered the stable")
     assert "below the fixed dt = " in status and "run.time_step = 'adaptive'" in status
@@ -113,8 +113,9 @@ def test_stable_step_estimate_against_the_assembled_tangent(model, shared_dir):
     estimates L_0 / c from the acoustic tensor at their strain, calibrated at rest) must
     not exceed the exact stable step 2/sqrt(lambda_max(M^-1 K_t)) of the tangent stiffness
     K_t, assembled from the UFL derivative of the force (fully integrated elements: 2x2x2
-    points, as the kernels) and solved by SLEPc, and be within 30 % of it (the bound on
-    the acoustic tensor is exact at rest and for uniaxial states)."""
+    points, as the kernels) and solved by SLEPc (to its tolerance, 1e-8), and be within
+    20 % of it (0.82 of it seen, SVK: the bound on the acoustic tensor is exact at rest
+    and for uniaxial states, the rest is the cells' L/c against the mesh's modes)."""
     scene = fast_bar(model, dt_scale=0.9, integration="full")
     sim = build_simulation(scene, MPI.COMM_WORLD, shared_dir)
     V = sim.internal.V
@@ -146,7 +147,7 @@ def test_stable_step_estimate_against_the_assembled_tangent(model, shared_dir):
     assert sim.run() == "done"
     assert len(ratios) >= 5
     limit_over_exact = [r for r, _ in ratios]
-    assert 0.7 <= min(limit_over_exact) and max(limit_over_exact) <= 1.0
+    assert 0.8 <= min(limit_over_exact) and max(limit_over_exact) <= 1.0 + 1e-8
     if model == "neo_hookean":  # the test means something: the limit fell by over 10 %
         assert min(e for _, e in ratios) < 0.9 * sim.info["dt_stable"]
 
