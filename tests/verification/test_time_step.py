@@ -107,8 +107,9 @@ def wall_scenes():
     edge = block_scene(h=0.0025, origin=(0.0, 0.0, 1e-4), wall=[patch], end_time=0.02,
                        velocity=(0.0, 0.0, -1.0))  # fmt: skip
     carried = bar_scene(elements=12, speed=0.0, wall=False, end_time=4e-5)
+    hammer = {"mass": 0.002, "velocity": [0.1, 0.0, -5.0]}
     carried["wall"] = [{"kind": "plane", "point": [0.0, 0.0, 0.0121], "normal_point": [0, 0, 0],
-                        "slide": "tied", "motion": {"mass": 0.002, "velocity": [0.1, 0, -5.0]}}]  # fmt: skip
+                        "slide": "tied", "motion": hammer}]  # fmt: skip
     return {"friction": on_plane, "curved": curved, "parallelogram": edge, "main node": carried}
 
 
@@ -137,8 +138,14 @@ def crush_scene(**run_keys) -> dict:
         "run": {"end_time": 30e-6, **run_keys},
         "mesh": {"shape": "bar", "size": [4e-3, 4e-3, 16e-3], "element_size": 1e-3},
         "material": COPPER,
-        "wall": [{"kind": "plane", "point": [0.0, 0.0, 16e-3], "normal_point": [0.0, 0.0, 0.0],
-                  "motion": {"mass": 0.02, "velocity": [0.0, 0.0, -250.0]}}],  # fmt: skip
+        "wall": [
+            {
+                "kind": "plane",
+                "point": [0.0, 0.0, 16e-3],
+                "normal_point": [0.0, 0.0, 0.0],
+                "motion": {"mass": 0.02, "velocity": [0.0, 0.0, -250.0]},
+            }
+        ],  # fmt: skip
         "output": {"plot": False, "history_interval": 10},
     }
 
