@@ -55,6 +55,7 @@ from rwall_fem.output.folder import ResultsFolder, check_folder
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_interval
+from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
@@ -107,10 +108,11 @@ def run_in_folder(
             run_log.facts.append(
                 f"removed the outputs of an earlier run: {', '.join(folder.removed)}"
             )
-        sim.run()
-        if said is not None:
-            said(sim)
-        sim.history.wait()
+        with truthful_when_interrupted(sim):
+            sim.run()
+            if said is not None:
+                said(sim)
+            sim.history.wait()
         line = f"outputs written {time.perf_counter() - run_log.ended_at:.2f} s after the time loop"
         if run_log.frames:
             log.info("%s", line)
