@@ -10,15 +10,23 @@ wheel requires.
 from __future__ import annotations
 
 import atexit
+import contextlib
 import functools
 import importlib.util
 import inspect
 import logging
 import os
+import re
 import shutil
 import tempfile
 import time
 from pathlib import Path
+
+# PETSc puts its own handlers on SIGTERM, SIGBUS, SIGSEGV, ... when it starts (the PyPI
+# wheel's does), in place of Python's: SIGTERM would end the process through MPI_Abort
+# without a word, before rwall_fem.interrupts could say why (exit 143 or 15).
+if "-no_signal_handler" not in os.environ.get("PETSC_OPTIONS", ""):
+    os.environ["PETSC_OPTIONS"] = f"{os.environ.get('PETSC_OPTIONS', '')} -no_signal_handler"
 
 if importlib.util.find_spec("dolfinx_solver") is not None:
     import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
@@ -53,7 +61,7 @@ def vector_space(msh) -> fem.FunctionSpace:
     gdim = msh.geometry.dim
     if _MODERN:
         return fem.functionspace(msh, ("Lagrange", 1, (gdim,)))
-    return fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    return compiled(lambda: fem.VectorFunctionSpace(msh, ("Lagrange", 1)))  # FFCx's element
 
 
 def vtk_mesh(V):
@@ -109,7 +117,7 @@ def scalar_space(msh, family: str = "DG", degree: int = 0) -> fem.FunctionSpace:
     """Scalar space, e.g. piecewise constants for cell data."""
     if _MODERN:
         return fem.functionspace(msh, (family, degree))
-    return fem.FunctionSpace(msh, (family, degree))
+    return compiled(lambda: fem.FunctionSpace(msh, (family, degree)))  # FFCx's element
 
 
 def form(ufl_form) -> fem.Form:
@@ -130,23 +138,31 @@ def compiled(build):
       a private temporary folder takes its place for this process, with a warning;
     - a compiler that fails or is missing is one line (:func:`~rwall_fem.kernels.compiler_error`),
       on every rank, as for the element kernels;
-    - a stop signal during the compilation leaves the cache as a failed compilation does
-      (FFCx would otherwise wait for the lost module at its next use, then fail).
+    - a stop signal during the compilation leaves the cache as a failed compilation does:
+      FFCx would otherwise wait for the lost module at its next use, then fail;
+    - a failed compilation is tried once more, on every rank alike (DOLFINx's MPI wrapper
+      tells the ranks other than 0 only that it failed): a module that another process
+      left unfinished (killed while it compiled), which FFCx names once it has waited for
+      it in vain, is set aside first.
     """
     from rwall_fem.kernels import compiler_error
 
     cache = _form_cache()
-    started = time.time()
-    try:
-        return build()
-    except KeyboardInterrupt:
-        _drop_unfinished(cache, started)
-        raise
-    except Exception as err:
-        if not _compiler_failed(err):
+    for attempt in (1, 2):
+        started = time.time()
+        try:
+            return build()
+        except KeyboardInterrupt:
+            _drop_unfinished(cache, started)
             raise
-        lines = str(err).strip().splitlines() or [type(err).__name__]
-        raise compiler_error("DOLFINx's forms (FFCx)", lines[-1]) from None
+        except Exception as err:
+            if not _compiler_failed(err):
+                raise
+            if attempt == 1:
+                _set_aside_timed_out(" ".join(str(err).split()))
+                continue
+            detail = (str(err).strip().splitlines() or [type(err).__name__])[-1]
+            raise compiler_error("DOLFINx's forms (FFCx)", detail) from None
 
 
 @functools.cache
@@ -188,6 +204,15 @@ def _compiler_failed(err: BaseException) -> bool:
             return True
         err = err.__cause__ or err.__context__
     return False
+
+
+def _set_aside_timed_out(message: str) -> None:
+    """Rename as failed the unfinished C file that FFCx names when ``message`` says that
+    it waited for it in vain."""
+    named = re.search(r"timed out.*remove (\S+\.c)\)", message)
+    if named:
+        with contextlib.suppress(OSError):
+            Path(named[1]).replace(Path(named[1] + ".failed"))
 
 
 def _drop_unfinished(cache: Path, since: float) -> None:

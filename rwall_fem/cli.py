@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import functools
 import logging
-import os
 import sys
 import time
 
@@ -150,14 +149,13 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _leave_the_job() -> None:
-    """After a stop signal outside the time loop, end a process of a job of several MPI
-    ranks at once: the others may be anywhere, even in a collective call that would keep
-    this one in MPI's finalisation for ever; the launcher then ends them."""
+    """After a stop signal outside the time loop, a process of a job of several MPI ranks
+    ends at once (:func:`rwall_fem.interrupts.leave`): the others may be anywhere."""
+    from rwall_fem import interrupts
+
     MPI = sys.modules.get("mpi4py.MPI")
     if MPI is not None and MPI.Is_initialized() and MPI.COMM_WORLD.size > 1:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(3)
+        interrupts.leave(3)
 
 
 def _set_up_logging(quiet: bool, rank: int) -> None:

@@ -42,12 +42,14 @@ __all__ = [
     "adopt",
     "at_once",
     "handling",
+    "leave",
     "on_emergency",
     "stop_children",
 ]
 
 CHILD_SECONDS = 1.0  # wall time a child has to end after SIGTERM, before SIGKILL, s
 GRACE_SECONDS = 3.0  # wall time the main thread has to end after a signal, s
+LINGER_SECONDS = 0.3  # wall time a rank other than 0 leaves rank 0 to say why, s
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 REASONS = {"SIGINT": "interrupted (SIGINT, Ctrl-C)", "SIGTERM": "terminated by SIGTERM"}
 _RANK_VARIABLES = ("OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK")
@@ -115,9 +117,10 @@ class _Handling:
                 continue
             name = signal.Signals(number).name
             started = time.monotonic()
-            while not self.ended.wait(0.05):
+            while not self.ended.is_set():
                 if self.abrupt or time.monotonic() - started > GRACE_SECONDS:
                     self._emergency(self.received or name)
+                self.ended.wait(0.05)
 
     def _emergency(self, name: str) -> None:
         """End the process from the watcher thread: the main thread is stuck in C code."""
@@ -127,9 +130,7 @@ class _Handling:
             with contextlib.suppress(Exception):
                 reason = cleanup(reason) or reason
         self.say(reason)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(3)
+        leave(3)
 
     def say(self, reason: str) -> None:
         """The one line, from rank 0, once."""
@@ -193,6 +194,18 @@ def on_emergency(cleanup):
         yield
     finally:
         active.cleanups.remove(cleanup)
+
+
+def leave(code: int) -> None:
+    """End this process now, without MPI's finalisation (another rank may be anywhere, even
+    in a collective call that would keep this one there for ever; the launcher ends the
+    others). A rank other than 0 waits :data:`LINGER_SECONDS` first: Open MPI's ``mpirun``
+    stops passing on the output of rank 0 once another rank has ended."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if rank() != 0:
+        time.sleep(LINGER_SECONDS)
+    os._exit(code)
 
 
 def adopt(pid: int) -> None:

@@ -30,6 +30,7 @@ import io
 import logging
 import os
 import platform
+import re
 import shutil
 import sys
 import tempfile
@@ -147,11 +148,15 @@ def _digest(path: Path) -> str:
 def _cached(name: str, folder: Path) -> Path | None:
     """A library ``<name>.<digest>.so`` of ``folder`` whose bytes have that digest: one cut
     short (a full disk, a kill while it was copied) or changed would fail to load, or
-    crash the process with SIGBUS when a page of it is missing. Libraries that fail the
-    check (and those of older versions, named otherwise) are removed if possible."""
+    crash the process with SIGBUS when a page of it is missing. A library that fails the
+    check is removed if possible (libraries named otherwise, of older versions, are left
+    to the processes that may use them)."""
     for path in sorted(folder.glob(f"{name}.*.so")):
+        digest = path.name.removeprefix(f"{name}.").removesuffix(".so")
+        if not re.fullmatch(r"[0-9a-f]{16}", digest):
+            continue
         try:
-            if path.name == f"{name}.{_digest(path)}.so":
+            if _digest(path) == digest:
                 return path
             path.unlink()
         except OSError:
