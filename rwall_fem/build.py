@@ -420,7 +420,8 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
     where = f"{scene.source}: wall[{i}]"
     point = np.asarray(spec.point)
     noise = scene.mesh.noise if scene.mesh is not None else None
-    if spec.motion is not None and noise is not None:
+    moved = spec.motion is not None and noise is not None
+    if moved:
         # The main node is a node of the model: noise moves it too, with an id no mesh
         # node has. The wall's orientation follows where it is defined from M.
         point = point + coordinate_noise([2**62 + i], *noise)[0]
@@ -428,7 +429,7 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
     try:
         shape = SHAPES[spec.kind](point, **arguments)
     except ValueError as err:
-        raise SceneError(f"{where}: {err} (after coordinate noise)") from None
+        raise SceneError(f"{where}: {err}{' (after coordinate noise)' if moved else ''}") from None
 
     motion = None
     if spec.motion is not None:

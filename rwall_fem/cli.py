@@ -105,20 +105,23 @@ def _command(argv: list[str] | None) -> int:
     with np.errstate(all="ignore"):
         try:
             if args.command == "study":
-                return _study(args.out, args.quick, comm)
-            if args.command == "check":
-                return _check(args.scene, args.overrides, comm, args.lift_limits)
-            summary = _run(
-                args.scene, args.out, args.overrides, comm, quiet, args.lift_limits, args.resume
-            )
+                code = _study(args.out, args.quick, comm)
+            elif args.command == "check":
+                code = _check(args.scene, args.overrides, comm, args.lift_limits)
+            else:
+                summary = _run(
+                    args.scene, args.out, args.overrides, comm, quiet, args.lift_limits,
+                    args.resume,
+                )  # fmt: skip
+                code = 0 if summary["status"] == "done" else 3
         except (SceneError, CheckpointError, KernelBuildError) as err:
             if comm.rank == 0:
                 print(f"rwall-fem: error: {err}", file=sys.stderr)
-            return 2
+            code = 2
         except (OutputError, OSError) as err:
             if comm.rank == 0:
                 print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
-            return 4
+            code = 4
         except Exception:
             if comm.size == 1:
                 raise
@@ -128,7 +131,11 @@ def _command(argv: list[str] | None) -> int:
             traceback.print_exc()
             print(f"rwall-fem: error: internal error on rank {comm.rank}", file=sys.stderr)
             comm.Abort(1)
-    return 0 if summary["status"] == "done" else 3
+    # Rank 0 draws the pictures alone: the others wait for it here, where a stop signal is
+    # still handled, rather than in MPI's finalisation, where SIGTERM would end them and
+    # their launcher would kill rank 0 before it could stop its renderer and say why.
+    comm.Barrier()
+    return code
 
 
 class _Parser(argparse.ArgumentParser):

@@ -150,6 +150,8 @@ def _stored(directory: Path):
 def _npz(path: Path, names: tuple[str, ...]) -> dict:
     """Every array of the ``.npz`` file ``path``, read now (a cut file fails here, not
     later), which must have ``names``; ValueError (or OSError) otherwise."""
+    if not zipfile.is_zipfile(path):
+        raise ValueError(f"not a whole .npz file ({path.stat().st_size} bytes, cut short?)")
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {name: npz[name] for name in npz.files}

@@ -76,7 +76,8 @@ class CsvTable:
         self._pending.clear()
 
     def _give_up(self, whole: int) -> None:
-        """Cut the file back to ``whole`` bytes and write no more to it."""
+        """Cut the file after its last whole line (at least ``whole`` bytes, what it held
+        before the failed write) and write no more to it."""
         self._closed = True
         self._pending.clear()
         if self._file is None:
@@ -84,8 +85,9 @@ class CsvTable:
         with contextlib.suppress(OSError):  # its buffer cannot be written: whatever is, is cut
             self._file.close()
         self._file = None
-        with contextlib.suppress(OSError):
-            os.truncate(self.path, whole)
+        with contextlib.suppress(OSError), open(self.path, "rb+") as file:
+            file.seek(whole)
+            file.truncate(whole + file.read().rfind(b"\n") + 1)
 
     def resume(self, count: int) -> tuple | None:
         """Continue the table of a resumed run after the first ``count`` rows of its file;

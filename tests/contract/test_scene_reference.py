@@ -104,6 +104,10 @@ BEYOND = {
     "74_wall_secondary_all_excluded",
     "75_mesh_file_noise_not_small",
     "76_mesh_file_above_max_cells",
+    "100_hourglass_on_a_tetrahedral_mesh_file",
+    "101_hourglass_coefficient_on_a_tetrahedral_mesh_file",
+    "102_reduced_on_a_tetrahedral_mesh_file",
+    "104_wall_points_overflow",
 }
 
 
