@@ -7,10 +7,11 @@
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
-checkpoint that does not fit the scene), 3 run stopped by a guard, SIGTERM or SIGINT
-(Ctrl-C) (one line on stderr; the outputs up to the stop are kept, and a checkpoint of
-the step), 4 an output could not be written at the end of the run (one line on stderr;
-the others are written).
+mistake on the command line, a checkpoint that does not fit the scene, code the C
+compiler cannot build), 3 run stopped by a guard, SIGTERM or SIGINT (Ctrl-C) (one line
+on stderr; the outputs up to the stop are kept, and a checkpoint of the step), or a
+command stopped by one of them at any other stage (:mod:`rwall_fem.interrupts`), 4 an
+output could not be written (one line on stderr naming it; the others are written).
 
 Messages: facts on stdout, warnings and errors on stderr, each line starting with
 ``rwall-fem:``; only rank 0 speaks. ``--quiet`` keeps warnings and errors. While a run
