@@ -50,6 +50,7 @@ from rwall_fem.output.folder import ResultsFolder, check_folder
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_schedule
+from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
@@ -103,10 +104,11 @@ def run_in_folder(
             run_log.facts.append(
                 f"removed the outputs of an earlier run: {', '.join(folder.removed)}"
             )
-        sim.run()
-        if said is not None:
-            said(sim)
-        sim.history.wait()
+        with truthful_when_interrupted(sim):
+            sim.run()
+            if said is not None:
+                said(sim)
+            sim.history.wait()
         line = f"outputs written {time.perf_counter() - run_log.ended_at:.2f} s after the time loop"
         if run_log.frames:
             log.info("%s", line)
@@ -407,7 +409,8 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
     where = f"{scene.source}: wall[{i}]"
     point = np.asarray(spec.point)
     noise = scene.mesh.noise if scene.mesh is not None else None
-    if spec.motion is not None and noise is not None:
+    moved = spec.motion is not None and noise is not None
+    if moved:
         # The main node is a node of the model: noise moves it too, with an id no mesh
         # node has. The wall's orientation follows where it is defined from M.
         point = point + coordinate_noise([2**62 + i], *noise)[0]
@@ -415,7 +418,7 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
     try:
         shape = SHAPES[spec.kind](point, **arguments)
     except ValueError as err:
-        raise SceneError(f"{where}: {err} (after coordinate noise)") from None
+        raise SceneError(f"{where}: {err}{' (after coordinate noise)' if moved else ''}") from None
 
     motion = None
     if spec.motion is not None:

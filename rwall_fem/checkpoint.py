@@ -38,7 +38,7 @@ from mpi4py import MPI
 
 from rwall_fem.output import OutputError
 
-__all__ = ["CheckpointError", "Checkpoints", "body_digest", "scene_keys"]
+__all__ = ["CheckpointError", "Checkpoints", "body_digest", "latest_checkpoint", "scene_keys"]
 
 log = logging.getLogger("rwall_fem")
 
@@ -135,17 +135,23 @@ class Checkpoints:
                     "no checkpoint at step %d: NaN or Inf in the state (kept: %s)", s.step, kept
                 )
             return
-        arrays = {
-            f"{name}/{key}": np.asarray(value)
-            for name, piece in sim.stateful.items()
-            for key, value in piece.checkpoint_state().items()
-        }
+        arrays, failure = {}, None
+        try:  # a piece flushes its outputs first, which may fail on rank 0 alone
+            arrays = {
+                f"{name}/{key}": np.asarray(value)
+                for name, piece in sim.stateful.items()
+                for key, value in piece.checkpoint_state().items()
+            }
+        except OutputError as err:
+            failure = str(err)
+        self._agree_outputs(failure)
         header = self.identity | {"step": s.step, "time": s.t, "rank": comm.rank}
         partial = self.directory / "partial"
-        self._together(lambda: _empty_directory(partial), rank0=True)
-        self._together(lambda: _write(partial / f"rank_{comm.rank}.npz", header, arrays))
+        mine = partial / f"rank_{comm.rank}.npz"
+        self._together(lambda: _empty_directory(partial), partial, rank0=True)
+        self._together(lambda: _write(mine, header, arrays), mine)
         final = self.directory / f"step_{s.step:010d}"
-        self._together(lambda: _publish(partial, final), rank0=True)
+        self._together(lambda: _publish(partial, final), final, rank0=True)
         self._saved, self._since = s.step, time.monotonic()
 
     def resume(self, sim) -> None:
@@ -153,30 +159,30 @@ class Checkpoints:
         step after it. Raises :class:`CheckpointError` (one line, on every rank) when there
         is none, or when it is another scene's, rank count's, body's or version's."""
         comm = self.comm
-        latest = _latest(self.directory) if comm.rank == 0 else None
-        latest = comm.bcast(latest, root=0)
-        if latest is None:
-            raise CheckpointError(
-                f"{self.directory}: no checkpoint to resume from (a run writes one at a stop, "
-                "and every output.checkpoint_steps or _seconds)"
-            )
+        latest = latest_checkpoint(self.directory.parent, comm)
         path = Path(latest) / f"rank_{comm.rank}.npz"
         arrays, header, error = None, None, None
         try:
             with np.load(path, allow_pickle=False) as npz:
                 arrays = dict(npz)
             header = json.loads(str(arrays.pop("header")))
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:
-            error = f"{path}: cannot be read ({type(err).__name__}: {err})"
+            error = _header_problem(header)
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:
+            error = f"cannot be read ({type(err).__name__}: {' '.join(str(err).split())})"
+        if error:
+            error, header = f"{path}: {error}", None
         ranks = comm.bcast(header["ranks"] if header else None, root=0)
         if ranks is not None and ranks != comm.size:
             raise CheckpointError(
                 f"{latest}: written by a run on {ranks} rank(s); this run has {comm.size}: "
                 f"resume on {ranks}"
             )
-        self._agree(error or (header and self._differences(header, latest)))
+        self._agree(error or self._differences(header, latest))
         for name, piece in sim.stateful.items():
-            self._agree(_restore(piece, name, arrays, latest))
+            self._agree(_restore(piece, name, arrays, path))
+        if sim.state.step != header["step"]:
+            error = f"{path}: its state is of step {sim.state.step}, its header of {header['step']}"
+        self._agree(error)
         sim.first_step = header["step"] + 1
         self._saved = header["step"]
         log.info("resuming after step %d (t = %.6g s) from %s", header["step"], sim.state.t, latest)
@@ -205,30 +211,66 @@ class Checkpoints:
         if errors:
             raise CheckpointError(errors[0])
 
-    def _together(self, action, rank0: bool = False) -> None:
-        """Run ``action`` (on rank 0 only if ``rank0``); an OSError on any rank raises
-        :class:`~rwall_fem.output.OutputError` on every rank."""
+    def _together(self, action, path: Path, rank0: bool = False) -> None:
+        """Run ``action`` on ``path`` (on rank 0 only if ``rank0``); an OSError on any rank
+        raises :class:`~rwall_fem.output.OutputError`, naming the file, on every rank."""
         error = None
         if not rank0 or self.comm.rank == 0:
             try:
                 action()
             except OSError as err:
-                error = f"checkpoint: {err.filename}: {err.strerror}"
+                error = f"checkpoint: {err.filename or path}: {err.strerror}"
+        self._agree_outputs(error)
+
+    def _agree_outputs(self, error: str | None) -> None:
+        """Raise the first rank's output error, if any rank has one, on every rank."""
         errors = [e for e in self.comm.allgather(error) if e]
         if errors:
             raise OutputError(errors[0])
 
 
-def _restore(piece, name: str, arrays: dict, where) -> str | None:
-    """Give ``piece`` its arrays; a one-line error if they do not fit."""
+# The header of a checkpoint file: its keys and the types of their values.
+HEADER = {"code": str, "dolfinx": str, "scene": dict, "scene_hash": str, "body": str,
+          "ranks": int, "step": int, "time": float, "rank": int}  # fmt: skip
+
+
+def _header_problem(header) -> str | None:
+    """What makes ``header`` (read from JSON) not that of a checkpoint, or None."""
+    if not isinstance(header, dict):
+        return f"its header is {type(header).__name__}, not a checkpoint's (an object)"
+    for key, kind in HEADER.items():
+        value = header.get(key)
+        if kind is float and isinstance(value, int):
+            value = float(value)
+        if not isinstance(value, kind) or isinstance(value, bool):
+            return f"its header has no {key} (a {kind.__name__}): not a checkpoint's"
+    if header["step"] < 0 or header["ranks"] < 1:
+        return f"its header has step {header['step']} on {header['ranks']} rank(s)"
+    return None
+
+
+def _restore(piece, name: str, arrays: dict, path: Path) -> str | None:
+    """Give ``piece`` its arrays from the file ``path``; a one-line error naming the file
+    if they do not fit. What the piece would write now gives the shapes its arrays must
+    have (NumPy would spread an array of the wrong shape over the state without a word);
+    an array empty now (the contacts of a wall before its first step) may have any."""
     prefix = f"{name}/"
     mine = {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
+    for key, now in piece.checkpoint_state().items():
+        now = np.asarray(now)
+        if key not in mine:
+            return f"{path}: {name} has no {key!r} (written by another version of the code)"
+        if now.size and mine[key].shape != now.shape:
+            return (
+                f"{path}: {name}/{key} has the shape {mine[key].shape}; this run's is "
+                f"{now.shape} (the file was changed, or is another run's)"
+            )
+        if now.size and mine[key].dtype.kind not in "biuf":
+            return f"{path}: {name}/{key} holds {mine[key].dtype} values, not numbers"
     try:
         piece.restore_state(mine)
-    except KeyError as err:
-        return f"{where}: {name} has no {err} (written by another version of the code)"
-    except ValueError as err:
-        return str(err)
+    except (KeyError, ValueError, TypeError, IndexError) as err:
+        return f"{path}: {name}: {' '.join(str(err).split())}"
     return None
 
 
@@ -260,6 +302,19 @@ def _sync(directory: Path) -> None:
         os.fsync(descriptor)
     finally:
         os.close(descriptor)
+
+
+def latest_checkpoint(results: Path, comm) -> str:
+    """The latest complete checkpoint of the results folder ``results`` (every rank);
+    :class:`CheckpointError` when there is none, or no such folder."""
+    latest = _latest(Path(results) / "checkpoint") if comm.rank == 0 else None
+    latest = comm.bcast(latest, root=0)
+    if latest is None:
+        raise CheckpointError(
+            f"{Path(results) / 'checkpoint'}: no checkpoint to resume from (a run writes one "
+            "at a stop, and every output.checkpoint_steps or _seconds)"
+        )
+    return latest
 
 
 def _latest(directory: Path) -> str | None:

@@ -7,10 +7,11 @@
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
-checkpoint that does not fit the scene), 3 run stopped by a guard, SIGTERM or SIGINT
-(Ctrl-C) (one line on stderr; the outputs up to the stop are kept, and a checkpoint of
-the step), 4 an output could not be written at the end of the run (one line on stderr;
-the others are written).
+mistake on the command line, a checkpoint that does not fit the scene, code the C
+compiler cannot build), 3 run stopped by a guard, SIGTERM or SIGINT (Ctrl-C) (one line
+on stderr; the outputs up to the stop are kept, and a checkpoint of the step), or a
+command stopped by one of them at any other stage (:mod:`rwall_fem.interrupts`), 4 an
+output could not be written (one line on stderr naming it; the others are written).
 
 Messages: facts on stdout, warnings and errors on stderr, each line starting with
 ``rwall-fem:``; only rank 0 speaks. ``--quiet`` keeps warnings and errors. While a run
@@ -30,10 +31,23 @@ __all__ = ["main"]
 
 
 def main(argv: list[str] | None = None) -> int:
+    from rwall_fem import interrupts
+
+    # First of all: a Ctrl-C while the libraries load is one line too.
+    with interrupts.handling() as say:
+        try:
+            return _command(argv)
+        except interrupts.Interrupted as stop:  # outside the time loop (it stops by itself)
+            say(stop.reason)
+            _leave_the_job()
+            return 3
+
+
+def _command(argv: list[str] | None) -> int:
     from rwall_fem import __version__
     from rwall_fem.output.render import COLORS
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rwall-fem", description="Solid bodies striking rigid walls (explicit FEM on DOLFINx)."
     )
     parser.add_argument("--version", action="version", version=f"rwall-fem {__version__}")
@@ -73,14 +87,10 @@ def main(argv: list[str] | None = None) -> int:
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
     args = parser.parse_args(argv)
-    if args.command == "study":
-        from rwall_fem.study import run_study
-
-        run_study(args.out, quick=args.quick)
-        return 0
     if args.command == "render":
         return _render(args.directory, args.color)
 
+    import numpy as np
     from mpi4py import MPI
 
     from rwall_fem.checkpoint import CheckpointError
@@ -91,33 +101,69 @@ def main(argv: list[str] | None = None) -> int:
     comm = MPI.COMM_WORLD
     quiet = getattr(args, "quiet", False)
     _set_up_logging(quiet, comm.rank)
-    try:
-        if args.command == "check":
-            return _check(args.scene, args.overrides, comm, args.lift_limits)
-        summary = _run(
-            args.scene, args.out, args.overrides, comm, quiet, args.lift_limits, args.resume
-        )
-    except (SceneError, CheckpointError, KernelBuildError) as err:
-        if comm.rank == 0:
-            print(f"rwall-fem: error: {err}", file=sys.stderr)
-        return 2
-    except (OutputError, OSError) as err:
-        print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
-        return 4
-    except KeyboardInterrupt:  # Ctrl-C outside the time loop (in it, the run stops cleanly)
-        if comm.rank == 0:
-            print("rwall-fem: stopped: interrupted (SIGINT, Ctrl-C)", file=sys.stderr)
-        return 3
-    except Exception:
-        if comm.size == 1:
-            raise
-        # A failure of this rank alone: the others may wait for it in a collective call.
-        import traceback
+    # The arithmetic of a state that went NaN or Inf warns at every operation; the guards
+    # stop such a run in one line naming the step and the node, and the summary says null.
+    with np.errstate(all="ignore"):
+        try:
+            if args.command == "study":
+                code = _study(args.out, args.quick, comm)
+            elif args.command == "check":
+                code = _check(args.scene, args.overrides, comm, args.lift_limits)
+            else:
+                summary = _run(
+                    args.scene, args.out, args.overrides, comm, quiet, args.lift_limits,
+                    args.resume,
+                )  # fmt: skip
+                code = 0 if summary["status"] == "done" else 3
+        except (SceneError, CheckpointError, KernelBuildError) as err:
+            if comm.rank == 0:
+                print(f"rwall-fem: error: {err}", file=sys.stderr)
+            code = 2
+        except (OutputError, OSError) as err:
+            if comm.rank == 0:
+                print(f"rwall-fem: error: outputs: {err}", file=sys.stderr)
+            code = 4
+        except Exception:
+            if comm.size == 1:
+                raise
+            # A failure of this rank alone: the others may wait for it in a collective call.
+            import traceback
 
-        traceback.print_exc()
-        print(f"rwall-fem: error: internal error on rank {comm.rank}", file=sys.stderr)
-        comm.Abort(1)
-    return 0 if summary["status"] == "done" else 3
+            traceback.print_exc()
+            print(f"rwall-fem: error: internal error on rank {comm.rank}", file=sys.stderr)
+            comm.Abort(1)
+    # Rank 0 draws the pictures alone: the others wait for it here, where a stop signal is
+    # still handled, rather than in MPI's finalisation, where SIGTERM would end them and
+    # their launcher would kill rank 0 before it could stop its renderer and say why.
+    comm.Barrier()
+    return code
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, with its errors in one line (its usage text is what ``--help`` prints),
+    from rank 0 only."""
+
+    def error(self, message: str):
+        from rwall_fem.interrupts import rank
+
+        if rank() == 0:
+            name = self.prog.removeprefix("rwall-fem").strip()
+            where = f"{name}: " if name else ""
+            print(
+                f"rwall-fem: error: {where}{message} (see {self.prog} --help)",
+                file=sys.stderr,
+            )
+        sys.exit(2)
+
+
+def _leave_the_job() -> None:
+    """After a stop signal outside the time loop, a process of a job of several MPI ranks
+    ends at once (:func:`rwall_fem.interrupts.leave`): the others may be anywhere."""
+    from rwall_fem import interrupts
+
+    MPI = sys.modules.get("mpi4py.MPI")
+    if MPI is not None and MPI.Is_initialized() and MPI.COMM_WORLD.size > 1:
+        interrupts.leave(3)
 
 
 def _set_up_logging(quiet: bool, rank: int) -> None:
@@ -169,11 +215,16 @@ class _WarningsOnly(logging.Filter):
 
 
 def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resume: bool) -> dict:
+    from pathlib import Path
+
     from rwall_fem.build import build_simulation, run_in_folder
+    from rwall_fem.checkpoint import latest_checkpoint
     from rwall_fem.output.run_log import CycleLines, cycle_schedule
     from rwall_fem.scene import load_scene
 
     scene = load_scene(scene_file, overrides)
+    if resume:  # before meshing, and before the folder is made
+        latest_checkpoint(Path(out) if out is not None else scene.output.directory, comm)
     sim = build_simulation(scene, comm, out, limits=not lift_limits)
     if comm.rank == 0 and not quiet:
         if sys.stderr.isatty():
@@ -185,6 +236,18 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
             sim.recorders.append(CycleLines(sys.stderr, schedule))
     run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet), resume=resume)
     return sim.history.summary
+
+
+def _study(out: str, quick: bool, comm) -> int:
+    """``rwall-fem study``: its folder checked first, as a run's is."""
+    from pathlib import Path
+
+    from rwall_fem.output.folder import check_folder
+    from rwall_fem.study import run_study
+
+    check_folder(Path(out), "--out", comm)
+    run_study(out, quick=quick, comm=comm)
+    return 0
 
 
 def _say_how_it_ended(sim, quiet: bool) -> None:

@@ -62,20 +62,29 @@ class Technology:
         cls,
         cell: str,
         integration=None,
-        hourglass: str = "physical",
+        hourglass=None,
         coefficient=None,
         *,
         plastic: bool = False,
     ) -> Technology:
         """The technology for ``cell`` from a scene's ``[element]`` choices: ``integration``
-        None means the default of the cell type; ``hourglass`` and ``coefficient`` (None:
-        the default of the form, and of an elasto-plastic body when ``plastic``) only
-        matter with reduced integration.
+        None means the default of the cell type; ``hourglass`` (None: "physical") and
+        ``coefficient`` (None: the default of the form, and of an elasto-plastic body when
+        ``plastic``) only matter with reduced integration, and may not be given for
+        tetrahedra (a mesh file's cells are known only here).
 
         Raises ValueError (one line, naming the key) for a combination that does not exist.
         """
         if cell not in CELLS:
             raise ValueError(f"no element technology for {cell} cells; allowed: {CELLS}")
+        if integration is None and cell == "tetrahedron":
+            for name, value in (("hourglass", hourglass), ("hourglass_coefficient", coefficient)):
+                if value is not None:
+                    raise ValueError(
+                        f"element.{name}: needs integration = 'reduced', and tetrahedra are "
+                        "integrated 'full' (P1, one exact point): leave it out"
+                    )
+        hourglass = hourglass or "physical"
         if integration is None:
             integration = "reduced" if cell == "hexahedron" else "full"
         if integration == "reduced" and cell == "tetrahedron":

@@ -69,7 +69,7 @@ def lumped_mass(V, density: float) -> np.ndarray:
     """
     w = ufl.TestFunction(V)
     ones = ufl.as_vector([1.0] * V.mesh.geometry.dim)
-    b = fem.petsc.assemble_vector(fem.form(density * ufl.inner(ones, w) * ufl.dx))
+    b = fem.petsc.assemble_vector(_compat.form(density * ufl.inner(ones, w) * ufl.dx))
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     mass = b.array.reshape(-1, V.dofmap.index_map_bs)[:, 0].copy()
     b.destroy()
@@ -85,7 +85,7 @@ def lumped_mass(V, density: float) -> np.ndarray:
 def stiffness_form(V, material: Material) -> fem.Form:
     """The compiled small-strain stiffness form a(u, w) = int sigma(u) : eps(w) dx on ``V``."""
     u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-    return fem.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx)
+    return _compat.form(ufl.inner(stress(u, material), strain(w)) * ufl.dx)
 
 
 class _ScaledStiffness:

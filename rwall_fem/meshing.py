@@ -7,14 +7,17 @@ boundary node sets by name.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.resources
+import signal
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
-from rwall_fem import _compat
+from rwall_fem import _compat, interrupts
 
 __all__ = [
     "BodyMesh",
@@ -233,15 +236,50 @@ def read_mesh(
     a mesh, no cells, mixed cell types, more than ``max_cells`` cells: a
     :class:`MeshTooLarge`) reaches every rank as the same ``ValueError`` of one line,
     before any collective call that the others would wait in for ever.
-    """
-    import gmsh
 
+    Nothing here needs undoing: a stop signal ends the process at once
+    (:func:`rwall_fem.interrupts.at_once`), even while gmsh's C code runs.
+    """
+    with interrupts.at_once(), _sigint_kept() as keep:
+        return _read_mesh(comm, path, parameters, max_cells, keep)
+
+
+def gmsh_module():
+    """The gmsh module, imported without losing the SIGINT handler in place."""
+    with _sigint_kept() as keep:
+        import gmsh
+
+        keep()
+    return gmsh
+
+
+@contextlib.contextmanager
+def _sigint_kept():
+    """Keep the SIGINT handler of the main thread, which gmsh sets to end the process at
+    once and silently when it is imported (4.8) or initialised (4.15), putting back on
+    finalize what it found then; yields a function that puts it back now."""
+    main = threading.current_thread() is threading.main_thread()
+    handler = signal.getsignal(signal.SIGINT) if main else None
+
+    def keep():
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+
+    try:
+        yield keep
+    finally:
+        keep()
+
+
+def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
+    gmsh = gmsh_module()
     groups, error, cells = None, None, 0
     if comm.rank == 0:
         argv = [""]
         for name, value in (parameters or {}).items():
             argv += ["-setnumber", name, repr(float(value))]
         gmsh.initialize(argv, readConfigFiles=False)
+        keep()
         try:
             groups = _gmsh_model(Path(path))
             cells = sum(len(tags) for tags in gmsh.model.mesh.getElements(3)[1])

@@ -37,12 +37,15 @@ def git_hash() -> str | None:
 def library_versions() -> dict[str, str]:
     """Python, DOLFINx, PETSc, SLEPc, MPI, mpi4py, NumPy and gmsh versions."""
     import dolfinx
-    import gmsh
     import mpi4py
     import numpy
     import slepc4py
     from mpi4py import MPI
     from petsc4py import PETSc
+
+    from rwall_fem.meshing import gmsh_module
+
+    gmsh = gmsh_module()  # as meshing imports it: a first import here would lose Ctrl-C
 
     def dotted(version) -> str:
         return ".".join(map(str, version[:3]))

@@ -14,7 +14,11 @@ over a batch of cells become SIMD instructions without an OpenMP runtime.
 
 Each compile happens in a private temporary folder and the finished module is
 moved into the cache with one atomic rename, so concurrent processes (MPI ranks
-starting together) never load a half-written file.
+starting together) never load a half-written file. Its name carries the digest of
+its bytes, checked before it is loaded: a library cut short (a full disk) or changed
+is removed and built again, never loaded. A cache folder that cannot be written (a
+read-only file system, another user's) gives way to a private temporary folder, and a
+warning says that each run compiles.
 """
 
 from __future__ import annotations
@@ -23,14 +27,27 @@ import contextlib
 import hashlib
 import importlib.util
 import io
+import logging
 import os
 import platform
+import re
+import shutil
 import sys
 import tempfile
 from functools import cache
 from pathlib import Path
 
-__all__ = ["HOURGLASS", "MODELS", "POINT_SLOTS", "STEP_SLOTS", "KernelBuildError", "load"]
+__all__ = [
+    "HOURGLASS",
+    "MODELS",
+    "POINT_SLOTS",
+    "STEP_SLOTS",
+    "KernelBuildError",
+    "compiler_error",
+    "load",
+]
+
+log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "tetrahedron.c", "hexahedron.c",
            "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
@@ -106,7 +123,8 @@ void central_difference(int64_t n, double dt_v, double dt, const double *mass, c
 
 
 class KernelBuildError(RuntimeError):
-    """The C compiler could not build the element kernels; the message is one line."""
+    """The C compiler could not build compiled code (the element kernels, DOLFINx's forms);
+    the message is one line."""
 
 
 def _cache_dir() -> Path:
@@ -145,8 +163,68 @@ def _import(name: str, path: Path):
     return module
 
 
-def _compile(name: str, flags: list[str], folder: Path) -> Path:
-    """Compile the kernels as extension module ``name`` into ``folder``; returns its path."""
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+def _cached(name: str, folder: Path) -> Path | None:
+    """A library ``<name>.<digest>.so`` of ``folder`` whose bytes have that digest: one cut
+    short (a full disk, a kill while it was copied) or changed would fail to load, or
+    crash the process with SIGBUS when a page of it is missing. A library that fails the
+    check is removed if possible (libraries named otherwise, of older versions, are left
+    to the processes that may use them)."""
+    for path in sorted(folder.glob(f"{name}.*.so")):
+        digest = path.name.removeprefix(f"{name}.").removesuffix(".so")
+        if not re.fullmatch(r"[0-9a-f]{16}", digest):
+            continue
+        try:
+            if _digest(path) == digest:
+                return path
+            path.unlink()
+        except OSError:
+            continue
+    return None
+
+
+def _writable(folder: Path) -> Path:
+    """A new empty folder inside ``folder`` (made if needed) to build in; OSError if
+    ``folder`` cannot be written (read-only, a file in its way, no space)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=".build-", dir=folder))
+
+
+def _build(name: str, flags: list[str], folder: Path) -> tuple[Path, Path | None]:
+    """Compile the kernels as extension module ``name`` and publish the library in
+    ``folder`` under its digest (one atomic rename: a concurrent process sees all of it
+    or nothing). Returns its path, and the private temporary folder to remove once it is
+    loaded when ``folder`` cannot be written."""
+    private = None
+    try:
+        work = _writable(folder)
+    except OSError as err:
+        log.warning(
+            "the kernel cache %s cannot be written (%s): the kernels are compiled for this "
+            "process only (set RWALL_FEM_CACHE to a folder it can write)",
+            folder,
+            err.strerror,
+        )
+        private = folder = Path(tempfile.mkdtemp(prefix="rwall_fem_kernels_"))
+        work = _writable(folder)
+    try:
+        built = _compile(name, flags, work)
+        final = folder / f"{name}.{_digest(built)}.so"
+        os.replace(built, final)
+    except BaseException:
+        if private is not None:
+            shutil.rmtree(private, ignore_errors=True)
+        raise
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return final, private
+
+
+def _compile(name: str, flags: list[str], work: Path) -> Path:
+    """Compile the kernels as extension module ``name`` in the folder ``work``."""
     import cffi
 
     ffi = cffi.FFI()
@@ -154,36 +232,40 @@ def _compile(name: str, flags: list[str], folder: Path) -> Path:
     here = Path(__file__).parent
     source = "".join(f'#include "{n}"\n' for n in SOURCES if n.endswith(".c"))
     ffi.set_source(name, source, include_dirs=[str(here)], extra_compile_args=flags)
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder) as work:
-        # setuptools reports each compiler command on stdout: keep it out of the run's output.
-        with contextlib.redirect_stdout(io.StringIO()):
-            built = Path(ffi.compile(tmpdir=work, verbose=False))
-        final = folder / built.name
-        os.replace(built, final)  # atomic: a concurrent process sees all of it or nothing
-    return final
+    # setuptools reports each compiler command on stdout: keep it out of the run's output.
+    with contextlib.redirect_stdout(io.StringIO()):
+        return Path(ffi.compile(tmpdir=str(work), verbose=False))
+
+
+def compiler_error(what: str, detail: str) -> KernelBuildError:
+    """The one line of a compilation of ``what`` that failed with ``detail``."""
+    return KernelBuildError(
+        f"could not compile {what} with the C compiler {os.environ.get('CC', 'cc')} "
+        f"({detail}): install gcc (Debian: apt-get install gcc libc6-dev) or set CC to a C "
+        "compiler"
+    )
 
 
 @cache
 def load():
-    """The compiled kernels ``(ffi, lib)``, built on first use (a few seconds) and cached."""
+    """The compiled kernels ``(ffi, lib)``: the cached library if it passes its check, else
+    built (a few seconds) and cached; without a cache that can be written, built for this
+    process alone. :class:`KernelBuildError` (one line) when no flag set compiles."""
     failures = []
     for flags in FLAG_SETS:
         name = f"_rwall_kernels_{_key(flags)}"
-        folder = _cache_dir()
-        found = sorted(folder.glob(f"{name}.*.so")) + sorted(folder.glob(f"{name}.so"))
+        path, private = _cached(name, _cache_dir()), None
         try:
-            path = found[0] if found else _compile(name, flags, folder)
-        except PermissionError:  # a read-only cache: compile for this process only
-            path = _compile(name, flags, Path(tempfile.mkdtemp(prefix="rwall_fem_kernels_")))
+            if path is None:
+                path, private = _build(name, flags, _cache_dir())
         except Exception as err:  # the compiler's failure, whatever setuptools wraps it in
             lines = str(err).strip().splitlines() or [type(err).__name__]
             failures.append(f"{' '.join(flags[:2])}: {lines[-1]}")
             continue
-        module = _import(name, path)
+        try:
+            module = _import(name, path)
+        finally:
+            if private is not None:  # the loaded library stays mapped
+                shutil.rmtree(private, ignore_errors=True)
         return module.ffi, module.lib
-    raise KernelBuildError(
-        "could not compile the element kernels with the C compiler "
-        f"{os.environ.get('CC', 'cc')} ({'; '.join(failures)}): install gcc (Debian: "
-        "apt-get install gcc libc6-dev) or set CC to a C compiler"
-    )
+    raise compiler_error("the element kernels", "; ".join(failures))

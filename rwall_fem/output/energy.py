@@ -66,7 +66,7 @@ class EnergyBalance:
         )  # fmt: skip
         self.initial = initial  # E0, J
         self.reference = initial  # E_ref so far, J
-        self.max_error = 0.0  # largest |balance error| so far
+        self.max_error = 0.0  # largest finite |balance error| so far
         self.latest: dict[str, float] | None = None  # the latest sample, by column
 
     @property
@@ -98,7 +98,8 @@ class EnergyBalance:
         for name in self.works:
             balance -= energies[name]
         error = (balance - self.initial) / max(self.reference, np.finfo(float).tiny)
-        self.max_error = max(self.max_error, abs(error))
+        if np.isfinite(error):  # a NaN or Inf step says nothing of the balance before it
+            self.max_error = max(self.max_error, abs(error))
         row = (
             t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error,
             stored, 100.0 * error, dt, *((extras or {})[name] for name in self.extras),

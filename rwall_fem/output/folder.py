@@ -15,6 +15,7 @@ Every rank learns rank 0's outcome (one broadcast), so all of them refuse alike.
 
 from __future__ import annotations
 
+import errno
 import os
 import shutil
 import socket
@@ -22,6 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from rwall_fem import interrupts
 from rwall_fem.scene import SceneError
 
 __all__ = ["LOCK", "STALE", "ResultsFolder", "check_folder"]
@@ -75,17 +77,31 @@ class ResultsFolder:
         self.directory, self.comm, self.fresh = Path(directory), comm, fresh
         self.lock = self.directory / LOCK
         self.removed: list[str] = []
+        self._emergency = None
 
     def __enter__(self) -> ResultsFolder:
         error = None
         if self.comm.rank == 0:
             try:
-                self.directory.mkdir(parents=True, exist_ok=True)
+                if self.fresh:
+                    self.directory.mkdir(parents=True, exist_ok=True)
+                elif not self.directory.is_dir():  # a resume makes nothing
+                    raise FileNotFoundError(errno.ENOENT, "no such folder, nothing to resume")
                 error = self._take_lock()
             except OSError as err:
-                error = f"cannot create {self.directory} ({err.strerror})"
-            if error is None and self.fresh:
-                self.removed = self._remove_stale()
+                verb = "create" if self.fresh else "resume in"
+                error = f"cannot {verb} {self.directory} ({err.strerror})"
+            if error is None:
+                # A stop signal while a long C call holds the main thread: the watcher
+                # ends the process, and removes the lock first.
+                self._emergency = interrupts.on_emergency(self._drop_lock)
+                self._emergency.__enter__()
+                try:
+                    if self.fresh:
+                        self.removed = self._remove_stale()
+                except BaseException:
+                    self.__exit__()
+                    raise
         error = self.comm.bcast(error, root=0)
         if error:
             raise SceneError(error)
@@ -93,8 +109,14 @@ class ResultsFolder:
 
     def __exit__(self, *exc) -> bool:
         if self.comm.rank == 0:
-            self.lock.unlink(missing_ok=True)
+            self._drop_lock()
+            if self._emergency is not None:
+                self._emergency.__exit__(None, None, None)
+                self._emergency = None
         return False
+
+    def _drop_lock(self, reason: str | None = None) -> None:
+        self.lock.unlink(missing_ok=True)
 
     def _take_lock(self) -> str | None:
         """Create the lock file (atomically); None, or why the folder is in use."""

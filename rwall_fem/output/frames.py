@@ -57,6 +57,7 @@ class Frames:
         self.walls, self.color = walls, color
         self._field = fem.Function(V)
         self._count = 0
+        self._failed = False  # a frame could not be written (rank 0): no more are
         topology, cell_types, points = _compat.vtk_mesh(V)
         mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
         self._mesh = mesh
@@ -94,13 +95,16 @@ class Frames:
         return self.steps.due(s)
 
     def _save_mesh(self) -> None:
-        self.data.mkdir(parents=True, exist_ok=True)
+        try:
+            self.data.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise OutputError(f"{self.data}: cannot be made ({err.strerror})") from None
         for stale in [*self.data.glob("frame_*.npz"), *self.data.parent.glob("frame_*.png")]:
             stale.unlink()  # a previous run into the same directory
         walls_info = [{"kind": w.shape.kind, **w.shape.parameters()} for w in self.walls]
         topology, cell_types, points = self._mesh
-        np.savez(
-            self.data / "mesh.npz",
+        self._save(
+            "mesh.npz",
             topology=topology,
             cell_types=cell_types,
             points=points,
@@ -113,13 +117,27 @@ class Frames:
         self.steps.taken(s)
         u, v = self._nodal(s.u), self._nodal(s.v)
         cells = {f"cell_{k}": self._cells(a) for k, a in sim.internal.cell_fields(s).items()}
-        if self.comm.rank == 0:
-            if not self._count:
-                self._save_mesh()
-            offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
-            path = self.data / f"frame_{self._count:04d}.npz"
-            np.savez(path, t=s.t, u=u, v=v, offsets=offsets, **cells)
+        if self.comm.rank == 0 and not self._failed:
+            try:
+                if not self._count:
+                    self._save_mesh()
+                offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
+                name = f"frame_{self._count:04d}.npz"
+                self._save(name, t=s.t, u=u, v=v, offsets=offsets, **cells)
+            except OutputError as err:  # the history ends the run on every rank
+                self._failed = True
+                sim.history.write_failed(err)
         self._count += 1
+
+    def _save(self, name: str, **arrays) -> None:
+        """Write ``frames/data/<name>``; OutputError naming it, and no cut file left, when
+        it cannot be written (a full disk)."""
+        path = self.data / name
+        try:
+            np.savez(path, **arrays)
+        except OSError as err:
+            path.unlink(missing_ok=True)
+            raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """How many frames are stored, and the next time to store one."""
@@ -141,7 +159,7 @@ class Frames:
 
     def close(self, sim) -> None:
         """Render the stored frames into PNGs and ``animation.gif`` (rank 0)."""
-        if self.comm.rank != 0 or not self._count:
+        if self.comm.rank != 0 or not self._count or self._failed:
             return
         env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
         env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -154,6 +172,6 @@ class Frames:
         )
         if result.returncode != 0:
             lines = result.stderr.strip().splitlines() or ["no message"]
-            error = OutputError(f"rendering the frames failed: {lines[-1]}")
+            error = OutputError(f"rendering the frames into {self.data.parent} failed: {lines[-1]}")
             error.add_note(result.stderr[-2000:])  # the renderer's traceback
             raise error

@@ -19,6 +19,7 @@ MPI's ``mpirun`` sends SIGTERM one second before SIGKILL: that second is enough.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import subprocess
@@ -28,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rwall_fem import interrupts
 from rwall_fem.output import OutputError
 from rwall_fem.output.energy import EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
@@ -83,10 +85,11 @@ class History:
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
             | {"step_change_work": ()}
-            | {"signals": (len(SIGNALS),), "seconds": ()}
+            | {"signals": (len(SIGNALS),), "seconds": (), "failed": ()}
             | self.wall_table.sums,
         )
-        self._poll = _Sums(comm, {"signals": (len(SIGNALS),), "seconds": ()})
+        self._poll = _Sums(comm, {"signals": (len(SIGNALS),), "seconds": (), "failed": ()})
+        self._failure: OutputError | None = None  # an output that rank 0 could not write
         self._next_poll = 0  # the next step at which the ranks agree on stop signals
         # Step and wall time of the latest agreement (none yet: since the history was built).
         self._last: tuple[int, float] | None = None
@@ -125,6 +128,7 @@ class History:
         self.wall_table.fill(local)
         total = self._sums.reduce()
         self._plan_next_poll(s, total)
+        self._stop_if_failed(total)
 
         energies = {
             name: float(total[name]) for name in (*self.balance.stored, *self.balance.parts)
@@ -158,9 +162,24 @@ class History:
         )
 
     def _fill_agreement(self, local: dict, sim) -> None:
-        """This rank's stop signals and its wall time since the latest agreement (s)."""
+        """This rank's stop signals, its wall time since the latest agreement (s) and
+        whether it failed to write an output."""
         local["signals"][:] = [name in sim.stop_requests for name in SIGNALS]
         local["seconds"][...] = time.perf_counter() - (self._last or (0, self._built))[1]
+        failed = self._failure or next((t.error for t in self._tables if t.error), None)
+        local["failed"][...] = failed is not None
+
+    def write_failed(self, error: OutputError) -> None:
+        """An output of this rank could not be written (rank 0 writes most alone): the
+        run ends at the next agreement of the ranks, within ``POLL_SECONDS``, on every
+        rank with this error."""
+        self._failure = self._failure or error
+
+    def _stop_if_failed(self, total: dict) -> None:
+        """Raise :class:`OutputError` on every rank when any failed to write an output."""
+        if total["failed"]:
+            failed = self._failure or next((t.error for t in self._tables if t.error), None)
+            raise failed or OutputError("an output of another rank could not be written")
 
     def _plan_next_poll(self, s, total: dict) -> None:
         """The next agreement, about ``POLL_SECONDS`` of wall time ahead at the mean time
@@ -176,13 +195,17 @@ class History:
         self._fill_agreement(self._poll.local, sim)
         total = self._poll.reduce()
         self._plan_next_poll(s, total)
+        self._stop_if_failed(total)
         return bool(total["signals"].any())
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """The energy balance, the wall table, the momentum of the start and how many rows
         ``energy.csv`` and ``walls.csv`` have; both files are flushed first, so that they
-        hold those rows when the checkpoint exists."""
+        hold those rows when the checkpoint exists (OutputError if they cannot be)."""
         self._flush()
+        for table in self._tables:
+            if table.error:
+                raise table.error
         rows = [self._energy_csv.count, self._walls_csv.count]
         arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
         arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
@@ -209,9 +232,12 @@ class History:
             )
 
     def _flush(self) -> None:
+        """Write the pending rows; a file that cannot be written keeps its error, which
+        the ranks agree on at the next sample or poll."""
         self._written_at = time.monotonic()
         for table in self._tables:
-            table.flush()
+            with contextlib.suppress(OutputError):
+                table.flush()
 
     @property
     def energy(self) -> np.ndarray:
@@ -231,13 +257,25 @@ class History:
         this one is killed (Open MPI's ``mpirun`` sends SIGKILL one second after
         SIGTERM): after a stop signal it is not waited for here but in :meth:`wait`,
         once the caller has said that the run stopped.
+
+        A file that cannot be written (a full disk) keeps none of the others from being
+        written; the first such :class:`OutputError` is raised after them.
         """
         peaks = self.wall_table.peak_contacts
         self.summary = run_summary(sim, self.balance, peaks, self.initial_momentum)
+        failures = []
         for table in self._tables:
-            table.close()
+            try:
+                table.close()
+            except OutputError as err:
+                failures.append(err)
         if sim.comm.rank == 0:
-            write_summary(self.directory, self.summary)
+            try:
+                write_summary(self.directory, self.summary)
+            except OutputError as err:
+                failures.append(err)
+            if failures:
+                raise failures[0]
             if self.plot and self._energy_csv.count:
                 self._drawing = _draw_histories(self.directory)
                 if not sim.stop_requests:
@@ -251,7 +289,7 @@ class History:
         _, stderr = drawing.communicate()
         if drawing.returncode != 0:
             lines = stderr.strip().splitlines() or ["no message"]
-            error = OutputError(f"drawing histories.png failed: {lines[-1]}")
+            error = OutputError(f"drawing {self.directory / 'histories.png'} failed: {lines[-1]}")
             error.add_note(stderr[-2000:])
             raise error
 
@@ -261,7 +299,7 @@ def _draw_histories(directory: Path) -> subprocess.Popen:
     session, without the MPI variables of this process."""
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
     code = "import sys; from rwall_fem.output.plots import plot_histories as p; p(sys.argv[1])"
-    return subprocess.Popen(
+    drawing = subprocess.Popen(
         [sys.executable, "-c", code, str(directory)],
         env=env,
         stdout=subprocess.DEVNULL,
@@ -269,6 +307,8 @@ def _draw_histories(directory: Path) -> subprocess.Popen:
         text=True,
         start_new_session=True,
     )
+    interrupts.adopt(drawing.pid)  # a stop signal after the time loop stops it too
+    return drawing
 
 
 class _Sums:

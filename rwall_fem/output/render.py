@@ -18,10 +18,12 @@ import argparse
 import json
 import os
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from rwall_fem import interrupts
 from rwall_fem.output.coloring import COLORS, coloring
 from rwall_fem.output.view import choose_view, up_direction, wall_surface
 from rwall_fem.walls.shapes import shape_from_parameters
@@ -50,8 +52,7 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     import pyvista
 
     directory = Path(directory)
-    mesh, walls, paths = _stored(directory)
-    frames = [dict(np.load(path)) for path in paths]
+    mesh, walls, paths, frames = _stored(directory)
     points = mesh["points"]
     up = up_direction(mesh.get("gravity"), walls)
     try:
@@ -72,32 +73,36 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     files = []
     for path, frame, values, drawn in zip(paths, frames, paint.values, surfaces, strict=True):
         plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW)
-        grid = body_grid(pyvista, mesh, frame)
-        (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
-        plotter.add_mesh(
-            grid,
-            scalars=paint.title,
-            clim=paint.clim,
-            cmap=paint.cmap,
-            show_edges=edges,
-            edge_color="#404040",
-            line_width=0.5,
-            ambient=0.3,
-            diffuse=0.7,
-            show_scalar_bar=False,
-        )
-        _colour_bar(plotter, paint)
-        for wall, surface in zip(walls, drawn, strict=True):
-            if view.behind(wall):
-                plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
-            else:
-                plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
-        time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
-        plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
-        view.apply(plotter)
-        png = directory / "frames" / path.with_suffix(".png").name
-        plotter.screenshot(str(png))
-        plotter.close()
+        # Closed however the frame ends: a plotter that a stop signal leaves open fails in
+        # its destructor at exit, with a traceback.
+        try:
+            grid = body_grid(pyvista, mesh, frame)
+            (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
+            plotter.add_mesh(
+                grid,
+                scalars=paint.title,
+                clim=paint.clim,
+                cmap=paint.cmap,
+                show_edges=edges,
+                edge_color="#404040",
+                line_width=0.5,
+                ambient=0.3,
+                diffuse=0.7,
+                show_scalar_bar=False,
+            )
+            _colour_bar(plotter, paint)
+            for wall, surface in zip(walls, drawn, strict=True):
+                if view.behind(wall):
+                    plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
+                else:
+                    plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
+            time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
+            plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
+            view.apply(plotter)
+            png = directory / "frames" / path.with_suffix(".png").name
+            plotter.screenshot(str(png))
+        finally:
+            plotter.close()
         files.append(png)
     images = [imageio.imread(p) for p in files]
     imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
@@ -107,17 +112,63 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
 
 
 def _stored(directory: Path):
-    """The body (``mesh.npz`` as a dict), the wall shapes and the frame files that
-    ``directory`` holds; RenderError when there are none."""
+    """The body (``mesh.npz`` as a dict), the wall shapes, and the frame files that
+    ``directory`` holds with their contents; RenderError when there are none or the body
+    cannot be read. A frame file that cannot be read (cut short by a kill or a full
+    disk) or does not fit the body is left out, with a warning line."""
     data = directory / "frames" / "data"
     if not directory.is_dir():
         raise RenderError(f"{directory}: no such folder")
     paths = sorted(data.glob("frame_*.npz"))
     if not (data / "mesh.npz").is_file() or not paths:
         raise RenderError(f"{directory}: no frame data (run with output.frames > 0)")
-    mesh = dict(np.load(data / "mesh.npz"))
-    walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
-    return mesh, walls, paths
+    try:
+        mesh = _npz(data / "mesh.npz", ("topology", "cell_types", "points", "speed", "walls"))
+        walls = [shape_from_parameters(w) for w in json.loads(str(mesh["walls"]))]
+        if mesh["points"].ndim != 2 or mesh["points"].shape[1:] != (3,):
+            raise ValueError(f"points of shape {mesh['points'].shape}, not (n, 3)")
+    except (OSError, ValueError, TypeError, KeyError) as err:
+        raise RenderError(f"{data / 'mesh.npz'}: cannot be read: {_one_line(err)}") from None
+    kept, frames = [], []
+    for path in paths:
+        try:
+            frame = _npz(path, ("t", "u", "v", "offsets"))
+            for name in ("u", "v"):
+                if frame[name].shape != mesh["points"].shape:
+                    raise ValueError(f"{name} has shape {frame[name].shape}, not that of the body")
+            if frame["offsets"].shape != (len(walls), 3):
+                raise ValueError(f"offsets of {len(frame['offsets'])} walls, not {len(walls)}")
+        except (OSError, ValueError, TypeError, KeyError) as err:
+            print(
+                f"rwall-fem: warning: {path}: cannot be read, left out: {_one_line(err)}",
+                file=sys.stderr,
+            )
+            continue
+        kept.append(path)
+        frames.append(frame)
+    if not frames:
+        raise RenderError(f"{data}: no frame file can be read")
+    return mesh, walls, kept, frames
+
+
+def _npz(path: Path, names: tuple[str, ...]) -> dict:
+    """Every array of the ``.npz`` file ``path``, read now (a cut file fails here, not
+    later), which must have ``names``; ValueError (or OSError) otherwise."""
+    if not zipfile.is_zipfile(path):
+        raise ValueError(f"not a whole .npz file ({path.stat().st_size} bytes, cut short?)")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {name: npz[name] for name in npz.files}
+    except (zipfile.BadZipFile, EOFError) as err:
+        raise ValueError(f"not a whole .npz file ({err})") from None
+    missing = [name for name in names if name not in arrays]
+    if missing:
+        raise ValueError(f"no {', '.join(missing)}")
+    return arrays
+
+
+def _one_line(err: Exception) -> str:
+    return " ".join(str(err).split()) or type(err).__name__
 
 
 def body_grid(pyvista, mesh: dict, frame: dict):
@@ -198,11 +249,18 @@ def main(argv: list[str] | None = None) -> int:
         f"(default {COLORS[0]})",
     )
     args = parser.parse_args(argv)
-    try:
-        files = render_frames(args.directory, args.color)
-    except RenderError as err:
-        print(f"rwall-fem: error: {err}", file=sys.stderr)
-        return 2
+    with interrupts.handling() as say:
+        try:
+            files = render_frames(args.directory, args.color)
+        except RenderError as err:
+            print(f"rwall-fem: error: {err}", file=sys.stderr)
+            return 2
+        except interrupts.Interrupted as stop:
+            say(stop.reason)
+            return 3
+        except OSError as err:  # a picture that cannot be written
+            print(f"rwall-fem: error: outputs: {_one_line(err)}", file=sys.stderr)
+            return 4
     print(f"rwall-fem: {len(files)} frames and animation.gif in {args.directory}")
     return 0
 

@@ -13,6 +13,7 @@ MPI logs show progress.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import logging
@@ -23,6 +24,7 @@ import time
 from pathlib import Path
 from typing import TextIO
 
+from rwall_fem.output import OutputError
 from rwall_fem.output.schedule import Every, Times
 
 __all__ = ["CycleLines", "RunLog", "cycle_schedule", "scene_text"]
@@ -90,40 +92,64 @@ class RunLog:
         self.ended_at = None
         self._file = None
         self._started = None
+        self._failed = False  # the file could not be written: it is written no more
 
     def due(self, s) -> bool:
         return self.steps.due(s)
 
     def record(self, sim, s) -> None:
+        """A cycle line (rank 0). A log that cannot be written (a full disk) is no longer
+        written, and the history ends the run on every rank (it makes them agree)."""
         self.steps.taken(s)
         sim.step_size.controlling_cell()  # collective: on every rank, for the cycle lines
-        if self.comm.rank != 0:
+        if self.comm.rank != 0 or self._failed:
             return
-        if self._file is None:
-            self._start(sim)
-        line = _cycle_line(sim, s, time.perf_counter() - self._started)
-        self._write(line)
+        try:
+            if self._file is None:
+                self._start(sim)
+            line = _cycle_line(sim, s, time.perf_counter() - self._started)
+            self._write(line)
+        except OutputError as err:
+            sim.history.write_failed(err)
 
     def write(self, line: str) -> None:
         """Add ``line`` to the log (rank 0; after the run, the file is opened again)."""
-        if self.comm.rank != 0:
+        if self.comm.rank != 0 or self._failed:
             return
         if self._file is None:
-            with open(self.path, "a") as file:
-                file.write(line + "\n")
+            try:
+                with open(self.path, "a") as file:
+                    file.write(line + "\n")
+            except OSError as err:
+                raise self._failure(err) from None
         else:
             self._write(line)
 
     def _write(self, text: str) -> None:
-        self._file.write(text + "\n")
-        self._file.flush()
+        try:
+            self._file.write(text + "\n")
+            self._file.flush()
+        except OSError as err:
+            raise self._failure(err) from None
+
+    def _failure(self, err: OSError) -> OutputError:
+        """The error of a log that cannot be written, which is then written no more."""
+        self._failed = True
+        if self._file is not None:
+            with contextlib.suppress(OSError):
+                self._file.close()
+            self._file = None
+        return OutputError(f"{self.path}: cannot be written ({err.strerror})")
 
     def _start(self, sim) -> None:
         from rwall_fem import __version__
         from rwall_fem.provenance import git_hash, library_versions
 
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file = open(self.path, "a" if sim.first_step else "w")  # a resume continues it
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._file = open(self.path, "a" if sim.first_step else "w")  # a resume continues
+        except OSError as err:
+            raise self._failure(err) from None
         self._started = time.perf_counter()
         versions = ", ".join(f"{k} {v}" for k, v in library_versions().items())
         resumed = ["", f"resumed at step {sim.first_step}"] if sim.first_step else []
@@ -156,7 +182,7 @@ class RunLog:
         self.ended_at = time.perf_counter()
         if self.frames:
             log.info("rendering %d frames after the time loop", self.frames)
-        if self.comm.rank != 0:
+        if self.comm.rank != 0 or self._failed:
             return
         if self._file is None:  # the run ended before its first step
             self._start(sim)

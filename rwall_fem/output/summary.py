@@ -15,13 +15,25 @@ in m: kept there by the wall, as Radioss's starter warns).
 
 from __future__ import annotations
 
+import contextlib
 import json
+import math
+import os
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["deformed_bounds", "momentum", "run_summary", "write_summary"]
+from rwall_fem import interrupts
+from rwall_fem.output import OutputError
+
+__all__ = [
+    "deformed_bounds",
+    "momentum",
+    "run_summary",
+    "truthful_when_interrupted",
+    "write_summary",
+]
 
 
 def momentum(state, walls, comm) -> np.ndarray:
@@ -125,9 +137,84 @@ def _wall(w, peak_contacts: int, comm) -> dict:
 
 
 def write_summary(directory: Path, summary: dict) -> None:
-    """Write ``summary`` to ``directory/summary.json``."""
-    Path(directory).mkdir(parents=True, exist_ok=True)
-    (Path(directory) / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    """Write ``summary`` to ``directory/summary.json``, whole or not at all (a new file
+    renamed over the old), as strict JSON: a value that is NaN or Inf is written null,
+    and the key ``non_finite`` lists where (``energy.kinetic``, ``final_momentum[2]``).
+    Raises :class:`~rwall_fem.output.OutputError` naming the file."""
+    path = Path(directory) / "summary.json"
+    lost: list[str] = []
+    clean = _strict(summary, "", lost)
+    if lost:
+        clean["non_finite"] = lost
+    text = json.dumps(clean, indent=2, allow_nan=False) + "\n"
+    partial = path.with_name(".summary.json.partial")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial.write_text(text)
+        os.replace(partial, path)
+    except OSError as err:
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)
+        raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
+    except BaseException:  # a stop signal: no half-written file is left
+        partial.unlink(missing_ok=True)
+        raise
+
+
+def _strict(value, path: str, lost: list[str]):
+    """``value`` with its non-finite floats replaced by None, their paths added to ``lost``."""
+    if isinstance(value, dict):
+        return {k: _strict(v, f"{path}.{k}" if path else k, lost) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v, f"{path}[{i}]", lost) for i, v in enumerate(value)]
+    if isinstance(value, float) and not math.isfinite(value):
+        lost.append(path)
+        return None
+    return value
+
+
+@contextlib.contextmanager
+def truthful_when_interrupted(sim):
+    """Hold while ``sim`` runs and its outputs are finished (the history's summary may
+    already say "done"): a stop signal (a KeyboardInterrupt) that comes after the time
+    loop makes ``summary.json`` say "stopped" and why, and adds that to ``run.log``; the
+    interruption's text (its ``reason``) then says so too. So does the end of the process
+    by :mod:`rwall_fem.interrupts`' watcher, when the main thread is stuck in C code."""
+    rank = sim.comm.rank  # read here: the watcher thread must not call MPI
+
+    def record(reason: str) -> str:
+        return _record_interruption(sim, rank, reason)
+
+    with interrupts.on_emergency(record):
+        try:
+            yield
+        except KeyboardInterrupt as stop:
+            reason = record(getattr(stop, "reason", interrupts.REASONS["SIGINT"]))
+            if isinstance(stop, interrupts.Interrupted):
+                stop.reason = reason
+            raise
+
+
+def _record_interruption(sim, rank: int, reason: str) -> str:
+    """The reason of a stop signal after the time loop, written into ``summary.json``
+    and ``run.log`` (rank 0); before the history's summary exists, ``reason`` as it is."""
+    history = sim.history
+    summary = dict(history.summary) if history is not None and history.summary else None
+    if summary is None:
+        return reason
+    late = "while the outputs were being finished (pictures and histories.png may be missing)"
+    if summary["status"] == "done":
+        summary["status"] = "stopped"
+        summary["reason"] = f"{reason} after the last step, {late}"
+    else:
+        summary["reason"] = f"{summary['reason']}; then {reason} {late}"
+    history.summary = summary
+    if rank == 0:
+        with contextlib.suppress(OutputError, OSError):
+            write_summary(history.directory, summary)
+            with open(Path(history.directory) / "run.log", "a") as log:
+                log.write(f"then stopped: {summary['reason']}\n")
+    return summary["reason"]
 
 
 def _finite_or_none(x: float):

@@ -10,11 +10,14 @@ checkpoint (:meth:`CsvTable.resume`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+
+from rwall_fem.output import OutputError
 
 __all__ = ["PENDING_LINES", "CsvTable"]
 
@@ -27,6 +30,7 @@ class CsvTable:
     def __init__(self, path: Path, columns: Sequence[str], comm):
         self.path, self.columns, self.comm = Path(path), list(columns), comm
         self.count = 0  # rows so far
+        self.error: OutputError | None = None  # why the file could not be written (rank 0)
         self._pending: list[str] = []
         self._file = None
         self._closed = False
@@ -39,20 +43,51 @@ class CsvTable:
             return
         self._pending.append(_line(row))
         if len(self._pending) >= PENDING_LINES:
-            self.flush()
+            with contextlib.suppress(OutputError):  # kept in :attr:`error`
+                self.flush()
 
-    def flush(self) -> None:
-        """Write the pending lines and flush the file (rank 0); the first flush creates the
-        directory and the file with its header."""
-        if self.comm.rank != 0 or self._closed:
+    def flush(self, create: bool = False) -> None:
+        """Write the pending lines and flush the file (rank 0); the first flush with lines
+        to write (or ``create``) creates the directory and the file with its header.
+
+        When the file cannot be written (a full disk), what part of the lines reached it
+        is cut off, so that it ends with a whole line, nothing more is written to it, and
+        :class:`~rwall_fem.output.OutputError` names it (on rank 0 alone: the caller
+        makes the ranks agree), now and in :attr:`error`."""
+        if self.comm.rank != 0 or self._closed or not (self._pending or self._file or create):
             return
-        if self._file is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._file = open(self.path, "w")
-            self._file.write(",".join(self.columns) + "\n")
-        self._file.write("".join(self._pending))
-        self._file.flush()
+        whole = 0  # the size of the file up to its last whole line, bytes
+        try:
+            if self._file is None:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self._file = open(self.path, "w")
+                self._file.write(",".join(self.columns) + "\n")
+                self._file.flush()
+            whole = self._file.tell()
+            self._file.write("".join(self._pending))
+            self._file.flush()
+        except OSError as err:
+            self._give_up(whole)
+            self.error = OutputError(
+                f"{self.path}: cannot be written ({err.strerror}); it ends with the last "
+                "whole row written"
+            )
+            raise self.error from None
         self._pending.clear()
+
+    def _give_up(self, whole: int) -> None:
+        """Cut the file after its last whole line (at least ``whole`` bytes, what it held
+        before the failed write) and write no more to it."""
+        self._closed = True
+        self._pending.clear()
+        if self._file is None:
+            return
+        with contextlib.suppress(OSError):  # its buffer cannot be written: whatever is, is cut
+            self._file.close()
+        self._file = None
+        with contextlib.suppress(OSError), open(self.path, "rb+") as file:
+            file.seek(whole)
+            file.truncate(whole + file.read().rfind(b"\n") + 1)
 
     def resume(self, count: int) -> tuple | None:
         """Continue the table of a resumed run after the first ``count`` rows of its file;
@@ -77,8 +112,8 @@ class CsvTable:
         return last
 
     def close(self) -> None:
-        """Write what is left and close the file."""
-        self.flush()
+        """Write what is left and close the file (made, with its header, if no row came)."""
+        self.flush(create=True)
         if self._file is not None:
             self._file.close()
         self._closed = True
@@ -88,7 +123,7 @@ class CsvTable:
         flushes and reads the file, the others receive it (collective)."""
         rows = None
         if self.comm.rank == 0:
-            self.flush()
+            self.flush(create=True)
             rows = np.loadtxt(self.path, delimiter=",", skiprows=1, ndmin=2)
             rows = rows.reshape(-1, len(self.columns))
         return self.comm.bcast(rows, root=0)

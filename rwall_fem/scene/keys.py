@@ -313,9 +313,13 @@ class MeshFile(ValueType):
         try:
             file = (ctx.base / value).resolve()
             found = file.is_file()
-        except (OSError, ValueError):  # e.g. a NUL character
+        except (OSError, RuntimeError):  # a loop of links (RuntimeError up to Python 3.12)
+            raise Invalid(f"{show(value)} is a loop of symbolic links, not a mesh file") from None
+        except ValueError:  # e.g. a NUL character
             found = False
             file = Path(value)
+        if not found and file.exists():
+            raise Invalid(f"{show(str(file))} is not a file (a folder, a device or a pipe)")
         if not found:
             raise Invalid(f"mesh file not found: {show(str(file))}")
         if file.suffix not in (".msh", ".geo"):

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import codecs
+import os
+import stat
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -11,7 +13,9 @@ from rwall_fem.scene.keys import Context, SceneError, read_table, show
 from rwall_fem.scene.overrides import apply_override
 from rwall_fem.scene.schema import Scene
 
-__all__ = ["load_scene", "parse_scene", "read_toml"]
+__all__ = ["MAX_SCENE_BYTES", "load_scene", "parse_scene", "read_toml"]
+
+MAX_SCENE_BYTES = 16 * 2**20  # a scene is text of a few kB; its mesh is a file of its own
 
 
 def load_scene(path: str | Path, overrides: list[str] = ()) -> Scene:
@@ -24,8 +28,20 @@ def load_scene(path: str | Path, overrides: list[str] = ()) -> Scene:
 
 
 def read_toml(path: Path) -> dict:
-    """The TOML mapping in the file ``path``; a UTF-8 byte-order mark is skipped."""
+    """The TOML mapping in the file ``path``; a UTF-8 byte-order mark is skipped. Only a
+    regular file of at most ``MAX_SCENE_BYTES`` is read: a pipe would wait for a writer
+    for ever, a device such as /dev/zero would never end."""
     try:
+        info = os.stat(path)  # before opening: opening a pipe waits for a writer
+        if stat.S_ISDIR(info.st_mode):
+            raise IsADirectoryError
+        if not stat.S_ISREG(info.st_mode):
+            raise SceneError(f"{path}: not a scene file (a device or a pipe, not a file)")
+        if info.st_size > MAX_SCENE_BYTES:
+            raise SceneError(
+                f"{path}: {info.st_size} bytes, more than a scene file's "
+                f"{MAX_SCENE_BYTES // 2**20} MiB: not a scene file"
+            )
         data = path.read_bytes()
     except (FileNotFoundError, IsADirectoryError, NotADirectoryError):
         raise SceneError(f"{path}: scene file not found") from None

@@ -187,7 +187,33 @@ class RunSettings:
     )
 
 
-@rule(RunSettings)
+_ADAPTIVE_ONLY = {"not": {"anyOf": [{"required": k} for k in
+                           (["dt_min"], ["dt_min_action"], ["max_added_mass"])]}}  # fmt: skip
+
+
+@rule(
+    RunSettings,
+    json=[
+        {
+            "not": {
+                "required": ["dt", "time_step"],
+                "properties": {"time_step": {"const": "adaptive"}},
+            }
+        },
+        {"if": {"required": ["dt"]}, "then": _ADAPTIVE_ONLY},
+        {
+            "if": {"required": ["time_step"], "properties": {"time_step": {"const": "fixed"}}},
+            "then": _ADAPTIVE_ONLY,
+        },
+        {
+            "if": {
+                "required": ["dt_min_action"],
+                "properties": {"dt_min_action": {"const": "mass_scaling"}},
+            },
+            "then": {"required": ["dt_min"], "properties": {"dt_min": {"exclusiveMinimum": 0}}},
+        },
+    ],
+)
 def _one_kind_of_step(v, raw, fail):
     """A given dt is a fixed step: time_step is then 'fixed' (its default); dt_min and
     mass scaling are for the adaptive step."""
@@ -560,12 +586,13 @@ class Element:
         "hexahedra, one exact point on (P1) tetrahedra",
         default_doc="reduced on hexahedra, full on tetrahedra (None: by cell type)",
     )
-    hourglass: str = key(
+    hourglass: str | None = key(
         Choice((*_HOURGLASS_FORMS, "none")),
-        "physical",
+        None,
         when={"integration": ("reduced",)},
         doc="physical: assumed-strain stabilisation (Belytschko-Bindeman, Radioss HEPH); "
         "stiffness, viscous: Flanagan-Belytschko forms; none",
+        default_doc="physical",
     )
     hourglass_coefficient: float | None = key(
         Real(low=0.0),
@@ -798,8 +825,38 @@ class Output:
         Real(low=0.0, low_open=False),
         0.0,
         unit="s",
-        doc="wall time between checkpoints; 0: none (a stop by SIGTERM or a guard writes one)",
+        doc="wall time between checkpoints, at least 1 s; 0: none (a stop by SIGTERM or a "
+        "guard writes one)",
     )
+
+
+# Checkpoints are large files written and synced by every rank: a wall-time interval
+# shorter than this would write one at nearly every step (as Radioss's /RFILE and
+# LS-DYNA's d3dump count in cycles, output.checkpoint_steps is the way to go finer).
+MIN_CHECKPOINT_SECONDS = 1.0
+
+
+@rule(
+    Output,
+    json=[
+        {
+            "properties": {
+                "checkpoint_seconds": {"anyOf": [{"const": 0}, {"minimum": MIN_CHECKPOINT_SECONDS}]}
+            }
+        }
+    ],
+)
+def _checkpoints_are_not_every_step(v, raw, fail):
+    """checkpoint_seconds is 0 (none) or at least 1 s: every checkpoint writes and syncs a
+    file per rank, and a shorter interval would write one at nearly every step."""
+    seconds = v["checkpoint_seconds"]
+    if 0.0 < seconds < MIN_CHECKPOINT_SECONDS:
+        fail(
+            "checkpoint_seconds",
+            f"{seconds:g} s would write and sync a checkpoint at nearly every step; give 0 "
+            f"(none) or at least {MIN_CHECKPOINT_SECONDS:g} s, or output.checkpoint_steps for "
+            "checkpoints every so many steps",
+        )
 
 
 # --- the scene -----------------------------------------------------------------------

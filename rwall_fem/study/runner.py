@@ -22,6 +22,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from rwall_fem.build import build_simulation
+from rwall_fem.output import OutputError
 from rwall_fem.scene import parse_scene
 from rwall_fem.study.cases import CASES, Case
 from rwall_fem.study.report import write_outputs
@@ -122,7 +123,13 @@ def run_study(out="results/study", *, quick: bool = False, comm=MPI.COMM_WORLD,
                         )
     seconds = comm.allreduce(time.perf_counter() - started, op=MPI.MAX)
     load.append(os.getloadavg()[0])
+    error = None
     if comm.rank == 0:
-        write_outputs(rows, cases, out, seconds, load)
-    comm.Barrier()
+        try:
+            write_outputs(rows, cases, out, seconds, load)
+        except OSError as err:
+            error = f"{err.filename or out}: cannot be written ({err.strerror})"
+    error = comm.bcast(error, root=0)  # every rank ends alike
+    if error:
+        raise OutputError(error)
     return rows

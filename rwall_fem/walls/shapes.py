@@ -28,11 +28,18 @@ _TINY = 1e-300
 
 
 def _unit(vector, what: str) -> np.ndarray:
+    """``vector`` of length 1; ValueError (one line) when it has no direction or overflowed."""
     vector = np.asarray(vector, dtype=float)
-    length = np.linalg.norm(vector)
-    if not np.isfinite(length) or length == 0:
+    if not np.isfinite(vector).all():
+        raise ValueError(
+            f"{what} overflows a double (points about 1e308 m apart); keep the points within "
+            "1e300 m"
+        )
+    largest = np.abs(vector).max()
+    if largest == 0:
         raise ValueError(f"{what} has no direction")
-    return vector / length
+    vector = vector / largest  # the norm of components near 1e308 would overflow
+    return vector / np.linalg.norm(vector)
 
 
 class PlaneWall:

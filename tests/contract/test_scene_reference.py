@@ -104,6 +104,11 @@ BEYOND = {
     "74_wall_secondary_all_excluded",
     "75_mesh_file_noise_not_small",
     "76_mesh_file_above_max_cells",
+    "81_dt_min_above_the_step_at_rest",
+    "100_hourglass_on_a_tetrahedral_mesh_file",
+    "101_hourglass_coefficient_on_a_tetrahedral_mesh_file",
+    "102_reduced_on_a_tetrahedral_mesh_file",
+    "104_wall_points_overflow",
 }
 
 

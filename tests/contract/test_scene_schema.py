@@ -79,8 +79,8 @@ def test_seed_takes_the_whole_64_bit_range():
 
 def test_element_defaults_by_cell_type_and_form():
     """None: decided when the body is built (the cell type, the form and the material)."""
-    assert _parse(bar_scene(elements=4)).element == Element(None, "physical", None)
-    assert Element() == Element(None, "physical", None)
+    assert _parse(bar_scene(elements=4)).element == Element(None, None, None)
+    assert Element() == Element(None, None, None)
     for form in ("physical", "stiffness", "viscous", "none"):
         element = _parse(_with("element", hourglass=form)).element
         assert element == Element(None, form, None)
