@@ -9,6 +9,8 @@ __all__ = ["toml_text"]
 
 
 def _value(v) -> str:
+    if hasattr(v, "item") and not isinstance(v, (list, tuple, dict)):
+        v = v.item()  # a NumPy scalar: its repr is not TOML
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
