@@ -1,0 +1,492 @@
+"""A deck read whole becomes the raw table of a scene, the same keys a TOML file holds,
+and its mesh a gmsh file: from here on everything is shared with TOML scenes.
+
+One body for now: several /PART make one body when they share /MAT and /PROP; parts of
+different materials or properties need the scene's parts (``[[part]]``), not built yet,
+and are refused in one line naming them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rwall_fem.radioss.mesh import FaceGroups, face_groups, write_msh
+from rwall_fem.radioss.model import Deck, Prescribed, Wall
+from rwall_fem.radioss.reader import DeckError
+
+__all__ = ["SceneParts", "scene_of"]
+
+_SLIDE = {0: "free", 1: "tied", 2: "friction"}
+_FILTER = {1: "coefficient", 2: "steps", 3: "frequency"}
+_SHAPE = {"PLANE": "plane", "CYL": "cylinder", "SPHER": "sphere", "PARAL": "parallelogram"}
+
+
+@dataclass
+class SceneParts:
+    """The raw scene table, the mesh to write (cell type, cells, face groups), and lines
+    saying what the deck became (for ``rwall-fem check``)."""
+
+    raw: dict
+    cell: str
+    cells: np.ndarray
+    groups: FaceGroups
+    facts: list[str]
+
+    def mesh_key(self, deck: Deck) -> str:
+        """A digest of everything the mesh file holds (its name in the cache)."""
+        digest = hashlib.sha256()
+        for array in (deck.node_ids, deck.coordinates, self.cells):
+            digest.update(np.ascontiguousarray(array).tobytes())
+        for name, faces in self.groups.atoms.items():
+            digest.update(name.encode() + np.ascontiguousarray(faces).tobytes())
+        return digest.hexdigest()[:24]
+
+    def write_mesh(self, deck: Deck, path: Path) -> None:
+        write_msh(path, deck.node_ids, deck.coordinates, self.cell, self.cells, self.groups)
+
+
+def scene_of(deck: Deck) -> SceneParts:
+    """The scene the deck describes (mesh file key left for the caller to fill)."""
+    parts = [p for p in deck.parts.values()]
+    for part in parts:
+        if part.mat not in deck.materials:
+            raise DeckError(f"{part.where}: /PART/{part.id}: mat_ID {part.mat} refers to no /MAT")
+        if part.prop not in deck.properties:
+            raise DeckError(
+                f"{part.where}: /PART/{part.id}: prop_ID {part.prop} refers to no /PROP"
+            )
+    if not deck.bodies:
+        raise DeckError(f"{deck.starter}: no elements (/BRICK or /TETRA4)")
+    for body in deck.bodies:
+        if body.part not in deck.parts:
+            body.card.fail(f"part_ID {body.part} refers to no /PART")
+    _check_element_nodes(deck)
+    used = sorted({b.part for b in deck.bodies})
+    kinds = {(deck.parts[p].mat, deck.parts[p].prop) for p in used}
+    if len(kinds) > 1:
+        listed = ", ".join(
+            f"{p} (mat {deck.parts[p].mat}, prop {deck.parts[p].prop})" for p in used
+        )
+        raise DeckError(
+            f"{deck.starter}: parts {listed} differ in material or property: a body of several "
+            "materials or properties needs the scene's parts ([[part]], not built yet); give "
+            "them one /MAT and one /PROP to run them as one body"
+        )
+    cells_by_kind = {b.cell for b in deck.bodies}
+    if len(cells_by_kind) > 1:
+        raise DeckError(
+            f"{deck.starter}: both /BRICK and /TETRA4 elements: DOLFINx holds one cell type "
+            "per mesh"
+        )
+    cell = cells_by_kind.pop()
+    cells = np.concatenate([b.nodes for b in deck.bodies])
+    for part in deck.parts.values():
+        if part.id not in used:
+            deck.warnings.append(f"{part.where}: /PART/{part.id}: has no elements")
+    mat_id, prop_id = kinds.pop()
+    body_nodes = np.unique(cells)
+    mains = {w.main_node for w in deck.walls if w.main_node}
+    _resolve_groups(deck, cells, body_nodes, mains)
+
+    facts = [
+        f"units: input {deck.input_units.describe()}, work {deck.work_units.describe()} "
+        "(converted to SI)",
+        f"body: parts {', '.join(map(str, used))}: {len(cells)} {cell} cells, "
+        f"{len(body_nodes)} nodes",
+    ]
+    material, material_fact = _material(deck, mat_id)
+    element, element_fact = _element(deck, prop_id, cell, material, cells)
+    facts += [material_fact, element_fact]
+    raw: dict = {
+        "run": {"end_time": deck.end_time},
+        "mesh": {},
+        "material": material,
+        "output": {"directory": f"results/{_slug(deck.run_name)}", "history_interval": 1},
+    }
+    if element:
+        raw["element"] = element
+    if deck.dt_scale is not None:
+        raw["run"]["dt_scale"] = deck.dt_scale
+    if deck.min_dt is not None:
+        raw["run"]["min_dt"] = deck.min_dt
+    if deck.animation is not None:
+        start, interval = deck.animation
+        raw["output"]["frames"] = int(np.floor((deck.end_time - start) / interval + 1e-9)) + 1
+        if start > 0:
+            deck.warnings.append(
+                f"/ANIM/DT: Tstart = {start:g} s: the {raw['output']['frames']} frames are "
+                "spread over the whole run"
+            )
+    if deck.history_interval is not None:
+        facts.append(
+            f"/TFILE {deck.history_interval:g} s: energy.csv and walls.csv get a row every "
+            "step (rwall_fem's history interval counts steps)"
+        )
+
+    group_nodes = {gid: g.nodes for gid, g in deck.groups.items() if _used_group(deck, gid)}
+    atoms, unreached = face_groups(cell, cells, {
+        gid: np.intersect1d(nodes, body_nodes) for gid, nodes in group_nodes.items()
+    })  # fmt: skip
+    for gid, missing in unreached.items():
+        if len(missing):
+            g = deck.groups[gid]
+            shown = ", ".join(map(str, missing[:5])) + (", ..." if len(missing) > 5 else "")
+            raise DeckError(
+                f"{g.where}: /GRNOD/{g.kind}/{gid}: nodes {shown} lie on no element face whose "
+                "nodes are all in the group: rwall_fem's node sets are unions of element faces"
+            )
+    velocity = _initial_velocity(deck, body_nodes, mains)
+    if velocity is not None:
+        raw["initial"] = {"velocity": list(velocity)}
+        facts.append(f"initial velocity: {_vec(velocity)} m/s")
+    gravity = _gravity(deck, body_nodes)
+    if gravity is not None:
+        raw["gravity"] = {"acceleration": list(gravity)}
+        facts.append(f"gravity: {_vec(gravity)} m/s^2")
+    boundaries, wall_velocity = _boundaries(deck, atoms, mains)
+    if boundaries:
+        raw["boundary"] = boundaries
+        facts += [f"boundary on {b['group']}: components {b.get('components', 'xyz')}"
+                  for b in boundaries]  # fmt: skip
+    walls = [_wall(deck, w, atoms, wall_velocity.get(w.main_node)) for w in deck.walls]
+    if walls:
+        raw["wall"] = walls
+        for w, table in zip(deck.walls, walls, strict=True):
+            facts.append(_wall_fact(w, table))
+    facts.append(
+        f"run: end time {deck.end_time:g} s"
+        + (f", dt scale {deck.dt_scale:g}" if deck.dt_scale is not None else "")
+        + (f", {raw['output']['frames']} frames" if "frames" in raw["output"] else "")
+    )
+    return SceneParts(raw, cell, cells, atoms, facts)
+
+
+def _slug(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_") or "deck"
+
+
+def _vec(v) -> str:
+    return "[" + ", ".join(f"{c:g}" for c in v) + "]"
+
+
+def _check_element_nodes(deck: Deck) -> None:
+    for body in deck.bodies:
+        rows = deck.node_positions(body.nodes.ravel()).reshape(body.nodes.shape)
+        bad = np.argwhere(rows < 0)
+        if len(bad):
+            k, j = bad[0]
+            body.card.fail(
+                f"element {body.ids[k]}: node {body.nodes[k, j]} refers to no /NODE",
+                body.card.lines[k],
+            )
+
+
+def _resolve_groups(deck: Deck, cells, body_nodes, mains) -> None:
+    """The node IDs of every /GRNOD; an ID that refers to nothing is refused."""
+    for g in deck.groups.values():
+        where = f"{g.where}: /GRNOD/{g.kind}/{g.id}"
+        if g.kind == "NODE":
+            missing = g.items[deck.node_positions(g.items) < 0]
+            if len(missing):
+                raise DeckError(f"{where}: node {missing[0]} refers to no /NODE")
+            g.nodes = g.items
+        elif g.kind == "PART":
+            for pid in g.items:
+                if pid not in deck.parts:
+                    raise DeckError(f"{where}: part {pid} refers to no /PART")
+            nodes = [b.nodes.ravel() for b in deck.bodies if b.part in set(g.items.tolist())]
+            g.nodes = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, np.int64)
+        else:
+            inside = np.zeros(len(deck.node_ids), dtype=bool)
+            for bid in g.items:
+                if bid not in deck.boxes:
+                    raise DeckError(f"{where}: box {bid} refers to no /BOX")
+                low, high, _ = deck.boxes[bid]
+                inside |= np.all((deck.coordinates >= low) & (deck.coordinates <= high), axis=1)
+            g.nodes = deck.node_ids[inside]
+
+
+def _group(deck: Deck, gid: int, where: str, what: str):
+    if gid not in deck.groups:
+        raise DeckError(f"{where}: {what} {gid} refers to no /GRNOD")
+    return deck.groups[gid]
+
+
+def _used_group(deck: Deck, gid: int) -> bool:
+    """Whether a group must be written to the mesh (a wall, /BCS or /IMPVEL uses it)."""
+    uses = [w.add_group for w in deck.walls] + [w.exclude_group for w in deck.walls]
+    uses += [g for _, g, _ in deck.clamps] + [p.group for p in deck.velocities]
+    return gid in uses
+
+
+def _material(deck: Deck, mid: int) -> tuple[dict, str]:
+    m = deck.materials[mid]
+    table = {"density": m["density"], "young": m["young"], "poisson": m["poisson"]}
+    head = f"material: /MAT/{m['law']}/{mid} ({m['where']})"
+    if m["law"] == "LAW1":
+        return {"model": "linear_elastic", **table}, f"{head} -> linear_elastic"
+    if m["law"] == "LAW36":
+        fct = deck.functions.get(m["curve"])
+        if fct is None:
+            raise DeckError(f"{m['curve_where']}: /MAT/LAW36/{mid}: fct_ID1 {m['curve']} "
+                            "refers to no /FUNCT")  # fmt: skip
+        if fct.x[0] != 0.0 or len(fct.x) > 64 or np.any(fct.y <= 0):
+            raise DeckError(f"{fct.where}: /FUNCT/{fct.id}: a hardening curve starts at plastic "
+                            "strain 0, has at most 64 points and positive stresses")  # fmt: skip
+        rows = [[float(x), float(y * m["curve_scale"])] for x, y in zip(fct.x, fct.y, strict=True)]
+        if fct.y[-1] != fct.y[-2]:
+            deck.warnings.append(
+                f"{fct.where}: /FUNCT/{fct.id}: rwall_fem holds the yield stress after the last "
+                f"point (plastic strain {fct.x[-1]:g}); Radioss extends the last slope"
+            )
+        material = {"model": "elastic_plastic", **table, "hardening": "table",
+                    "hardening_curve": rows}  # fmt: skip
+        return material, f"{head} -> elastic_plastic, tabulated hardening ({len(rows)} points)"
+    a, b, n = m["a"], m["b"], m["n"]
+    if "c" in m or "t_melt" in m:
+        material = {"model": "johnson_cook", **table, "yield_stress": a,
+                    "hardening_coefficient": b, "hardening_exponent": n}  # fmt: skip
+        if "c" in m:
+            material |= {"strain_rate_coefficient": m["c"], "reference_strain_rate": m["rate0"]}
+        if "t_melt" in m:
+            material["heating"] = {
+                "softening_exponent": m["m"], "melting_temperature": m["t_melt"],
+                "specific_heat": m["heat"] / m["density"], "room_temperature": m["t_room"],
+                "taylor_quinney": 1.0,
+            }  # fmt: skip
+        return material, f"{head} -> johnson_cook"
+    if n == 1.0:
+        material = {"model": "elastic_plastic", **table, "hardening": "linear",
+                    "yield_stress": a, "hardening_modulus": b}  # fmt: skip
+        return material, f"{head} -> elastic_plastic, linear hardening"
+    material = {"model": "elastic_plastic", **table, "hardening": "power", "yield_stress": a,
+                "hardening_coefficient": b, "hardening_exponent": n}  # fmt: skip
+    return material, f"{head} -> elastic_plastic, power hardening"
+
+
+def _element(deck: Deck, pid: int, cell: str, material: dict, cells) -> tuple[dict, str]:
+    p = deck.properties[pid]
+    head = f"property: /PROP/SOLID/{pid} Isolid {p['isolid']} ({p['where']})"
+    if cell == "tetrahedron":
+        return {}, f"{head} -> P1 tetrahedra (Itetra4 0)"
+    element = dict(p["element"])
+    plastic = material["model"] in ("elastic_plastic", "johnson_cook")
+    if p["isolid"] == 24 and plastic and p["icpre"] == 0:
+        deck.warnings.append(
+            f"{p['line']}: /PROP/SOLID/{pid}: Icpre 0 on an elasto-plastic body: rwall_fem's "
+            "physical hourglass control has no volumetric part on plastic bodies (as Icpre 1)"
+        )
+    if p["isolid"] == 2 and not _parallelepipeds(deck, cells):
+        deck.warnings.append(
+            f"{p['line']}: /PROP/SOLID/{pid}: Isolid 2 (Hallquist's hourglass modes) is read "
+            "as Isolid 1 (orthogonal Flanagan-Belytschko modes): they differ on cells that "
+            "are not parallelepipeds"
+        )
+    text = ", ".join(f"{k} {v}" for k, v in element.items())
+    return element, f"{head} -> {text}"
+
+
+def _parallelepipeds(deck: Deck, cells) -> bool:
+    """Whether every hexahedron is a parallelepiped (no hourglass part in its shape)."""
+    x = deck.coordinates[deck.node_positions(cells.ravel())].reshape(len(cells), 8, 3)
+    h = np.array([[1, -1, 1, -1, 1, -1, 1, -1], [1, 1, -1, -1, -1, -1, 1, 1],
+                  [1, -1, -1, 1, -1, 1, 1, -1], [-1, 1, -1, 1, 1, -1, 1, -1]])  # fmt: skip
+    size = np.ptp(x, axis=1).max()
+    return bool(np.abs(np.einsum("ai,cid->cad", h, x)).max() <= 1e-9 * size)
+
+
+def _covers(group_nodes, body_nodes) -> bool:
+    return bool(np.isin(body_nodes, group_nodes).all())
+
+
+def _initial_velocity(deck: Deck, body_nodes, mains):
+    chosen = None
+    for velocity, gid, where in deck.initial:
+        g = _group(deck, gid, where, "/INIVEL/TRA: Gnod_id")
+        if set(g.nodes.tolist()) & mains:
+            raise DeckError(f"{where}: /INIVEL/TRA: group {gid} holds the main node of a "
+                            "/RWALL: its velocity is the wall's VX0 VY0 VZ0")  # fmt: skip
+        if not _covers(g.nodes, body_nodes):
+            raise DeckError(
+                f"{where}: /INIVEL/TRA: group {gid} holds only some nodes of the body: an "
+                "initial velocity per part needs the scene's parts ([[part]], not built yet)"
+            )
+        if chosen is not None and not np.allclose(chosen, velocity, rtol=0, atol=0):
+            raise DeckError(f"{where}: /INIVEL/TRA: a second initial velocity of the same "
+                            "nodes")  # fmt: skip
+        chosen = velocity
+    return chosen
+
+
+def _function_on_run(deck: Deck, p: Prescribed) -> tuple[np.ndarray, np.ndarray]:
+    """The function of ``p`` in SI (t, value) over the run; it must cover [0, end]."""
+    fct = deck.functions.get(p.fct)
+    if fct is None:
+        raise DeckError(f"{p.where}: {p.card}: fct_IDT {p.fct} refers to no /FUNCT")
+    t, y = fct.x * p.t_scale, fct.y * p.y_scale
+    span = deck.end_time
+    if t[0] > 0 or t[-1] < span * (1 - 1e-12):
+        raise DeckError(
+            f"{fct.where}: /FUNCT/{fct.id}: covers t in [{t[0]:g}, {t[-1]:g}] s, and "
+            f"{p.card} needs [0, {span:g}] s: rwall_fem holds a table constant outside its "
+            "points, Radioss extrapolates; extend the function"
+        )
+    return t, y
+
+
+def _gravity(deck: Deck, body_nodes):
+    if not deck.gravity:
+        return None
+    g = np.zeros(3)
+    for p in deck.gravity:
+        group = _group(deck, p.group, p.where, "/GRAV: grnd_ID")
+        if not _covers(group.nodes, body_nodes):
+            raise DeckError(f"{p.where}: {p.card}: group {p.group} holds only some nodes of the "
+                            "body: rwall_fem's gravity acts on every node")  # fmt: skip
+        t, y = _function_on_run(deck, p)
+        inside = t <= deck.end_time
+        if np.ptp(y[inside | (np.arange(len(t)) == np.argmax(t > deck.end_time))]) != 0:
+            raise DeckError(f"{p.where}: {p.card}: the function {p.fct} varies over the run: "
+                            "rwall_fem's gravity is constant")  # fmt: skip
+        g["XYZ".index(p.direction)] += y[0]
+    return g
+
+
+def _table(deck: Deck, items: list[Prescribed]) -> tuple[list[list[float]], str]:
+    """Rows [t, vx, vy, vz] at the union of the functions' points, and the components."""
+    curves = {p.direction: _function_on_run(deck, p) for p in items}
+    times = np.unique(np.concatenate([t for t, _ in curves.values()]))
+    rows = np.zeros((len(times), 4))
+    rows[:, 0] = times
+    for axis, (t, y) in curves.items():
+        rows[:, 1 + "XYZ".index(axis)] = np.interp(times, t, y)
+    components = "".join(sorted(a.lower() for a in curves))
+    return rows.tolist(), components
+
+
+def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
+    """The [[boundary]] tables of /BCS and of /IMPVEL on body nodes, and the prescribed
+    velocities of walls' main nodes (main node -> list of /IMPVEL)."""
+    out = []
+    for components, gid, where in deck.clamps:
+        g = _group(deck, gid, where, "/BCS: grnd_ID")
+        if set(g.nodes.tolist()) & mains:
+            raise DeckError(f"{where}: /BCS: group {gid} holds the main node of a /RWALL: fix "
+                            "a wall by giving it no node_ID")  # fmt: skip
+        out += [{"group": a, "components": components} for a in atoms.of[gid]]
+    on_walls: dict[int, list[Prescribed]] = {}
+    by_group: dict[int, list[Prescribed]] = {}
+    for p in deck.velocities:
+        g = _group(deck, p.group, p.where, "/IMPVEL: grnd_ID")
+        held = set(g.nodes.tolist()) & mains
+        if held and len(g.nodes) > len(held):
+            raise DeckError(f"{p.where}: {p.card}: group {p.group} mixes the main node of a "
+                            "/RWALL with nodes of the body")  # fmt: skip
+        target = on_walls.setdefault(held.pop(), []) if held else by_group.setdefault(p.group, [])
+        if any(q.direction == p.direction for q in target):
+            raise DeckError(f"{p.where}: {p.card}: a second imposed velocity along "
+                            f"{p.direction} of the same nodes")  # fmt: skip
+        target.append(p)
+    for gid, items in by_group.items():
+        rows, components = _table(deck, items)
+        out += [{"group": a, "velocity": rows, "components": components} for a in atoms.of[gid]]
+    return out, on_walls
+
+
+def _wall(deck: Deck, w: Wall, atoms: FaceGroups, imposed: list[Prescribed] | None) -> dict:
+    name = f"/RWALL/{w.kind}/{w.id}"
+    where = f"{w.where}: {name}"
+    table: dict = {"kind": _SHAPE[w.kind]}
+    point = w.point
+    if w.main_node:
+        row = deck.node_positions(np.array([w.main_node]))[0]
+        if row < 0:
+            raise DeckError(f"{where}: node_ID {w.main_node} refers to no /NODE")
+        if any((b.nodes == w.main_node).any() for b in deck.bodies):
+            raise DeckError(f"{where}: node_ID {w.main_node} is a node of the body; the main "
+                            "node of a wall is a node of its own")  # fmt: skip
+        point = deck.coordinates[row]
+    table["point"] = list(point)
+    if w.kind == "PLANE":
+        table["normal_point"] = list(w.point1)
+    elif w.kind == "CYL":
+        table["axis_point"] = list(w.point1)
+    elif w.kind == "PARAL":
+        table |= {"corner1": list(w.point1), "corner2": list(w.point2)}
+    if w.kind in ("CYL", "SPHER"):
+        if w.diameter <= 0:
+            raise DeckError(f"{where}: Diameter = {w.diameter:g} m: a {table['kind']} needs a "
+                            "diameter > 0")  # fmt: skip
+        table["diameter"] = w.diameter
+    table["slide"] = _SLIDE[w.slide]
+    if w.slide == 2:
+        table["friction"] = w.friction
+        if w.filter_flag:
+            table["friction_filter"] = {_FILTER[w.filter_flag]: w.filter_factor}
+    secondary: dict = {}
+    if w.search_distance > 0:
+        secondary["search_distance"] = w.search_distance
+    for key, gid, what in (("add", w.add_group, "grnd_ID1"), ("exclude", w.exclude_group,
+                                                                 "grnd_ID2")):  # fmt: skip
+        if gid:
+            g = _group(deck, gid, w.where, f"{name}: {what}")
+            if w.main_node and w.main_node in g.nodes:
+                raise DeckError(f"{where}: {what} {gid} holds the wall's own main node")
+            secondary[key] = atoms.of[gid]
+    if not secondary.get("add") and "search_distance" not in secondary:
+        raise DeckError(f"{where}: no secondary nodes (Dsearch is 0 and no grnd_ID1): the wall "
+                        "would act on nothing; give Dsearch or grnd_ID1")  # fmt: skip
+    table["secondary"] = secondary
+    if w.main_node:
+        if imposed:
+            rows, components = _table(deck, imposed)
+            free = [i for i, c in enumerate("xyz") if c not in components]
+            _free_components_unloaded(w, free, where)
+            for i in free:
+                for row in rows:
+                    row[1 + i] = float(w.velocity[i])
+            table["motion"] = {"velocity": rows}
+        else:
+            if w.mass <= 0:
+                raise DeckError(f"{where}: Mass = {w.mass:g} kg: a moving wall needs a mass > 0 "
+                                "(or an /IMPVEL on its node)")  # fmt: skip
+            table["motion"] = {"mass": w.mass, "velocity": list(w.velocity)}
+    return table
+
+
+def _free_components_unloaded(w: Wall, free: list[int], where: str) -> None:
+    """An /IMPVEL on some components of a main node: rwall_fem prescribes the whole motion,
+    so the others keep VX0..VZ0, exact only if no wall force acts along them: a
+    frictionless plane whose normal has no such component."""
+    if not free:
+        return
+    if w.kind in ("PLANE", "PARAL") and w.slide == 0:
+        normal = (w.point1 - w.point) if w.kind == "PLANE" else np.cross(
+            w.point1 - w.point, w.point2 - w.point)  # fmt: skip
+        normal = normal / np.linalg.norm(normal)
+        if np.all(np.abs(normal[free]) <= 1e-12):
+            return
+    axes = "".join("XYZ"[i] for i in free)
+    raise DeckError(f"{where}: /IMPVEL on its node leaves {axes} free, where the wall's force "
+                    "acts: impose X, Y and Z (rwall_fem prescribes a wall's whole motion)")
+
+
+def _wall_fact(w: Wall, table: dict) -> str:
+    motion = table.get("motion")
+    how = "fixed" if motion is None else ("prescribed" if "mass" not in motion else
+                                          f"main node {w.main_node}, {w.mass:g} kg")  # fmt: skip
+    sec = table["secondary"]
+    nodes = []
+    if "search_distance" in sec:
+        nodes.append(f"within {sec['search_distance']:g} m")
+    if sec.get("add"):
+        nodes.append(f"+ group {w.add_group}")
+    if sec.get("exclude"):
+        nodes.append(f"- group {w.exclude_group}")
+    return (f"wall: /RWALL/{w.kind}/{w.id} ({w.where}) -> {table['kind']}, {how}, slide "
+            f"{table['slide']}, secondary nodes {' '.join(nodes)}")

@@ -1,0 +1,152 @@
+"""Bad decks are refused in one line naming the file, the line and the card, with what is
+allowed, on every rank and with no traceback (a DeckError, which the command line turns
+into exit code 2 as any bad scene); cards that only ask for Radioss's outputs are skipped
+with one warning line each."""
+
+import logging
+import re
+import subprocess
+import sys
+
+import pytest
+from mpi4py import MPI
+
+from rwall_fem.radioss import DeckError, load_deck
+
+from .decks import BarDeck
+
+
+def good() -> BarDeck:
+    d = BarDeck(units="kg-mm-ms", nz=2)
+    d.part()
+    d.elastic(7850.0, 210e9, 0.3)
+    d.solid(24)
+    d.group(1, "PART", [1])
+    d.initial_velocity((0, 0, -5.0), 1)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0)
+    return d
+
+
+def written(d: BarDeck, directory, edit=None):
+    path = None
+    if MPI.COMM_WORLD.rank == 0:
+        path = d.write(directory)
+        if edit:
+            lines = path.read_text().splitlines()
+            edit(lines)
+            path.write_text("\n".join(lines) + "\n")
+    return MPI.COMM_WORLD.bcast(path, root=0)
+
+
+def line_of(lines, text, after=0):
+    return next(i for i, line in enumerate(lines) if i >= after and line.startswith(text))
+
+
+def cut_brick(lines):
+    k = line_of(lines, "/BRICK") + 1
+    lines[k] = lines[k][:60]
+
+
+def bad_field(lines):
+    k = line_of(lines, "/MAT/LAW1") + 3
+    lines[k] = "           2.1.0e2" + lines[k][18:]
+
+
+def dangling_mat(lines):
+    k = line_of(lines, "/PART") + 3
+    lines[k] = f"{1:10d}{7:10d}"
+
+
+def no_material(lines):
+    k = line_of(lines, "/PART") + 3
+    lines[k] = f"{1:10d}{0:10d}"
+
+
+def unsupported(lines):
+    k = line_of(lines, "/PROP")
+    lines[k:k] = ["/INTER/TYPE7/1", "contact", "         1         2"]
+
+
+def isolid(lines):
+    k = line_of(lines, "/PROP") + 2
+    lines[k] = f"{16:10d}" + lines[k][10:]
+
+
+def missing_line(lines):
+    k = line_of(lines, "/RWALL")
+    del lines[k + 5 :]
+
+
+CASES = {
+    # name: (edit, the card's header or line text, what the message says)
+    "truncated line": (cut_brick, "/BRICK", r"truncated line: element 1 needs 8 node IDs, got 5"),
+    "field that does not parse": (bad_field, "/MAT/LAW1", r"field E \(columns 1-20\): cannot read '2.1.0e2"),
+    "ID that refers to nothing": (dangling_mat, "/PART", r"mat_ID 7 refers to no /MAT"),
+    "part without a material": (no_material, "/PART", r"part 1 has no material"),
+    "unsupported card": (unsupported, "/INTER/TYPE7/1", r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN"),
+    "unsupported Isolid": (isolid, "/PROP", r"Isolid = 16: supported: 24"),
+    "truncated card": (missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
+    edit, card, pattern = CASES[case]
+    path = written(good(), shared_dir, edit)
+    with pytest.raises(DeckError) as info:
+        load_deck(path)
+    message = str(info.value)
+    assert "\n" not in message
+    lines = path.read_text().splitlines()
+    number = int(re.match(rf"{re.escape(str(path))}:(\d+): ", message)[1])
+    header = max(i for i in range(number) if lines[i].startswith("/"))
+    assert lines[header].startswith(card), message
+    assert re.search(pattern, message), message
+
+
+def test_parts_of_two_materials_are_refused_naming_them(shared_dir):
+    d = good()
+    d.nz = 2
+    d.cards += ["/PART/2", "second", f"{1:10d}{2:10d}"]
+    d.elastic(2700.0, 70e9, 0.33, mid=2)
+    d.cards += ["/BRICK/2", f"{99:10d}" + "".join(f"{n:10d}" for n in (1, 2, 5, 4, 10, 11, 14, 13))]
+    path = written(d, shared_dir)
+    with pytest.raises(DeckError, match=r"parts 1 \(mat 1, prop 1\), 2 \(mat 2, prop 1\) differ "
+                       r"in material or property: .*\[\[part\]\], not built yet"):  # fmt: skip
+        load_deck(path)
+
+
+class Lines(logging.Handler):
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.lines = []
+
+    def emit(self, record):
+        self.lines.append(record.getMessage())
+
+
+def test_output_cards_are_skipped_with_one_warning_each(shared_dir):
+    d = good()
+    d.cards += ["/TH/RWALL/1", "wall", "FNX", "         1"]
+    d.engine += ["/ANIM/VECT/VEL", "/PRINT/-100"]
+    path = written(d, shared_dir)
+    log, handler = logging.getLogger("rwall_fem"), Lines()
+    log.addHandler(handler)  # the command line's tests stop its propagation to pytest
+    try:
+        load_deck(path)
+    finally:
+        log.removeHandler(handler)
+    skipped = [line for line in handler.lines if "skipped" in line]
+    assert [s.split(": ")[1] for s in skipped] == ["/TH/RWALL/1", "/ANIM/VECT/VEL", "/PRINT/-100"]
+
+
+@pytest.mark.serial
+@pytest.mark.skipif(".rad" not in open(sys.modules["rwall_fem.radioss"].__file__.replace(
+    "radioss/__init__.py", "cli.py")).read(), reason="needs the CLI wiring of docs/radioss.md")  # fmt: skip
+def test_command_line_exits_2_with_one_line(tmp_path):
+    path = written(good(), tmp_path, no_material)
+    done = subprocess.run([sys.executable, "-m", "rwall_fem", "check", str(path)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "has no material" in done.stderr
+    assert "Traceback" not in done.stderr
