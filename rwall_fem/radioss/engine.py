@@ -38,7 +38,7 @@ def read_engine(deck: Deck, cards: list[Card]) -> None:
             if not 0.0 <= scale <= 1.0:
                 card.fail(f"scale = {scale:g}: the time-step scale is in (0, 1]", card.lines[0])
             deck.dt_scale = scale or None
-            deck.min_dt = floor * time if floor > 0 else None
+            deck.dt_min = floor * time if floor > 0 else None
         elif kind == "ANIM" and card.key(1) == "DT":
             start, interval = _numbers(card, 2, "Tstart Tfreq")
             if interval <= 0:

@@ -137,7 +137,7 @@ class Deck:
     walls: list[Wall] = field(default_factory=list)
     end_time: float | None = None  # s
     dt_scale: float | None = None
-    min_dt: float | None = None  # s
+    dt_min: float | None = None  # s
     animation: tuple[float, float] | None = None  # start, interval (s)
     history_interval: float | None = None  # s
     warnings: list[str] = field(default_factory=list)

@@ -112,8 +112,8 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["element"] = element
     if deck.dt_scale is not None:
         raw["run"]["dt_scale"] = deck.dt_scale
-    if deck.min_dt is not None:
-        raw["run"]["min_dt"] = deck.min_dt
+    if deck.dt_min is not None:
+        raw["run"]["dt_min"] = deck.dt_min
     if deck.animation is not None:
         start, interval = deck.animation
         raw["output"]["frames"] = int(np.floor((deck.end_time - start) / interval + 1e-9)) + 1
