@@ -429,7 +429,7 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
     _filter_fits(spec, where, state.dt)
     return RigidWall(
         shape,
-        _secondary_nodes(spec, where, shape, solid, state),
+        _secondary_nodes(spec, where, shape, solid, state, _erodes(scene)),
         f"wall[{i}]",
         slide=spec.slide,
         friction=spec.friction,
@@ -438,6 +438,12 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
         motion=motion,
         comm=comm,
     )
+
+
+def _erodes(scene: Scene) -> bool:
+    """Whether cells of the body may erode: a failure criterion, or erosion below dt_min."""
+    failure = getattr(scene.material, "failure", None)
+    return failure is not None or scene.run.dt_min_action == "erode"
 
 
 def _filter_fits(spec: WallSpec, where: str, dt: float) -> None:
@@ -469,10 +475,12 @@ def _boundary(scene: Scene, i: int, solid: _Solid) -> VelocityBoundary:
     return VelocityBoundary(f"boundary[{i}]", nodes, spec.velocity, spec.components)
 
 
-def _secondary_nodes(spec: WallSpec, where: str, shape, solid: _Solid, state: State) -> np.ndarray:
+def _secondary_nodes(
+    spec: WallSpec, where: str, shape, solid: _Solid, state: State, erodes: bool
+) -> np.ndarray:
     """Owned secondary nodes (``docs/theory.md``, "Secondary nodes"): boundary nodes by
-    default; or nodes with 0 <= d <= search_distance at the start, plus named sets; minus
-    excluded sets."""
+    default (every node of a body whose cells may erode); or nodes with 0 <= d <=
+    search_distance at the start, plus named sets; minus excluded sets."""
     V, body, owned = solid.V, solid.body, solid.owned
     sec = spec.secondary
     for key, names in (("add", sec.add), ("exclude", sec.exclude)):
@@ -484,7 +492,10 @@ def _secondary_nodes(spec: WallSpec, where: str, shape, solid: _Solid, state: St
                 )
     selected = np.zeros(owned, dtype=bool)
     if sec.search_distance is None and not sec.add:
-        selected[_owned(boundary_nodes(V), owned)] = True
+        if erodes:  # erosion bares the inside: every node may meet the wall
+            selected[:] = True
+        else:
+            selected[_owned(boundary_nodes(V), owned)] = True
     if sec.search_distance is not None:
         d = shape.distance(state.X)
         selected |= (d >= -_ROUND_OFF * solid.size) & (d <= sec.search_distance)

@@ -13,7 +13,8 @@ C kernels of :mod:`rwall_fem.kernels`. Technologies (the scene's ``[element]``):
 
 Materials: linear elasticity (small strain), Saint Venant-Kirchhoff and
 neo-Hookean (total Lagrangian), and J2 elasto-plasticity with isotropic hardening or
-Johnson-Cook (hypoelastic, updated Lagrangian, with a state per integration point).
+Johnson-Cook (hypoelastic, updated Lagrangian, with a state per integration point), which
+may fail (damage per point; failed cells are eroded: :mod:`rwall_fem.erosion`).
 The formulas are in ``docs/theory.md``.
 
 MPI: each rank computes its owned cells; displacements (and velocities for the
@@ -32,7 +33,8 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from rwall_fem import _compat
-from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
+from rwall_fem.erosion import ErodedCells
+from rwall_fem.kernels import FAILURE, HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
 
@@ -165,6 +167,12 @@ class ElementForce:
     smallest estimate (s). The cells' volumes (m^3) and characteristic lengths (m) at rest
     are :attr:`volume0` and :attr:`length0`. A small-strain body's estimate never
     changes (its stiffness does not): it is made once, unless :attr:`estimate_every_step`.
+
+    A material with a failure criterion accumulates damage per integration point (rows of
+    ``history`` after the state of the points) and its failed cells are eroded, as are,
+    after :meth:`erode_below`, the cells whose step falls below a floor; :attr:`erosion`
+    (an :class:`~rwall_fem.erosion.ErodedCells`, or None when no cell can erode) keeps
+    which, and the energies gain ``"eroded_internal"`` (``kernels/failure.h``).
     """
 
     def __init__(self, V, material, technology: Technology, u: GhostedField, v: GhostedField):
@@ -175,10 +183,6 @@ class ElementForce:
         self.name = model
         self.technology = technology
         self.conservative = technology.conservative and not self.plastic
-        hourglass = technology.integration == "reduced" and technology.hourglass != "none"
-        self.energy_names = ("internal", "hourglass") if hourglass else ("internal",)
-        # Parts of the internal energy, reported beside it but not added to the balance.
-        self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
         self.u, self.v = u, v
         self.f = GhostedField(V)
         self.V, self._probe = V, None  # the fields of forces(), made at its first call
@@ -198,6 +202,7 @@ class ElementForce:
             8 if technology.cell == "hexahedron" and technology.integration == "full" else 1
         )
         self.history = None
+        self.failure = getattr(material, "failure", None) if self.plastic else None
         if self.plastic:
             self._set_plasticity(material)
         self.volume0, self.length0 = self.cell_sizes(self.X)
@@ -206,11 +211,32 @@ class ElementForce:
         self.estimate_every_step = model != "linear_elastic"
         self.step = np.zeros(STEP_SLOTS)
         self._estimated = False
-        # stored elastic, hourglass, plastic dissipation (J)
-        self._energy = np.zeros(3)
+        # stored elastic, hourglass, plastic dissipation, internal energy of eroded cells (J)
+        self._energy = np.zeros(4)
+        self.erosion: ErodedCells | None = None
+        if self.failure is not None:
+            self._erode()
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
         self._accelerate = None
         self.nodal_force = self.f.owned  # N, owned nodes
+
+    @property
+    def energy_names(self) -> tuple[str, ...]:
+        """The energies the force stores: ``"internal"``, ``"hourglass"`` with hourglass
+        control, ``"eroded_internal"`` when cells can erode."""
+        t = self.technology
+        names = ("internal",)
+        if t.integration == "reduced" and t.hourglass != "none":
+            names += ("hourglass",)
+        return names + (("eroded_internal",) if self.erosion is not None else ())
+
+    @property
+    def energy_parts(self) -> tuple[str, ...]:
+        """Parts of the energies reported beside them but not added to the balance: the
+        elastic energy and plastic work of an elasto-plastic body, the kinetic energy of
+        detached nodes when cells can erode."""
+        parts = ("elastic", "plastic_work") if self.plastic else ()
+        return parts + (("eroded_kinetic",) if self.erosion is not None else ())
 
     def cell_sizes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The volume (m^3) and characteristic length (m) of every owned cell with its nodes
@@ -263,10 +289,33 @@ class ElementForce:
         p.below = ffi.cast("int32_t *", self.below.ctypes.data)
         p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
 
+    def erode_below(self, floor: float) -> None:
+        """From now on, erode the cells whose step estimate falls below ``floor`` (s), and
+        inverted ones (``run.dt_min_action = "erode"``; the estimates are made every step)."""
+        self.estimate_every_step = True
+        self.params.erode_step = floor
+        if self.erosion is None:
+            self._erode()
+            self._kernel = self._bind(
+                self.u.array, self.v.array, self.f.array, self._energy, self.step
+            )
+
+    def _erode(self) -> None:
+        """Let the kernels erode cells: room for the cells they list, the work of every cell
+        so far, the velocities an eroded cell needs to leave the energy books (collective)."""
+        self.erosion = e = ErodedCells(self.V, self.cells)
+        p, ffi = self.params, self.ffi
+        p.erode = 1
+        p.eroded = ffi.cast("int32_t *", e.listed.ctypes.data)
+        p.cell_work = ffi.cast("double *", e.work.ctypes.data)
+        p.cell_stride = self.num_cells
+        p.velocity = ffi.cast("double *", self.v.array.ctypes.data)
+
     def _set_plasticity(self, material) -> None:
         """The flow-stress law's constants, and the state per integration point: the stress
         (Pa), the equivalent plastic strain and the temperature (K) of each point, then the
-        hourglass forces (N) of a one-point hexahedron."""
+        hourglass forces (N) of a one-point hexahedron, then with a failure criterion the
+        damage of each point."""
         p = self.params
         law = material.hardening if material.model == "elastic_plastic" else "johnson_cook"
         p.hardening = HARDENING[law]
@@ -290,17 +339,31 @@ class ElementForce:
             p.specific_heat = heating.specific_heat
             p.taylor_quinney = heating.taylor_quinney
         slots = self.points * POINT_SLOTS + (12 if self.technology.integration == "reduced" else 0)
+        failure = self.failure
+        if failure is not None:  # the damage of each point, after the other slots
+            p.failure = FAILURE[failure.criterion]
+            p.damage_slot = slots
+            if failure.criterion == "plastic_strain":
+                p.failure_strain = failure.plastic_strain
+            else:
+                constants = (failure.d1, failure.d2, failure.d3, failure.d4, failure.d5)
+                for i, value in enumerate(constants):
+                    p.damage_constants[i] = value
+                p.damage_reference_rate = failure.reference_strain_rate
+            slots += self.points
         self.history = np.zeros((slots, self.num_cells))
         self.history[POINT_SLOTS - 1 : self.points * POINT_SLOTS : POINT_SLOTS] = room
 
     def _bind(self, u: np.ndarray, v: np.ndarray, f: np.ndarray, energy: np.ndarray, step):
-        """The kernel of the technology and material, with its arguments bound."""
+        """The kernel of the technology and material, with its arguments bound, over the
+        live cells."""
         ffi, t, model = self.ffi, self.technology, self.name
 
         def ptr(array, kind="double *"):
             return ffi.cast(kind, array.ctypes.data)
 
-        common = (self.num_cells, ptr(self.cells, "int32_t *"), ptr(self.X), ptr(u))
+        computed = self.num_cells if self.erosion is None else self.erosion.computed
+        common = (computed, ptr(self.cells, "int32_t *"), ptr(self.X), ptr(u))
         rest = (self.params, ptr(f), ptr(energy), ptr(step))
         family = "tet4" if t.cell == "tetrahedron" else "hex8"
         if self.plastic:
@@ -363,33 +426,58 @@ class ElementForce:
 
     def energies(self, state) -> dict[str, float]:
         """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
-        without a stored energy, the internal work less the hourglass energy), and
-        ``"hourglass"`` when the elements have hourglass control; for an elasto-plastic
-        body also the parts of the internal energy, ``"elastic"`` and ``"plastic_work"``."""
-        hourglass = self.hourglass_energy
-        internal = self.stored_energy if self.conservative else state.internal_work - hourglass
+        without a stored energy, the internal work less the hourglass energy and the
+        internal energy of eroded cells), and ``"hourglass"`` when the elements have
+        hourglass control, both of the live cells; for an elasto-plastic body also the
+        parts of the internal energy, ``"elastic"`` and ``"plastic_work"``; when cells can
+        erode, the internal energy the eroded cells took with them, ``"eroded_internal"``,
+        and the kinetic energy of the detached nodes, ``"eroded_kinetic"``."""
+        hourglass, eroded = self.hourglass_energy, float(self._energy[3])
+        internal = (
+            self.stored_energy if self.conservative else state.internal_work - hourglass - eroded
+        )
         energies = {"internal": internal}
         if "hourglass" in self.energy_names:
             energies["hourglass"] = hourglass
         if self.plastic:
             energies |= {"elastic": self.stored_energy, "plastic_work": self.plastic_work}
+        if self.erosion is not None:
+            energies |= {
+                "eroded_internal": eroded,
+                "eroded_kinetic": self.erosion.kinetic_energy(state),
+            }
         return energies
 
     def cell_fields(self, state) -> dict[str, np.ndarray]:
-        """Values per owned cell (means over its integration points) for the outputs: for an
-        elasto-plastic body the equivalent plastic strain ``"plastic_strain"`` and the von
-        Mises stress ``"von_mises_stress"`` (Pa); nothing for an elastic one."""
-        if not self.plastic:
-            return {}
-        points = self.history[: self.points * POINT_SLOTS].reshape(self.points, POINT_SLOTS, -1)
-        s = points[:, :6]
-        pressure = s[:, :3].mean(axis=1, keepdims=True)
-        deviator = s[:, :3] - pressure
-        squares = (deviator**2).sum(axis=1) + 2.0 * (s[:, 3:] ** 2).sum(axis=1)
-        return {
-            "plastic_strain": points[:, 6].mean(axis=0),
-            "von_mises_stress": np.sqrt(1.5 * squares).mean(axis=0),
-        }
+        """Values per owned cell for the outputs: for an elasto-plastic body the equivalent
+        plastic strain ``"plastic_strain"`` and the von Mises stress ``"von_mises_stress"``
+        (Pa), means over its integration points, and with a failure criterion the damage
+        ``"damage"``, the largest of its points' (1: failed); when cells can erode,
+        ``"eroded"``, 1 for an eroded cell (its other values are those it failed with) and
+        0 for a live one. Nothing for an elastic body that cannot erode."""
+        fields = {}
+        if self.plastic:
+            points = self.history[: self.points * POINT_SLOTS]
+            points = points.reshape(self.points, POINT_SLOTS, -1)
+            s = points[:, :6]
+            pressure = s[:, :3].mean(axis=1, keepdims=True)
+            deviator = s[:, :3] - pressure
+            squares = (deviator**2).sum(axis=1) + 2.0 * (s[:, 3:] ** 2).sum(axis=1)
+            fields = {
+                "plastic_strain": points[:, 6].mean(axis=0),
+                "von_mises_stress": np.sqrt(1.5 * squares).mean(axis=0),
+            }
+        if self.failure is not None:
+            fields["damage"] = self.damage.max(axis=0)
+        if self.erosion is not None:
+            fields["eroded"] = (~self.erosion.alive).astype(float)
+        return fields
+
+    @property
+    def damage(self) -> np.ndarray:
+        """The damage D of every integration point (rows) of the owned cells (columns)."""
+        start = self.params.damage_slot
+        return self.history[start : start + self.points]
 
     def plastic_strains(self) -> np.ndarray:
         """The equivalent plastic strain of every integration point of the owned cells."""
@@ -397,24 +485,28 @@ class ElementForce:
 
     def accelerate(self, state) -> None:
         """Set ``state.a = -f_int(u^n) / m`` on the owned nodes; estimate the cells' stable
-        steps and find the inverted cells on the way (:attr:`step`)."""
+        steps, find the inverted cells and erode the failed ones on the way (:attr:`step`)."""
         self.u.scatter_forward()
         # The step just taken, dt^{n-1/2}: the elasto-plastic increment u^n - u^{n-1} is
         # dt^{n-1/2} v^{n-1/2} (0 at the first step: the state is the initial one).
         self.params.dt = state.dt_previous
-        if not self.conservative:
-            self.v.scatter_forward()
-        else:
+        if self.conservative:
             self._energy[1] = 0.0
+        # The velocities: of the strain increments, of the viscous hourglass form, and what
+        # an eroded cell did last (failure.h), on the ghost nodes too.
+        if not self.conservative or self.erosion is not None:
+            self.v.scatter_forward()
         self._energy[0] = 0.0
         estimate = self.estimate_every_step or not self._estimated
         self.params.estimate = estimate
-        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0)
+        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         if estimate:
             self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
             self._estimated = True
         self.f.array.fill(0.0)
         self._kernel()
+        if self.step[11]:
+            self._remove_eroded()
         self.f.scatter_reverse_add()
         if self._accelerate is None:
             self._accelerate = functools.partial(
@@ -426,6 +518,18 @@ class ElementForce:
             )
         self._accelerate()
 
+    def _remove_eroded(self) -> None:
+        """Compute the cells the latest pass eroded no more."""
+        e = self.erosion
+        e.remove(int(self.step[11]))
+        self.params.live = self.ffi.cast("int32_t *", e.live.ctypes.data)
+        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
+
+    def detach_nodes(self) -> None:
+        """Count the live cells of the nodes again after a step in which some rank eroded
+        cells (collective)."""
+        self.erosion.detach()
+
     def forces(self, u: np.ndarray) -> np.ndarray:
         """Internal forces (N) on the owned nodes for a displacement ``u`` (owned, (n, 3)), in
         a new array; the body's state is left as it is (the stable step, the tests).
@@ -435,19 +539,22 @@ class ElementForce:
         """
         if self.plastic:
             raise TypeError("an elasto-plastic force depends on the path, not on u alone")
-        if self._probe is None:
+        computed = self.num_cells if self.erosion is None else self.erosion.computed
+        if self._probe is None or self._probe[5] != computed:
             V = self.V
             fields = (GhostedField(V), GhostedField(V), GhostedField(V))
-            energy, step = np.zeros(3), np.zeros(STEP_SLOTS)
-            self._probe = (*fields, self._bind(*(g.array for g in fields), energy, step), energy)
-        u_probe, _, f_probe, kernel, energy = self._probe
+            energy, step = np.zeros(4), np.zeros(STEP_SLOTS)
+            kernel = self._bind(*(g.array for g in fields), energy, step)
+            self._probe = (*fields, kernel, energy, computed)
+        u_probe, _, f_probe, kernel, energy, _ = self._probe
         u_probe.owned[:] = u
         u_probe.scatter_forward()
         f_probe.array.fill(0.0)
         energy[:] = 0.0
         estimate, self.params.estimate = self.params.estimate, False
+        erode, self.params.erode = self.params.erode, 0
         kernel()
-        self.params.estimate = estimate
+        self.params.estimate, self.params.erode = estimate, erode
         f_probe.scatter_reverse_add()
         return f_probe.owned.copy()
 
@@ -463,10 +570,12 @@ class ElementForce:
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """The energies of the latest force computation (J: the viscous hourglass form and
         the elasto-plastic kernels accumulate theirs), what it noted of the cells' steps,
-        and the elasto-plastic state per integration point."""
+        the elasto-plastic state per integration point, and which cells have eroded."""
         arrays = {"energy": self._energy, "step": self.step}
         if self.plastic:
             arrays["history"] = self.history
+        if self.erosion is not None:
+            arrays |= {f"erosion_{k}": v for k, v in self.erosion.checkpoint_state().items()}
         return arrays
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
@@ -475,6 +584,18 @@ class ElementForce:
         self._estimated = True
         if self.plastic:
             self.history[...] = arrays["history"]
+        if self.erosion is not None:
+            e, prefix = self.erosion, "erosion_"
+            e.restore_state(
+                {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
+            )
+            live = (
+                self.ffi.NULL if e.live is None else self.ffi.cast("int32_t *", e.live.ctypes.data)
+            )
+            self.params.live = live
+            self._kernel = self._bind(
+                self.u.array, self.v.array, self.f.array, self._energy, self.step
+            )
 
 
 # Node permutations that turn a cell inside out: a mirror of its reference cell.

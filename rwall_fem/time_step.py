@@ -111,22 +111,25 @@ class _StepSize:
         self.records = StepRecords(self.comm)
         self.stop_reason: str | None = None
         self.limit = math.inf  # the smallest (calibrated) estimate at the latest step, s
-        self._local = np.zeros(3)
-        self._total = np.zeros(3)
+        self._local = np.zeros(4)
+        self._total = np.zeros(4)
         self._reductions = 0  # steps reduced so far: the cache key of controlling_cell
         self._cell = None  # (key, what controlling_cell found)
 
     def _reduce(self, s) -> tuple[float, int, int]:
         """The smallest estimate (s) over the ranks, and the largest number of inverted and
-        of listed (mass-scaling) cells on a rank, from the latest kernel pass."""
+        of listed (mass-scaling) cells on a rank, from the latest kernel pass; after a pass
+        that eroded cells on some rank, the nodes they held are counted again."""
         step = self.force.step
-        self._local[:] = (step[0], -step[5], -step[10])
+        self._local[:] = (step[0], -step[5], -step[10], -step[11])
         self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
         self._reductions += 1
-        smallest, inverted, listed = self._total.tolist()
+        smallest, inverted, listed, eroded = self._total.tolist()
         self.limit = smallest
         if inverted:
             self.stop_reason = self._inverted(s)
+        if eroded:
+            self.force.detach_nodes()
         return smallest, int(-inverted), int(-listed)
 
     def _inverted(self, s) -> str:
@@ -225,10 +228,11 @@ class AdaptiveStep(_StepSize):
     """dt^{n+1/2} = ``dt_scale`` x the smallest (calibrated) estimate of the cells at step n
     (s), rounded down to 4 significant figures.
 
-    ``dt_min`` (s) and ``action`` are ``run.dt_min`` and ``run.dt_min_action``: below
-    ``dt_min`` the run stops after the step ("stop"), or ``mass_scaling`` (a
-    :class:`~rwall_fem.mass_scaling.MassScaling`) adds mass to the cells below it so that
-    the step holds at ``dt_min``. Past ``max_steps`` steps (None: no limit) the run stops.
+    ``dt_min`` (s) is ``run.dt_min``: below it the run stops after the step, unless
+    ``mass_scaling`` (a :class:`~rwall_fem.mass_scaling.MassScaling`) adds mass to the cells
+    below it so that the step holds at ``dt_min``, or ``erode`` (``run.dt_min_action =
+    "erode"``: the force's kernels erode those cells) holds it there. Past ``max_steps``
+    steps (None: no limit) the run stops.
     """
 
     mode = "adaptive"
@@ -243,11 +247,15 @@ class AdaptiveStep(_StepSize):
         dt_scale: float,
         dt_min: float = 0.0,
         mass_scaling=None,
+        erode: bool = False,
         max_steps: float | None = None,
     ):
         super().__init__(initial, force, calibration, comm)
         self.dt_scale, self.dt_min = dt_scale, dt_min
         self.mass_scaling, self.max_steps = mass_scaling, max_steps
+        self.erode = erode
+        if erode:
+            force.erode_below(self.floor)
 
     @property
     def varies(self) -> bool:
@@ -268,9 +276,12 @@ class AdaptiveStep(_StepSize):
             reason = self.mass_scaling.add(sim, s, self.floor)
             self.stop_reason = self.stop_reason or reason
             smallest = max(smallest, self.floor)
-        dt = round_down(self.dt_scale * smallest)
-        if scaled:
-            dt = max(dt, self.dt_min)  # the cells below it were given the mass to hold it
+        # With every cell eroded nothing limits the step: the nodes fly freely at the last.
+        dt = round_down(self.dt_scale * smallest) if math.isfinite(smallest) else s.dt
+        if scaled or self.erode:
+            # The cells below it were given the mass to hold it, or eroded: rounding down
+            # alone takes the step below dt_min.
+            dt = max(dt, self.dt_min)
         s.dt = dt
         self.records.note(s, here)
         if self.stop_reason is not None:
@@ -281,7 +292,7 @@ class AdaptiveStep(_StepSize):
             self.stop_reason = (
                 f"step {s.step}, t = {s.t:.6g} s: the stable step fell to {dt:.4g} s, below "
                 f"run.dt_min = {self.dt_min:g} s{cell} (run.dt_min_action = 'mass_scaling' "
-                "would hold it there)"
+                "would hold it there, 'erode' would erode the cell)"
             )
         elif self.max_steps is not None and s.step >= self.max_steps and not s.last:
             self.stop_reason = (
@@ -351,9 +362,10 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
             run.dt_min / run.dt_scale,
         )  # fmt: skip
     elif run.dt_min > initial:
+        outcome = "erode every cell" if run.dt_min_action == "erode" else "stop"
         raise SceneError(
             f"{scene.source}: run.dt_min: {run.dt_min:g} s is above the step at rest, "
-            f"{initial:.4g} s: the run would stop at its first step; lower it, or set "
+            f"{initial:.4g} s: the run would {outcome} at its first step; lower it, or set "
             "run.dt_min_action = 'mass_scaling'"
         )
     adaptive = AdaptiveStep(
@@ -364,6 +376,7 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
         dt_scale=run.dt_scale,
         dt_min=run.dt_min,
         mass_scaling=mass_scaling,
+        erode=run.dt_min_action == "erode",
         max_steps=run.max_steps if limits else None,
     )
     adaptive.at_rest = dt_stable / ratio

@@ -38,6 +38,7 @@ from functools import cache
 from pathlib import Path
 
 __all__ = [
+    "FAILURE",
     "HOURGLASS",
     "MODELS",
     "POINT_SLOTS",
@@ -49,8 +50,8 @@ __all__ = [
 
 log = logging.getLogger("rwall_fem")
 
-SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "tetrahedron.c", "hexahedron.c",
-           "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
+SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
+           "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -59,7 +60,8 @@ FLAG_SETS = (
 )
 MODELS = ("linear_elastic", "saint_venant_kirchhoff", "neo_hookean")  # the elastic laws
 POINT_SLOTS = 8  # state values per integration point of the plastic kernels (plasticity.h)
-STEP_SLOTS = 11  # what a kernel notes of the element steps and inverted cells (step.h)
+STEP_SLOTS = 12  # what a kernel notes of the element steps, inverted and eroded cells (step.h)
+FAILURE = {"plastic_strain": 1, "johnson_cook": 2}  # the failure criteria (failure.h)
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
 
 _CDEF = (
@@ -81,6 +83,18 @@ typedef struct {
   double step_floor;
   int32_t *below;
   double *below_step;
+  int failure;
+  double failure_strain;
+  double damage_constants[5];
+  double damage_reference_rate;
+  int damage_slot;
+  int erode;
+  double erode_step;
+  const int32_t *live;
+  int32_t *eroded;
+  double *cell_work;
+  int64_t cell_stride;
+  const double *velocity;
 } element_params;
 double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);

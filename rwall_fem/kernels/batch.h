@@ -62,29 +62,66 @@ typedef struct
   double step_floor;            /* s: the cells whose step is below it are listed in below */
   int32_t *below;               /* NULL, or room for every cell's index */
   double *below_step;           /* and for its step before mass scaling, s */
+  /* failure and erosion (failure.h) */
+  int failure;                  /* FAILURE_NONE, FAILURE_PLASTIC_STRAIN or FAILURE_JOHNSON_COOK */
+  double failure_strain;        /* eps_f of FAILURE_PLASTIC_STRAIN */
+  double damage_constants[5];   /* D1 .. D5 of FAILURE_JOHNSON_COOK */
+  double damage_reference_rate; /* 1/s, of its rate term */
+  int damage_slot;              /* the state's row of the first point's damage D */
+  int erode;                    /* decide erosion in this call (0: the cells only compute) */
+  double erode_step;            /* s: a cell whose step estimate is below it is eroded (0: none) */
+  const int32_t *live;          /* NULL: every cell; else the live cells' indices, increasing */
+  int32_t *eroded;              /* room for every cell's index: the cells eroded in this call */
+  double *cell_work;            /* NULL, or per cell its plastic work (row 0) and hourglass work
+                                   (row 1) so far, J, rows of cell_stride values */
+  int64_t cell_stride;
+  const double *velocity;       /* v^{n-1/2} of the nodes, m/s (what an eroded cell did last) */
 } element_params;
 
-/* Gather the 3 components of the npe nodes of cells c0 .. c0 + LANES - 1 into
- * out[3 I + i][lane]; lanes from nb on repeat cell c0. */
-INLINE void gather(const int32_t *restrict cells, int npe, int64_t c0, int nb,
+/* The cells of a batch: lane k holds cell id[k] (the lanes from nb on repeat the first);
+ * `run` when they are LANES consecutive cells, whose per-cell values load as one vector. */
+typedef struct
+{
+  int64_t id[LANES];
+  int nb;
+  int run;
+} batch_t;
+
+/* The batch of the cells k0 .. k0 + LANES - 1 of the n computed: the cells themselves, or
+ * when `live` is given (the live cells' indices, increasing), live[k0 ..]. */
+INLINE batch_t batch_at(const int32_t *restrict live, int64_t k0, int64_t n)
+{
+  batch_t b;
+  b.nb = n - k0 < LANES ? (int)(n - k0) : LANES;
+  for (int k = 0; k < LANES; ++k)
+  {
+    const int64_t j = k0 + (k < b.nb ? k : 0);
+    b.id[k] = live ? live[j] : j;
+  }
+  b.run = b.nb == LANES && b.id[LANES - 1] - b.id[0] == LANES - 1;
+  return b;
+}
+
+/* Gather the 3 components of the npe nodes of the batch's cells into out[3 I + i][lane]. */
+INLINE void gather(const int32_t *restrict cells, int npe, const batch_t *b,
                    const double *restrict values, vec *restrict out)
 {
   for (int k = 0; k < LANES; ++k)
   {
-    const int32_t *cell = cells + (c0 + (k < nb ? k : 0)) * npe;
+    const int32_t *cell = cells + b->id[k] * npe;
     for (int I = 0; I < npe; ++I)
       for (int i = 0; i < 3; ++i)
         out[3 * I + i][k] = values[3 * (int64_t)cell[I] + i];
   }
 }
 
-/* Add the nodal forces in[3 I + i][lane] of the nb valid lanes to f. */
-INLINE void scatter_add(const int32_t *restrict cells, int npe, int64_t c0, int nb,
+/* Add the nodal forces in[3 I + i][lane] of the batch's nb valid lanes to f. */
+INLINE void scatter_add(const int32_t *restrict cells, int npe, const batch_t *b,
                         const vec *restrict in, double *restrict f)
 {
-  for (int k = 0; k < nb; ++k)
+  for (int k = 0; k < b->nb; ++k)
   {
-    const int32_t *cell = cells + (c0 + k) * npe;
+    const int32_t *cell = cells + b->id[k] * npe;
     for (int I = 0; I < npe; ++I)
       for (int i = 0; i < 3; ++i)
         f[3 * (int64_t)cell[I] + i] += in[3 * I + i][k];
@@ -132,6 +169,38 @@ INLINE vec vlog(vec x)
   return (vec)(((ivec)r & finite) | (special & ~finite));
 }
 
+INLINE vec vmax(vec a, vec b)
+{
+  const ivec m = a > b;
+  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
+}
+
+INLINE vec vmin(vec a, vec b)
+{
+  const ivec m = a < b;
+  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
+}
+
+/* e^x to about one ulp, all lanes at once, for x in [-708, 709] (clipped there): x = n log 2
+ * + r with n the nearest integer of x / log 2, |r| <= log(2) / 2, e^r by 14 terms of its
+ * series (the next is below 1e-17 of the sum), times 2^n set in the exponent bits. */
+INLINE vec vexp(vec x)
+{
+  x = vmin(vmax(x, VZERO - 708.0), VZERO + 709.0);
+  const double shift = 6755399441055744.0; /* 1.5 2^52: adding it rounds to an integer */
+  const vec n = (x * 1.44269504088896340736 + shift) - shift;
+  const vec r = (x - n * 6.93147180369123816490e-01) - n * 1.90821492927058770002e-10;
+  vec series = VZERO + 1.0 / 87178291200.0; /* 1/14! */
+  double factorial = 87178291200.0;
+  for (int k = 13; k >= 0; --k)
+  {
+    factorial /= (k + 1);
+    series = series * r + 1.0 / factorial;
+  }
+  const ivec bits = (__builtin_convertvector(n, ivec) + 1023) << 52;
+  return series * (vec)bits;
+}
+
 INLINE vec vcbrt(vec x)
 {
   vec r;
@@ -148,18 +217,6 @@ INLINE vec vsqrt(vec x)
   return r;
 }
 
-INLINE vec vmax(vec a, vec b)
-{
-  const ivec m = a > b;
-  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
-}
-
-INLINE vec vmin(vec a, vec b)
-{
-  const ivec m = a < b;
-  return (vec)(((ivec)a & m) | ((ivec)b & ~m));
-}
-
 INLINE vec vselect(ivec m, vec a, vec b)
 {
   return (vec)(((ivec)a & m) | ((ivec)b & ~m));
@@ -173,16 +230,26 @@ INLINE int any_lane(ivec m)
   return r;
 }
 
-/* The per-cell values a[c0 .. c0 + LANES - 1]; lanes from nb on repeat cell c0. */
-INLINE vec cell_values(const double *restrict a, int64_t c0, int nb)
+/* The per-cell values a[id] of the batch's cells. */
+INLINE vec cell_values(const double *restrict a, const batch_t *b)
 {
   vec v;
-  if (nb == LANES)
-    __builtin_memcpy(&v, a + c0, sizeof v);
+  if (b->run)
+    __builtin_memcpy(&v, a + b->id[0], sizeof v);
   else
     for (int k = 0; k < LANES; ++k)
-      v[k] = a[c0 + (k < nb ? k : 0)];
+      v[k] = a[b->id[k]];
   return v;
+}
+
+/* Store the per-cell values v of the batch's nb valid lanes in a[id]. */
+INLINE void set_cell_values(double *restrict a, const batch_t *b, vec v)
+{
+  if (b->run)
+    __builtin_memcpy(a + b->id[0], &v, sizeof v);
+  else
+    for (int k = 0; k < b->nb; ++k)
+      a[b->id[k]] = v[k];
 }
 
 /* The sum of the first nb lanes. */

@@ -7,9 +7,8 @@
  * f_I += |det J| T(grad u) grad N_I (materials.h).  This is the rule UFL uses
  * with quadrature degree 2 on hexahedra, which the tests compare against.
  */
+#include "failure.h"
 #include "materials.h"
-#include "plasticity.h"
-#include "step.h"
 
 static const double SIGN[8][3] = {{-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1},
                                   {-1, -1, 1},  {1, -1, 1},  {-1, 1, 1},  {1, 1, 1}};
@@ -95,7 +94,8 @@ INLINE vec hex8_cell(int model, const vec *restrict x, const vec *restrict u, ve
 }
 
 /* Total Lagrangian hexahedra: the stable step of a cell is L_0 / c with its length at
- * rest and the largest wave speed of the law at its points (step.h). */
+ * rest and the largest wave speed of the law at its points (step.h); erosion as failure.h
+ * says. */
 INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cells,
                        const double *restrict X, const double *restrict u,
                        const element_params *p, double *restrict f, double *restrict energy,
@@ -103,22 +103,28 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
 {
   vec x[24], ue[24], fe[24], jacobian, modulus;
   double total = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 8, c0, nb, X, x);
-    gather(cells, 8, c0, nb, u, ue);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 8, &b, X, x);
+    gather(cells, 8, &b, u, ue);
     const vec w = hex8_cell(model, x, ue, fe, p, &jacobian, &modulus);
-    scatter_add(cells, 8, c0, nb, fe, f);
-    total += lane_sum(w, nb);
     const ivec inverted = jacobian <= 0.0;
-    note_inverted(inverted, c0, nb, x, ue, 8, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
+      dte = p->calibration * cell_values(p->length0, &b) * vsqrt(p->density / modulus);
+    const ivec failed = failed_lanes(p, VZERO, inverted, dte);
+    if (any_lane(failed))
     {
-      const vec dte = p->calibration * cell_values(p->length0, c0, nb)
-                      * vsqrt(p->density / modulus);
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 8, step);
+      vec du[24];
+      increments(p, cells, 8, &b, du);
+      erode(p, failed, &b, energy_left(w, du, fe, 8), VZERO, VZERO, fe, 8, energy, step);
     }
+    scatter_add(cells, 8, &b, fe, f);
+    total += lane_sum(vselect(failed, VZERO, w), b.nb);
+    note_inverted(inverted & ~failed, &b, x, ue, 8, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 8, step);
   }
   energy[0] += total;
 }
@@ -126,8 +132,9 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
 /* Elasto-plastic Q1 hexahedra, 2x2x2 points with mean dilatation (B-bar: every point
  * takes the element's mean volumetric increment, and the pressure acts through the mean
  * gradient), updated Lagrangian as tet4_plastic; the state holds POINT_SLOTS slots per
- * point.  energy[0] += stored elastic energy (J), energy[2] += plastic dissipation; a cell
- * is inverted when det J <= 0 at a point, and its stable step is L / c in the current
+ * point, and the damage rows of failure.h (a cell fails when one of its points does).
+ * energy[0] += stored elastic energy (J), energy[2] += plastic dissipation; a cell is
+ * inverted when det J <= 0 at a point, and its stable step is L / c in the current
  * configuration (step.h). */
 void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
@@ -136,12 +143,12 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
 {
   vec Xe[24], ue[24], ve[24], fe[24];
   double stored = 0.0, dissipated = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 8, c0, nb, X, Xe);
-    gather(cells, 8, c0, nb, u, ue);
-    gather(cells, 8, c0, nb, v, ve);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 8, &b, X, Xe);
+    gather(cells, 8, &b, u, ue);
+    gather(cells, 8, &b, v, ve);
     vec x[24], xm[24], du[24], smallest = VZERO + INFINITY;
     for (int i = 0; i < 24; ++i)
     {
@@ -161,16 +168,24 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       volume += wm[q];
     }
     const vec mean_trace = trace / volume;
-    vec dissipation = VZERO, sigma[8][9];
+    vec dissipation = VZERO, sigma[8][9], damage = VZERO;
     for (int q = 0; q < 8; ++q)
     {
       vec dL[9], eps_p, T;
       hex8_gradient(du, gm[q], dL);
       const vec shift = (1.0 / 3.0) * (mean_trace - (dL[0] + dL[4] + dL[8]));
       dL[0] += shift, dL[4] += shift, dL[8] += shift;
-      load_point(state, stride, c0, nb, POINT_SLOTS * q, sigma[q], &eps_p, &T);
-      dissipation += wm[q] * plastic_update(p, sigma[q], &eps_p, &T, dL);
-      store_point(state, stride, c0, nb, POINT_SLOTS * q, sigma[q], eps_p, T);
+      load_point(state, stride, &b, POINT_SLOTS * q, sigma[q], &eps_p, &T);
+      point_step done;
+      dissipation += wm[q] * plastic_update(p, sigma[q], &eps_p, &T, dL, &done);
+      store_point(state, stride, &b, POINT_SLOTS * q, sigma[q], eps_p, T);
+      if (p->failure)
+      {
+        const int slot = p->damage_slot + q;
+        const vec D = accumulate_damage(p, load_slot(state, stride, &b, slot), &done, T);
+        store_slot(state, stride, &b, slot, D);
+        damage = vmax(damage, D);
+      }
     }
     /* f_I = sum_q w_q s_q g_Iq + (sum_q w_q p_q) (sum_q w_q g_Iq) / sum_q w_q */
     vec G[24], pressure = VZERO, elastic = VZERO;
@@ -199,17 +214,26 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     const vec mean_pressure = pressure / volume;
     for (int I = 0; I < 24; ++I)
       fe[I] += mean_pressure * G[I];
-    scatter_add(cells, 8, c0, nb, fe, f);
-    stored += lane_sum(elastic, nb);
-    dissipated += lane_sum(dissipation, nb);
+    dissipated += lane_sum(dissipation, b.nb);
     const ivec inverted = smallest <= 0.0;
-    note_inverted(inverted, c0, nb, x, NULL, 8, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
     {
-      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, c0, nb));
-      const vec dte = p->calibration * characteristic_length(8, x, volume) / speed;
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 8, step);
+      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, &b));
+      dte = p->calibration * characteristic_length(8, x, volume) / speed;
     }
+    const ivec failed = failed_lanes(p, damage, inverted, dte);
+    vec plastic_total = VZERO, hourglass_total = VZERO;
+    if (p->cell_work)
+      track_work(p, &b, dissipation, VZERO, &plastic_total, &hourglass_total);
+    if (any_lane(failed))
+      erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 8), plastic_total,
+            VZERO, fe, 8, energy, step);
+    scatter_add(cells, 8, &b, fe, f);
+    stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 8, step);
   }
   energy[0] += stored;
   energy[2] += dissipated;

@@ -34,9 +34,8 @@
  * each times the hourglass coefficient.  energy[0] += stored elastic energy,
  * energy[1] += hourglass energy (stored) or its dissipation in this step.
  */
+#include "failure.h"
 #include "materials.h"
-#include "plasticity.h"
-#include "step.h"
 
 enum
 {
@@ -275,7 +274,8 @@ INLINE void hex8r_cell(int model, int hourglass, const vec *restrict x, const ve
 
 /* Total Lagrangian one-point hexahedra: the stable step of a cell is L_0 / c with its
  * length at rest and the wave speed of the law at its strain, and with the viscous form
- * at most that of its damped hourglass modes (step.h). */
+ * at most that of its damped hourglass modes (step.h); erosion as failure.h says (the
+ * viscous form's dissipation is tracked per cell in p->cell_work for it). */
 INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
                         const int32_t *restrict cells, const double *restrict X,
                         const double *restrict u, const double *restrict v,
@@ -284,28 +284,45 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
 {
   vec x[24], ue[24], ve[24], fe[24], stored, hourglass_energy, jacobian, modulus, volume;
   double total = 0.0, hourglass_total = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 8, c0, nb, X, x);
-    gather(cells, 8, c0, nb, u, ue);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 8, &b, X, x);
+    gather(cells, 8, &b, u, ue);
     if (hourglass == HOURGLASS_VISCOUS)
-      gather(cells, 8, c0, nb, v, ve);
+      gather(cells, 8, &b, v, ve);
     hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p, &jacobian,
                &modulus, &volume);
-    scatter_add(cells, 8, c0, nb, fe, f);
-    total += lane_sum(stored, nb);
-    hourglass_total += lane_sum(hourglass_energy, nb);
     const ivec inverted = jacobian <= 0.0;
-    note_inverted(inverted, c0, nb, x, ue, 8, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
     {
-      vec dte = p->calibration * cell_values(p->length0, c0, nb)
-                * vsqrt(p->density / modulus);
+      dte = p->calibration * cell_values(p->length0, &b) * vsqrt(p->density / modulus);
       if (hourglass == HOURGLASS_VISCOUS)
         dte = vmin(dte, viscous_hourglass_step(p, volume, volume));
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 8, step);
     }
+    const ivec failed = failed_lanes(p, VZERO, inverted, dte);
+    /* the viscous form's dissipation accumulates; the other forms' energy is stored */
+    vec dissipated = VZERO, held = hourglass_energy, unused;
+    if (hourglass == HOURGLASS_VISCOUS && p->cell_work)
+      track_work(p, &b, VZERO, hourglass_energy, &unused, &held);
+    if (hourglass == HOURGLASS_VISCOUS)
+      dissipated = held;
+    if (any_lane(failed))
+    {
+      vec du[24];
+      increments(p, cells, 8, &b, du);
+      erode(p, failed, &b, energy_left(stored + held, du, fe, 8), VZERO, dissipated, fe, 8,
+            energy, step);
+    }
+    scatter_add(cells, 8, &b, fe, f);
+    total += lane_sum(vselect(failed, VZERO, stored), b.nb);
+    hourglass_total += lane_sum(
+        hourglass == HOURGLASS_VISCOUS ? hourglass_energy : vselect(failed, VZERO, hourglass_energy),
+        b.nb);
+    note_inverted(inverted & ~failed, &b, x, ue, 8, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 8, step);
   }
   energy[0] += total;
   energy[1] += hourglass_total;
@@ -316,7 +333,8 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
  * the mid-step configuration; the force is that of the updated stress in the current one,
  * x = X + u.  The hourglass forces are incremental, Q^n = R Q^{n-1} + dQ(dq) with the
  * element's rotation R and dq the hourglass amplitudes of du in the current configuration
- * (the viscous form: Q = Q(dq / dt)); the state keeps Q after the point's slots.
+ * (the viscous form: Q = Q(dq / dt)); the state keeps Q after the point's slots, then the
+ * damage row of failure.h, which also says how cells fail and are eroded.
  * energy[0] += stored elastic energy (J), energy[1] += hourglass work of the step,
  * energy[2] += plastic dissipation of the step; a cell is inverted when its volume is not
  * positive, and its stable step is L / c in the current configuration, c from the elastic
@@ -330,12 +348,12 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
 {
   vec Xe[24], ue[24], ve[24], fe[24];
   double stored = 0.0, hourglass_work = 0.0, dissipated = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 8, c0, nb, X, Xe);
-    gather(cells, 8, c0, nb, u, ue);
-    gather(cells, 8, c0, nb, v, ve);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 8, &b, X, Xe);
+    gather(cells, 8, &b, u, ue);
+    gather(cells, 8, &b, v, ve);
     vec x[24], xm[24], du[24], dL[9], sigma[9], eps_p, T;
     for (int i = 0; i < 24; ++i)
     {
@@ -347,27 +365,35 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     hex8r_geometry(xm, &geo);
     const vec mid_volume = geo.volume;
     hex8r_gradient(du, &geo, dL);
-    load_point(state, stride, c0, nb, 0, sigma, &eps_p, &T);
-    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
-    store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
+    load_point(state, stride, &b, 0, sigma, &eps_p, &T);
+    point_step done;
+    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL, &done);
+    store_point(state, stride, &b, 0, sigma, eps_p, T);
+    vec damage = VZERO;
+    if (p->failure)
+    {
+      damage = accumulate_damage(p, load_slot(state, stride, &b, p->damage_slot), &done, T);
+      store_slot(state, stride, &b, p->damage_slot, damage);
+    }
     hex8r_geometry(x, &geo);
     const ivec inverted = geo.V <= 0.0;
-    note_inverted(inverted, c0, nb, x, NULL, 8, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
     {
-      const vec volume0 = cell_values(p->volume0, c0, nb);
+      const vec volume0 = cell_values(p->volume0, &b);
       const vec speed = p->wave_speed * vsqrt(geo.volume / volume0);
-      vec dte = p->calibration * characteristic_length(8, x, geo.volume) / speed;
+      dte = p->calibration * characteristic_length(8, x, geo.volume) / speed;
       if (hourglass == HOURGLASS_VISCOUS)
         dte = vmin(dte, viscous_hourglass_step(p, geo.volume, volume0));
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 8, step);
     }
     hex8r_nodal_forces(&geo, sigma, fe);
-    stored += lane_sum(geo.volume * elastic_energy_density(p, sigma), nb);
-    dissipated += lane_sum(mid_volume * dissipation, nb);
+    const vec elastic = geo.volume * elastic_energy_density(p, sigma);
+    const vec plastic = mid_volume * dissipation;
+    dissipated += lane_sum(plastic, b.nb);
+    vec work = VZERO;
     if (hourglass != HOURGLASS_NONE)
     {
-      vec gamma[4][8], dq[4][3], Q[4][3], work = VZERO;
+      vec gamma[4][8], dq[4][3], Q[4][3];
       hourglass_modes(&geo, du, gamma, dq);
       if (hourglass == HOURGLASS_VISCOUS)
       {
@@ -385,7 +411,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
         rotation(dL, R);
         for (int a = 0; a < 4; ++a)
           for (int i = 0; i < 3; ++i)
-            Q_old[a][i] = load_slot(state, stride, c0, nb, POINT_SLOTS + 3 * a + i);
+            Q_old[a][i] = load_slot(state, stride, &b, POINT_SLOTS + 3 * a + i);
         hourglass_forces(hourglass, &geo, dq, p, 0.0, dQ);
         for (int a = 0; a < 4; ++a)
         {
@@ -395,14 +421,25 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
                                 + R[3 * i + 2] * Q_old[a][2];
             Q[a][i] = rotated + dQ[a][i];
             work += (rotated + 0.5 * dQ[a][i]) * dq[a][i];
-            store_slot(state, stride, c0, nb, POINT_SLOTS + 3 * a + i, Q[a][i]);
+            store_slot(state, stride, &b, POINT_SLOTS + 3 * a + i, Q[a][i]);
           }
         }
       }
       hourglass_nodal_forces(gamma, Q, fe);
-      hourglass_work += lane_sum(work, nb);
+      hourglass_work += lane_sum(work, b.nb);
     }
-    scatter_add(cells, 8, c0, nb, fe, f);
+    const ivec failed = failed_lanes(p, damage, inverted, dte);
+    vec plastic_total = VZERO, hourglass_total = VZERO;
+    if (p->cell_work)
+      track_work(p, &b, plastic, work, &plastic_total, &hourglass_total);
+    if (any_lane(failed))
+      erode(p, failed, &b, energy_left(elastic + plastic_total + hourglass_total, du, fe, 8),
+            plastic_total, hourglass_total, fe, 8, energy, step);
+    scatter_add(cells, 8, &b, fe, f);
+    stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 8, step);
   }
   energy[0] += stored;
   energy[1] += hourglass_work;
@@ -450,17 +487,17 @@ void hex8_cell_sizes(int64_t num_cells, const int32_t *cells, const double *x, d
                      double *length)
 {
   vec xe[24];
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 8, c0, nb, x, xe);
+    const batch_t b = batch_at(NULL, k0, num_cells);
+    gather(cells, 8, &b, x, xe);
     hex8r_geometry_t geo;
     hex8r_geometry(xe, &geo);
     const vec l = characteristic_length(8, xe, geo.volume);
-    for (int k = 0; k < nb; ++k)
+    for (int k = 0; k < b.nb; ++k)
     {
-      volume[c0 + k] = geo.volume[k];
-      length[c0 + k] = l[k];
+      volume[k0 + k] = geo.volume[k];
+      length[k0 + k] = l[k];
     }
   }
 }

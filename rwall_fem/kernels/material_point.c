@@ -14,7 +14,8 @@ double plastic_point(const element_params *p, double sigma[6], double *eps_p, do
   s[2] = s[6] = VZERO + sigma[5];
   for (int i = 0; i < 9; ++i)
     g[i] = VZERO + dL[i];
-  const vec dissipation = plastic_update(p, s, &e, &t, g);
+  point_step done;
+  const vec dissipation = plastic_update(p, s, &e, &t, g, &done);
   sigma[0] = s[0][0], sigma[1] = s[4][0], sigma[2] = s[8][0];
   sigma[3] = s[1][0], sigma[4] = s[5][0], sigma[5] = s[2][0];
   *eps_p = e[0];

@@ -122,11 +122,20 @@ INLINE void rotate(vec sigma[9], const vec dL[9])
     }
 }
 
+/* What a step did at a point, for the failure criteria (failure.h). */
+typedef struct
+{
+  vec increment;   /* d, the plastic strain increment (0 where the step was elastic) */
+  vec rate;        /* the equivalent strain rate of the step, 1/s */
+  vec triaxiality; /* mean stress / von Mises stress after the return (where d > 0) */
+} point_step;
+
 /* One step of the material at a point: the stress sigma[9] (Pa, in/out), the plastic
- * strain *eps_p and temperature *T (in/out) from the increment gradient dL[9] over dt.
- * Returns the plastic dissipation density (J/m^3) of the step, sigma_y d. */
+ * strain *eps_p and temperature *T (in/out) from the increment gradient dL[9] over dt;
+ * what the step did in *done.  Returns the plastic dissipation density (J/m^3) of the
+ * step, sigma_y d. */
 INLINE vec plastic_update(const element_params *p, vec sigma[9], vec *eps_p, vec *T,
-                          const vec dL[9])
+                          const vec dL[9], point_step *done)
 {
   const double mu = p->mu, lambda = p->lmbda;
   rotate(sigma, dL);
@@ -151,6 +160,8 @@ INLINE vec plastic_update(const element_params *p, vec sigma[9], vec *eps_p, vec
   vec slope;
   const vec yield = flow_stress(p, *eps_p, rate, *T, &slope);
   const ivec plastic = q_trial > yield;
+  done->increment = done->triaxiality = VZERO;
+  done->rate = rate;
   if (!any_lane(plastic))
     return VZERO;
   vec d;
@@ -185,6 +196,9 @@ INLINE vec plastic_update(const element_params *p, vec sigma[9], vec *eps_p, vec
   *eps_p += d;
   final_yield = flow_stress(p, *eps_p, rate, *T, &unused);
   const vec dissipation = final_yield * d;
+  done->increment = d;
+  /* after the return the von Mises stress is the flow stress, positive where d > 0 */
+  done->triaxiality = pressure / vselect(plastic, final_yield, VZERO + 1.0);
   if (p->thermal)
     *T += (p->taylor_quinney / (p->density * p->specific_heat)) * dissipation;
   return dissipation;
@@ -204,36 +218,24 @@ INLINE vec elastic_energy_density(const element_params *p, const vec sigma[9])
   return ss * (1.0 / (4.0 * p->mu)) + pressure * pressure * (1.0 / (2.0 * bulk));
 }
 
-/* The POINT_SLOTS values of cells c0 .. c0 + LANES - 1 at point slot `base` of the state
- * (slot k of cell c at state[k * stride + c]); lanes from nb on repeat cell c0. */
-INLINE vec load_slot(const double *restrict state, int64_t stride, int64_t c0, int nb, int slot)
+/* Slot `slot` of the batch's cells in the state (slot k of cell c at state[k * stride + c]). */
+INLINE vec load_slot(const double *restrict state, int64_t stride, const batch_t *b, int slot)
 {
-  vec v;
-  const double *row = state + slot * stride + c0;
-  if (nb == LANES)
-    __builtin_memcpy(&v, row, sizeof v);
-  else
-    for (int k = 0; k < LANES; ++k)
-      v[k] = row[k < nb ? k : 0];
-  return v;
+  return cell_values(state + slot * stride, b);
 }
 
-INLINE void store_slot(double *restrict state, int64_t stride, int64_t c0, int nb, int slot, vec v)
+INLINE void store_slot(double *restrict state, int64_t stride, const batch_t *b, int slot, vec v)
 {
-  double *row = state + slot * stride + c0;
-  if (nb == LANES)
-    __builtin_memcpy(row, &v, sizeof v);
-  else
-    for (int k = 0; k < nb; ++k)
-      row[k] = v[k];
+  set_cell_values(state + slot * stride, b, v);
 }
 
-INLINE void load_point(const double *restrict state, int64_t stride, int64_t c0, int nb,
-                       int base, vec sigma[9], vec *eps_p, vec *T)
+/* The POINT_SLOTS values of the batch's cells from slot `base` of the state. */
+INLINE void load_point(const double *restrict state, int64_t stride, const batch_t *b, int base,
+                       vec sigma[9], vec *eps_p, vec *T)
 {
   vec v[POINT_SLOTS];
   for (int slot = 0; slot < POINT_SLOTS; ++slot)
-    v[slot] = load_slot(state, stride, c0, nb, base + slot);
+    v[slot] = load_slot(state, stride, b, base + slot);
   sigma[0] = v[0], sigma[4] = v[1], sigma[8] = v[2];
   sigma[1] = sigma[3] = v[3];
   sigma[5] = sigma[7] = v[4];
@@ -242,13 +244,13 @@ INLINE void load_point(const double *restrict state, int64_t stride, int64_t c0,
   *T = v[7];
 }
 
-INLINE void store_point(double *restrict state, int64_t stride, int64_t c0, int nb, int base,
+INLINE void store_point(double *restrict state, int64_t stride, const batch_t *b, int base,
                         const vec sigma[9], vec eps_p, vec T)
 {
   const vec v[POINT_SLOTS] = {sigma[0], sigma[4], sigma[8], sigma[1],
                               sigma[5], sigma[2], eps_p,    T};
   for (int slot = 0; slot < POINT_SLOTS; ++slot)
-    store_slot(state, stride, c0, nb, base + slot, v[slot]);
+    store_slot(state, stride, b, base + slot, v[slot]);
 }
 
 #endif

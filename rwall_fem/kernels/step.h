@@ -12,15 +12,17 @@
  *   step[1]     that cell (local index), step[2..4] its centroid (m, current position),
  *   step[5]     how many cells are inverted (a volume <= 0 at an integration point),
  *   step[6]     the first of them, step[7..9] its centroid (m),
- *   step[10]    how many cells it listed in p->below (dt_e below p->step_floor).
- * A mass-scaled cell's dt_e is multiplied by its p->step_factor, sqrt(m / m_0).
+ *   step[10]    how many cells it listed in p->below (dt_e below p->step_floor),
+ *   step[11]    how many cells it eroded, listed in p->eroded (failure.h).
+ * A mass-scaled cell's dt_e is multiplied by its p->step_factor, sqrt(m / m_0).  An eroded
+ * cell is neither estimated nor counted as inverted.
  */
 #ifndef RWALL_STEP_H
 #define RWALL_STEP_H
 
 #include "batch.h"
 
-#define STEP_SLOTS 11
+#define STEP_SLOTS 12
 
 /* Node pairs of the two diagonals of each face of a hexahedron (DOLFINx numbering). */
 static const int HEX_FACE_DIAGONALS[6][4] = {{0, 6, 2, 4}, {1, 7, 3, 5}, {0, 5, 1, 4},
@@ -97,44 +99,43 @@ INLINE void centroid(const vec *restrict x, const vec *restrict u, int npe, int 
   }
 }
 
-/* Note the steps dt_e (s) of the nb cells from c0, at x (+ u): the smallest so far, and
- * when p->below is given the cells below p->step_floor, with their steps before mass
- * scaling in p->below_step.  NaN (a broken state, caught by the run's guards) is never
- * the smallest. */
-INLINE void note_steps(const element_params *p, vec dte, int64_t c0, int nb,
+/* Note the steps dt_e (s) of the batch's cells, at x (+ u): the smallest so far, and when
+ * p->below is given the cells below p->step_floor, with their steps before mass scaling in
+ * p->below_step.  NaN (a broken state, caught by the run's guards) is never the smallest. */
+INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
                        const vec *restrict x, const vec *restrict u, int npe, double *step)
 {
-  const vec scaled = p->step_factor ? dte * cell_values(p->step_factor, c0, nb) : dte;
-  for (int k = 0; k < nb; ++k)
+  const vec scaled = p->step_factor ? dte * cell_values(p->step_factor, b) : dte;
+  for (int k = 0; k < b->nb; ++k)
   {
     const double d = scaled[k];
     if (d < step[0])
     {
       step[0] = d;
-      step[1] = (double)(c0 + k);
+      step[1] = (double)b->id[k];
       centroid(x, u, npe, k, step + 2);
     }
     if (p->below && d < p->step_floor)
     {
       const int64_t i = (int64_t)step[10]++;
-      p->below[i] = (int32_t)(c0 + k);
+      p->below[i] = (int32_t)b->id[k];
       p->below_step[i] = dte[k];
     }
   }
 }
 
 /* Count the cells of the batch that are inverted (`bad` lanes), and note the first. */
-INLINE void note_inverted(ivec bad, int64_t c0, int nb, const vec *restrict x,
+INLINE void note_inverted(ivec bad, const batch_t *b, const vec *restrict x,
                           const vec *restrict u, int npe, double *step)
 {
   if (!any_lane(bad))
     return;
-  for (int k = 0; k < nb; ++k)
+  for (int k = 0; k < b->nb; ++k)
     if (bad[k])
     {
       if (step[5] == 0.0)
       {
-        step[6] = (double)(c0 + k);
+        step[6] = (double)b->id[k];
         centroid(x, u, npe, k, step + 7);
       }
       step[5] += 1.0;

@@ -8,9 +8,8 @@
  * plastic flow constant-strain tetrahedra lock (one volume constraint per cell):
  * prefer hexahedra there (docs/theory.md).
  */
+#include "failure.h"
 #include "materials.h"
-#include "plasticity.h"
-#include "step.h"
 
 /* Shape function gradients g[I] (1/m) and volume (m^3) of the tetrahedra at x[3 I + i];
  * *det the signed 6 V (positive for the orientation of elasto-plastic cells). */
@@ -74,7 +73,7 @@ INLINE vec tet4_cell(int model, const vec *restrict x, const vec *restrict u, ve
 }
 
 /* Total Lagrangian tetrahedra: the stable step of a cell is L_0 / c with its length at
- * rest and the wave speed of the law at its strain (step.h). */
+ * rest and the wave speed of the law at its strain (step.h); erosion as failure.h says. */
 INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cells,
                        const double *restrict X, const double *restrict u,
                        const element_params *p, double *restrict f, double *restrict energy,
@@ -82,22 +81,28 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
 {
   vec x[12], ue[12], fe[12], jacobian, modulus;
   double total = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 4, c0, nb, X, x);
-    gather(cells, 4, c0, nb, u, ue);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 4, &b, X, x);
+    gather(cells, 4, &b, u, ue);
     const vec w = tet4_cell(model, x, ue, fe, p, &jacobian, &modulus);
-    scatter_add(cells, 4, c0, nb, fe, f);
-    total += lane_sum(w, nb);
     const ivec inverted = jacobian <= 0.0;
-    note_inverted(inverted, c0, nb, x, ue, 4, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
+      dte = p->calibration * cell_values(p->length0, &b) * vsqrt(p->density / modulus);
+    const ivec failed = failed_lanes(p, VZERO, inverted, dte);
+    if (any_lane(failed))
     {
-      const vec dte = p->calibration * cell_values(p->length0, c0, nb)
-                      * vsqrt(p->density / modulus);
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, ue, 4, step);
+      vec du[12];
+      increments(p, cells, 4, &b, du);
+      erode(p, failed, &b, energy_left(w, du, fe, 4), VZERO, VZERO, fe, 4, energy, step);
     }
+    scatter_add(cells, 4, &b, fe, f);
+    total += lane_sum(vselect(failed, VZERO, w), b.nb);
+    note_inverted(inverted & ~failed, &b, x, ue, 4, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 4, step);
   }
   energy[0] += total;
 }
@@ -109,7 +114,8 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
  * step (J); a cell is inverted when its volume is not positive (the cells are oriented
  * positively at the start), and its stable step is L / c in the current configuration,
  * c from the elastic moduli and the current density (step.h).  state: POINT_SLOTS rows
- * of `stride` values. */
+ * of `stride` values, and the damage row of failure.h, which also says how cells fail
+ * and are eroded. */
 void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double *restrict X,
                   const double *restrict u, const double *restrict v, const element_params *p,
                   double *restrict state, int64_t stride, double *restrict f,
@@ -117,12 +123,12 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
 {
   vec Xe[12], ue[12], ve[12], fe[12];
   double stored = 0.0, dissipated = 0.0;
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 4, c0, nb, X, Xe);
-    gather(cells, 4, c0, nb, u, ue);
-    gather(cells, 4, c0, nb, v, ve);
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    gather(cells, 4, &b, X, Xe);
+    gather(cells, 4, &b, u, ue);
+    gather(cells, 4, &b, v, ve);
     vec x[12], xm[12], du[12], g[4][3], dL[9], sigma[9], eps_p, T;
     for (int i = 0; i < 12; ++i)
     {
@@ -132,23 +138,41 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     }
     const vec mid_volume = tet4_geometry(xm, g);
     tet4_gradient(du, g, dL);
-    load_point(state, stride, c0, nb, 0, sigma, &eps_p, &T);
-    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL);
-    store_point(state, stride, c0, nb, 0, sigma, eps_p, T);
+    load_point(state, stride, &b, 0, sigma, &eps_p, &T);
+    point_step done;
+    const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL, &done);
+    store_point(state, stride, &b, 0, sigma, eps_p, T);
+    vec damage = VZERO;
+    if (p->failure)
+    {
+      damage = accumulate_damage(p, load_slot(state, stride, &b, p->damage_slot), &done, T);
+      store_slot(state, stride, &b, p->damage_slot, damage);
+    }
     vec det;
     const vec volume = tet4_geometry_signed(x, g, &det);
     tet4_nodal_forces(volume, sigma, g, fe);
-    scatter_add(cells, 4, c0, nb, fe, f);
-    stored += lane_sum(volume * elastic_energy_density(p, sigma), nb);
-    dissipated += lane_sum(mid_volume * dissipation, nb);
+    const vec elastic = volume * elastic_energy_density(p, sigma);
+    const vec plastic = mid_volume * dissipation;
+    dissipated += lane_sum(plastic, b.nb);
     const ivec inverted = det <= 0.0;
-    note_inverted(inverted, c0, nb, x, NULL, 4, step);
+    vec dte = VZERO + INFINITY;
     if (p->estimate)
     {
-      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, c0, nb));
-      const vec dte = p->calibration * characteristic_length(4, x, volume) / speed;
-      note_steps(p, vselect(inverted, VZERO + INFINITY, dte), c0, nb, x, NULL, 4, step);
+      const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, &b));
+      dte = p->calibration * characteristic_length(4, x, volume) / speed;
     }
+    const ivec failed = failed_lanes(p, damage, inverted, dte);
+    vec plastic_total = VZERO, hourglass_total = VZERO;
+    if (p->cell_work)
+      track_work(p, &b, plastic, VZERO, &plastic_total, &hourglass_total);
+    if (any_lane(failed))
+      erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 4), plastic_total,
+            VZERO, fe, 4, energy, step);
+    scatter_add(cells, 4, &b, fe, f);
+    stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 4, step);
   }
   energy[0] += stored;
   energy[2] += dissipated;
@@ -171,16 +195,16 @@ void tet4_cell_sizes(int64_t num_cells, const int32_t *cells, const double *x, d
                      double *length)
 {
   vec xe[12], g[4][3];
-  for (int64_t c0 = 0; c0 < num_cells; c0 += LANES)
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const int nb = num_cells - c0 < LANES ? (int)(num_cells - c0) : LANES;
-    gather(cells, 4, c0, nb, x, xe);
+    const batch_t b = batch_at(NULL, k0, num_cells);
+    gather(cells, 4, &b, x, xe);
     const vec v = tet4_geometry(xe, g);
     const vec l = characteristic_length(4, xe, v);
-    for (int k = 0; k < nb; ++k)
+    for (int k = 0; k < b.nb; ++k)
     {
-      volume[c0 + k] = v[k];
-      length[c0 + k] = l[k];
+      volume[k0 + k] = v[k];
+      length[k0 + k] = l[k];
     }
   }
 }

@@ -29,6 +29,7 @@ COLORS = ("normal_velocity", "speed", "displacement")
 CELL_FIELDS = {
     "plastic_strain": ("equivalent plastic strain", ""),
     "von_mises_stress": ("von Mises stress", "Pa"),
+    "damage": ("damage D", ""),
 }
 # Unit prefixes: (size of the unit in SI, name), largest first.
 PREFIXES = {

@@ -4,7 +4,8 @@ Each rank sends its cells, points, nodal values and the cell fields of the
 internal force to rank 0 (connectivity offset by the points already received);
 rank 0 stores them in ``frames/data``: ``mesh.npz`` once, then
 ``frame_NNNN.npz`` per frame (``t``, ``u``, ``v``, the walls' ``offsets`` and
-``cell_<name>`` for each cell field).
+``cell_<name>`` for each cell field; when cells can erode, ``cell_eroded`` and
+``detached``, 1 at the nodes no live cell holds).
 Pictures are drawn at the end of the run (or of a stopped run) by a separate
 process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
 VTK's wheels crash when they render in a process that holds DOLFINx's C++
@@ -117,6 +118,12 @@ class Frames:
         self.steps.taken(s)
         u, v = self._nodal(s.u), self._nodal(s.v)
         cells = {f"cell_{k}": self._cells(a) for k, a in sim.internal.cell_fields(s).items()}
+        erosion = getattr(sim.internal, "erosion", None)
+        if erosion is not None:  # the nodes no live cell holds, drawn as points
+            flags = np.zeros_like(s.u)
+            flags[erosion.detached] = 1.0
+            detached = self._nodal(flags)
+            cells["detached"] = None if detached is None else detached[:, 0]
         if self.comm.rank == 0 and not self._failed:
             try:
                 if not self._count:

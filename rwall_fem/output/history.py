@@ -63,6 +63,7 @@ class History:
         self.initial_momentum = momentum(sim.state, walls, comm)
         self.mass_scaling = getattr(sim.step_size, "mass_scaling", None)
         scaled = self.mass_scaling is not None
+        self.erosion = getattr(sim.internal, "erosion", None)  # cells that may erode
         self.step_changes = sim.update.corrects  # a stored energy with a varying step
         works = ["external_work", "wall_work"]
         works += ["mass_scaling_work"] if scaled else []
@@ -72,7 +73,8 @@ class History:
             stored=("kinetic", *sim.internal.energy_names),
             parts=sim.internal.energy_parts,
             works=works,
-            extras=("added_mass", "added_mass_percent") if scaled else (),
+            extras=(("added_mass", "added_mass_percent") if scaled else ())
+            + (("eroded_cells",) if self.erosion is not None else ()),
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -84,7 +86,7 @@ class History:
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
-            | {"step_change_work": ()}
+            | {"step_change_work": (), "eroded_cells": ()}
             | {"signals": (len(SIGNALS),), "seconds": (), "failed": ()}
             | self.wall_table.sums,
         )
@@ -123,6 +125,8 @@ class History:
         if self.mass_scaling is not None:
             local["mass_scaling_work"][...] = self.mass_scaling.work
         local["step_change_work"][...] = -s.step_correction
+        if self.erosion is not None:
+            local["eroded_cells"][...] = self.erosion.count
         # Sent with the sums, so that every rank stops at the same step when any got a signal.
         self._fill_agreement(local, sim)
         self.wall_table.fill(local)
@@ -148,6 +152,8 @@ class History:
                 "added_mass": self.mass_scaling.added,
                 "added_mass_percent": self.mass_scaling.added_percent,
             }
+        if self.erosion is not None:
+            extras["eroded_cells"] = int(total["eroded_cells"])
         self._energy_csv.append(self.balance.sample(s.t, energies, s.dt, extras))
         for row in self.wall_table.rows(s, total):
             self._walls_csv.append(row)

@@ -4,7 +4,8 @@ Reads the frame data that :class:`rwall_fem.output.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
 ``DIR/animation.gif``, and ``DIR/animation.mp4`` when the ``imageio-ffmpeg``
 encoder is installed (``pip install rwall_fem[mp4]``). The body is drawn on
-its deformed geometry at true scale (no magnification), coloured as
+its deformed geometry at true scale (no magnification), without its eroded cells (the
+nodes no live cell holds are drawn as points), coloured as
 :mod:`rwall_fem.output.coloring` says, with the walls as
 :mod:`rwall_fem.output.view` draws them: flat walls opaque (the camera sees
 them from their allowed side, behind the body), curved walls translucent with
@@ -78,6 +79,11 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
         try:
             grid = body_grid(pyvista, mesh, frame)
             (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
+            if "cell_eroded" in frame:  # eroded cells are not drawn, detached nodes are points
+                grid = grid.extract_cells(np.flatnonzero(frame["cell_eroded"] < 0.5))
+                loose = (mesh["points"] + frame["u"])[frame["detached"] > 0.5]
+                if len(loose):
+                    plotter.add_points(loose, color="#404040", point_size=3.0)
             plotter.add_mesh(
                 grid,
                 scalars=paint.title,

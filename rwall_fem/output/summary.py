@@ -8,7 +8,8 @@ last state; ``planned_steps``: as many as the step at the start would take), the
 reached (s) and ``end_time``, ``dt`` (the last step, s) and ``time_step``: the step's
 mode, calibration, first, smallest and largest steps (s), where and when the smallest
 was, and with mass scaling the mass added (kg and %) and its work (J),
-the energies of the last sample, and per wall its impulses, works, contacts and the
+the energies of the last sample, when cells can erode how many did and the nodes they
+left detached (``erosion``), and per wall its impulses, works, contacts and the
 secondary nodes that started behind it (``initially_penetrated``, ``deepest_penetration``
 in m: kept there by the wall, as Radioss's starter warns).
 """
@@ -72,6 +73,7 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         "energy": energy,
         "deformed_bounds": deformed_bounds(s, comm),
         **_plasticity(sim.internal, comm),
+        **_erosion(sim.internal, comm),
         "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
         "boundaries": [
             {
@@ -106,6 +108,22 @@ def _plasticity(internal, comm) -> dict:
         "plastic_work": comm.allreduce(internal.plastic_work),
         "max_plastic_strain": comm.allreduce(float(fields.max(initial=0.0)), MPI.MAX),
     }
+
+
+def _erosion(internal, comm) -> dict:
+    """How many cells eroded and how many nodes they left detached, and with a failure
+    criterion the largest damage of a live cell; nothing when no cell can erode."""
+    erosion = getattr(internal, "erosion", None)
+    if erosion is None:
+        return {}
+    entry = {
+        "eroded_cells": comm.allreduce(erosion.count),
+        "detached_nodes": comm.allreduce(len(erosion.detached)),
+    }
+    if internal.failure is not None:
+        damage = internal.damage[:, erosion.alive]
+        entry["max_damage"] = comm.allreduce(float(damage.max(initial=0.0)), MPI.MAX)
+    return {"erosion": entry}
 
 
 def _wall(w, peak_contacts: int, comm) -> dict:

@@ -10,7 +10,7 @@ the reference page prints. The validation (:func:`~rwall_fem.scene.keys.read_tab
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from rwall_fem.scene.keys import (
@@ -40,6 +40,7 @@ __all__ = [
     "SHAPE_KEYS",
     "BoundarySpec",
     "Element",
+    "Failure",
     "Heating",
     "Initial",
     "Material",
@@ -73,6 +74,7 @@ MATERIAL_KEYS = {model: _ELASTIC_KEYS for model in MATERIAL_MODELS} | {
         "hardening_coefficient",
         "hardening_exponent",
         "hardening_curve",
+        "failure",
     ),
     "johnson_cook": (
         *_ELASTIC_KEYS,
@@ -82,7 +84,13 @@ MATERIAL_KEYS = {model: _ELASTIC_KEYS for model in MATERIAL_MODELS} | {
         "strain_rate_coefficient",
         "reference_strain_rate",
         "heating",
+        "failure",
     ),
+}
+# The failure criteria and their keys besides "criterion".
+FAILURE_KEYS = {
+    "plastic_strain": ("plastic_strain",),
+    "johnson_cook": ("d1", "d2", "d3", "d4", "d5", "reference_strain_rate"),
 }
 
 # The keys of each mesh shape besides "shape", "noise" and the refinement keys.
@@ -150,10 +158,11 @@ class RunSettings:
         default_doc="0: none",
     )
     dt_min_action: str = key(
-        Choice(("stop", "mass_scaling")),
+        Choice(("stop", "mass_scaling", "erode")),
         "stop",
         doc="stop: the run stops (exit 3, with a checkpoint); mass_scaling: mass is added to "
-        "the cells that would go below dt_min, just enough to hold it (LS-DYNA's DT2MS)",
+        "the cells that would go below dt_min, just enough to hold it (LS-DYNA's DT2MS); "
+        "erode: those cells, and inverted ones, are eroded (Radioss's /DT/BRICK/DEL)",
     )
     max_added_mass: float = key(
         Real(low=0.0),
@@ -208,15 +217,15 @@ _ADAPTIVE_ONLY = {"not": {"anyOf": [{"required": k} for k in
         {
             "if": {
                 "required": ["dt_min_action"],
-                "properties": {"dt_min_action": {"const": "mass_scaling"}},
+                "properties": {"dt_min_action": {"enum": ["mass_scaling", "erode"]}},
             },
             "then": {"required": ["dt_min"], "properties": {"dt_min": {"exclusiveMinimum": 0}}},
         },
     ],
 )
 def _one_kind_of_step(v, raw, fail):
-    """A given dt is a fixed step: time_step is then 'fixed' (its default); dt_min and
-    mass scaling are for the adaptive step."""
+    """A given dt is a fixed step: time_step is then 'fixed' (its default); dt_min, mass
+    scaling and erosion below dt_min are for the adaptive step, and need dt_min > 0."""
     if v["dt"] is not None:
         if v["time_step"] == "adaptive":
             fail("dt", "is a fixed step, and time_step is 'adaptive': drop dt (dt_scale sets the "
@@ -228,8 +237,9 @@ def _one_kind_of_step(v, raw, fail):
         for name in ("dt_min", "dt_min_action", "max_added_mass"):
             if name in raw:
                 fail(name, "needs time_step = 'adaptive' (a fixed step never falls)")
-    elif v["dt_min_action"] == "mass_scaling" and not v["dt_min"] > 0.0:
-        fail("dt_min", "missing: mass scaling holds the step at dt_min, which must be above 0")
+    elif v["dt_min_action"] != "stop" and not v["dt_min"] > 0.0:
+        what = {"mass_scaling": "mass scaling holds the step at", "erode": "erosion acts below"}
+        fail("dt_min", f"missing: {what[v['dt_min_action']]} dt_min, which must be above 0")
 
 
 # --- [mesh] ------------------------------------------------------------------------
@@ -477,6 +487,42 @@ def _melting_above_room(v, raw, fail):
 
 
 @table(
+    "How the material fails (LS-DYNA's *MAT_ADD_EROSION and MAT_015's D1-D5, Radioss's "
+    "/FAIL/JOHNSON): damage D = sum d(eps_p) / eps_f per integration point; a cell whose "
+    "point reaches D = 1 is eroded. No [material.failure]: none.",
+    variants=Variants("criterion", FAILURE_KEYS, noun="the {} criterion"),
+)
+@dataclass(frozen=True)
+class Failure:
+    criterion: str = key(
+        Choice(tuple(FAILURE_KEYS)),
+        doc="plastic_strain: a constant equivalent plastic strain at failure; johnson_cook: "
+        "eps_f = [d1 + d2 exp(d3 sigma*)] [1 + d4 ln max(rate / reference_strain_rate, 1)] "
+        "[1 + d5 T*], sigma* the stress triaxiality",
+    )
+    plastic_strain: float | None = key(
+        Real(low=0.0), None, required=True, doc="eps_f, the equivalent plastic strain at failure"
+    )
+    d1: float | None = key(Real(), None, required=True, doc="D1 of eps_f")
+    d2: float | None = key(Real(), None, required=True, doc="D2 of eps_f")
+    d3: float | None = key(Real(), None, required=True, doc="D3 of eps_f (negative for metals)")
+    d4: float = key(Real(), 0.0, doc="D4 of eps_f, its rate term")
+    d5: float = key(
+        Real(),
+        0.0,
+        doc="D5 of eps_f, its temperature term (T* as in the flow stress: needs "
+        "[material.heating], without which T* stays 0)",
+    )
+    reference_strain_rate: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="1/s",
+        doc="the rate of the d4 term's reference",
+        default_doc="the material's reference_strain_rate (johnson_cook), else 1",
+    )
+
+
+@table(
     "The body's material: one law for the whole body.",
     variants=Variants("model", MATERIAL_KEYS, noun="the {} model"),
 )
@@ -554,6 +600,12 @@ class Material:
         doc="adiabatic heating and thermal softening",
         default_doc="none: isothermal",
     )
+    failure: Failure | None = key(
+        Sub(Failure),
+        None,
+        doc="the failure criterion; failed cells are eroded",
+        default_doc="none: the material never fails",
+    )
 
     @property
     def plastic(self) -> bool:
@@ -571,6 +623,16 @@ class Material:
         """Dilatational wave speed sqrt((lambda + 2 mu)/rho) in m/s."""
         lmbda, mu = self.lame
         return math.sqrt((lmbda + 2 * mu) / self.density)
+
+
+@rule(Material)
+def _damage_reference_rate(v, raw, fail):
+    """failure.reference_strain_rate of the johnson_cook criterion defaults to the
+    material's reference_strain_rate (1 /s for elastic_plastic)."""
+    failure = v["failure"]
+    if failure is not None and failure.criterion == "johnson_cook":
+        if failure.reference_strain_rate is None:
+            v["failure"] = replace(failure, reference_strain_rate=v["reference_strain_rate"])
 
 
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
@@ -811,9 +873,10 @@ class Output:
         default_doc="about 20 lines over the run",
     )
     color: str = key(
-        Choice(("normal_velocity", "speed", "displacement", "plastic_strain")),
+        Choice(("normal_velocity", "speed", "displacement", "plastic_strain", "damage")),
         "normal_velocity",
-        doc="what colours the frames (plastic_strain: elasto-plastic bodies)",
+        doc="what colours the frames (plastic_strain: elasto-plastic bodies; damage: bodies "
+        "with a failure criterion)",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
     checkpoint_steps: int = key(
