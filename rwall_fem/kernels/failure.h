@@ -64,8 +64,10 @@ INLINE vec accumulate_damage(const element_params *p, vec D, const point_step *d
 }
 
 /* The lanes that fail in this pass: `damage` (the largest of the cell's points) reached 1,
- * or with p->erode_step the cell is inverted or its step estimate dte (s) is below it. */
-INLINE ivec failed_lanes(const element_params *p, vec damage, ivec inverted, vec dte)
+ * or with p->erode_step the cell is inverted or its step estimate dte (s) is below it,
+ * provided the energy it holds (J) is finite: an inverted neo-Hookean cell has none to
+ * leave the books with, and stays inverted (the run stops). */
+INLINE ivec failed_lanes(const element_params *p, vec damage, ivec inverted, vec dte, vec held)
 {
   ivec failed = (ivec){0};
   if (!p->erode)
@@ -73,7 +75,7 @@ INLINE ivec failed_lanes(const element_params *p, vec damage, ivec inverted, vec
   if (p->failure)
     failed |= damage >= 1.0;
   if (p->erode_step > 0.0)
-    failed |= inverted | (dte < p->erode_step);
+    failed |= (inverted | (dte < p->erode_step)) & (vabs(held) < INFINITY);
   return failed;
 }
 

@@ -301,7 +301,7 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
       if (hourglass == HOURGLASS_VISCOUS)
         dte = vmin(dte, viscous_hourglass_step(p, volume, volume));
     }
-    const ivec failed = failed_lanes(p, VZERO, inverted, dte);
+    const ivec failed = failed_lanes(p, VZERO, inverted, dte, stored + hourglass_energy);
     /* the viscous form's dissipation accumulates; the other forms' energy is stored */
     vec dissipated = VZERO, held = hourglass_energy, unused;
     if (hourglass == HOURGLASS_VISCOUS && p->cell_work)
@@ -428,7 +428,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
       hourglass_nodal_forces(gamma, Q, fe);
       hourglass_work += lane_sum(work, b.nb);
     }
-    const ivec failed = failed_lanes(p, damage, inverted, dte);
+    const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
     vec plastic_total = VZERO, hourglass_total = VZERO;
     if (p->cell_work)
       track_work(p, &b, plastic, work, &plastic_total, &hourglass_total);

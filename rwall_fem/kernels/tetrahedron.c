@@ -91,7 +91,7 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
     vec dte = VZERO + INFINITY;
     if (p->estimate)
       dte = p->calibration * cell_values(p->length0, &b) * vsqrt(p->density / modulus);
-    const ivec failed = failed_lanes(p, VZERO, inverted, dte);
+    const ivec failed = failed_lanes(p, VZERO, inverted, dte, w);
     if (any_lane(failed))
     {
       vec du[12];
@@ -161,7 +161,7 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, &b));
       dte = p->calibration * characteristic_length(4, x, volume) / speed;
     }
-    const ivec failed = failed_lanes(p, damage, inverted, dte);
+    const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
     vec plastic_total = VZERO, hourglass_total = VZERO;
     if (p->cell_work)
       track_work(p, &b, plastic, VZERO, &plastic_total, &hourglass_total);
