@@ -225,13 +225,18 @@ study: venv-0.5
 
 # The kernels against the old BAIJ product, whole steps, 2-rank efficiency, the 80k-hexahedron
 # scene, material costs, memory, start-up, the Taylor rod (bench/results.md, ~45 minutes), then
-# the cost of each effect (bench/effects.md). OLD_TREE: a worktree of the old code (commit
-# c11ba60, with its .venv) whose time loop on the 80k scene is run alternately with the new.
+# the cost of each effect (bench/effects.md) and of failure and erosion (bench/erosion.md).
+# OLD_TREE: a worktree of the old code (commit c11ba60, with its .venv) whose time loop on the
+# 80k scene is run alternately with the new. PRE_EROSION_TREE: a checkout of the code before
+# failure and erosion, whose kernels bench/erosion.py times beside the new ones.
 OLD_TREE ?=
+PRE_EROSION_TREE ?=
 bench: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
 	    $(VENV)/bin/python bench/bench.py --out bench/results.md $(if $(OLD_TREE),--old-tree $(OLD_TREE))
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/effects.py
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/erosion.py \
+	    $(if $(PRE_EROSION_TREE),--main-tree $(PRE_EROSION_TREE))
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

@@ -95,7 +95,7 @@ def main_kernel(force: ElementForce, ffi, lib):
     """``force``'s kernel call as the checkout of :func:`main_kernels` makes it: its own
     parameter struct with the same values, the same arrays."""
     p = ffi.new("element_params *")
-    for name in dir(p):
+    for name, _ in ffi.typeof("element_params").fields:
         value = getattr(force.params, name)
         if name in ("table_strain", "table_stress"):
             getattr(p, name)[0 : len(value)] = list(value)

@@ -53,7 +53,38 @@ here = Path(__file__).parent
 size = float(os.environ.get("PERFORATION_ELEMENT_SIZE", "1e-3"))
 speeds = [float(v) for v in os.environ.get("PERFORATION_SPEEDS", "300 350 400 450").split()]
 comm = MPI.COMM_WORLD
-results = []
+
+
+class Section:
+    """Recorder of the plate's cut along y = 0 when the nose's centre reaches z = 2 mm (the
+    plate's exit face is at z = 0): the deformed centroids (m) of the cells within a cell
+    of the cut, their damage and whether they have eroded, and the projectile's centre,
+    gathered on rank 0."""
+
+    def __init__(self, sim):
+        self.taken, self.cells, self.centre = False, None, None
+
+    def due(self, s):
+        return not self.taken
+
+    def record(self, sim, s):
+        centre = sim.walls[0].position
+        if centre[2] > 2e-3:
+            return
+        self.taken, f = True, sim.internal
+        x = (f.X + f.u.array)[f.cells].mean(axis=1)
+        near = np.abs(x[:, 1]) < 0.5 * size
+        mine = np.column_stack([x[near], f.cell_fields(s)["damage"][near],
+                                (~f.erosion.alive)[near]])  # fmt: skip
+        every = comm.gather(mine, root=0)
+        self.cells = None if every is None else np.vstack(every)
+        self.centre = centre.copy()
+
+    def close(self, sim):
+        pass
+
+
+results, section = [], None
 for speed in speeds:
     scene = rwall_fem.load_scene(
         here / "perforation_weldox.toml",
@@ -62,6 +93,9 @@ for speed in speeds:
     body = read_mesh(comm, here / "perforation_plate.geo", {"h_impact": size})
     out = Path(f"results/demo_perforation_weldox/{speed:.0f}")
     sim = rwall_fem.build_simulation(scene, comm, out, body=body)
+    if section is None:  # the first speed's run: its cut through the plate
+        section = Section(sim)
+        sim.recorders.append(section)
     sim.run()
     summary = sim.history.summary
     wall = summary["walls"][0]
@@ -106,5 +140,28 @@ if comm.rank == 0:
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title("12 mm Weldox 460 E, 20 mm hemispherical nose, 197 g")
     path = Path("results/demo_perforation_weldox/residual_velocity.png")
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    print(f"wrote {path}")
+
+# ## The plate when the nose is through
+# The cells about the cut y = 0 at the first speed, when the nose's centre reaches the
+# exit face: live cells coloured by their damage, eroded ones as grey crosses (drawn where
+# they failed, moved on by their nodes since).
+
+if comm.rank == 0 and section.cells is not None:
+    x, damage = section.cells[:, :3] * 1e3, section.cells[:, 3]
+    live, (cx, _, cz) = section.cells[:, 4] < 0.5, section.centre * 1e3
+    fig, ax = plt.subplots(figsize=(6, 4))
+    shown = ax.scatter(x[live, 0], x[live, 2], c=damage[live], s=6, vmin=0.0, vmax=1.0)
+    ax.plot(x[~live, 0], x[~live, 2], "x", color="0.6", ms=3)
+    ax.add_patch(plt.Circle((cx, cz), 10.0, fill=False, color="k"))
+    fig.colorbar(shown, ax=ax, label="damage D")
+    ax.set_xlim(-40.0, 40.0)
+    ax.set_ylim(-25.0, 35.0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_title(f"{speeds[0]:.0f} m/s, the nose's centre at the exit face")
+    path = Path("results/demo_perforation_weldox/section.png")
     fig.savefig(path, dpi=120, bbox_inches="tight")
     print(f"wrote {path}")

@@ -11,7 +11,7 @@
 DefineConstant[
   thickness = {0.012, Min 1e-6, Name "Parameters/thickness"},
   radius = {0.25, Min 1e-6, Name "Parameters/radius of the clamped rim"},
-  h_impact = {1e-3, Min 1e-6, Name "Parameters/element size at the impact"},
+  h_impact = {2e-3, Min 1e-6, Name "Parameters/element size at the impact"},
   fine_radius = {0.016, Min 0, Name "Parameters/radius of the fine zone"},
   h_rim = {0.015, Min 1e-6, Name "Parameters/element size at the rim"},
   layers = {0, Min 0, Step 1, Name "Parameters/layers through the thickness (0: auto)"}

@@ -7,7 +7,8 @@
 - the stored energies come from the internal force: ``"internal"`` (the strain energy of
   the element kernels: 1/2 u.Ku for linear elasticity, the integral of the energy density
   for the hyperelastic models; for a force without stored energy, its work at mid-step
-  velocities) and ``"hourglass"`` (one-point hexahedra with hourglass control);
+  velocities), ``"hourglass"`` (one-point hexahedra with hourglass control) and, when
+  cells may erode, ``"eroded_internal"`` (what the eroded cells took with them);
 - the work of every other force (body forces, walls, boundary conditions) is booked at
   mid-step velocities, 1/2 g^n . (v^{n-1/2} + v^{n+1/2}) dt. The wall work is that of
   the contact impulses relative to the wall (normal stop and friction); the driving work
@@ -20,7 +21,8 @@ Each row of ``energy.csv`` also carries what LS-DYNA's GLSTAT and Radioss's ener
 report print: the total energy (the sum of the stored energies), the balance error in
 percent, and the time step of that step (s); with mass scaling also the mass added so
 far (kg and % of the body's), and its work (``mass_scaling_work``: the kinetic energy
-the added masses cost when they joined their nodes at rest).
+the added masses cost when they joined their nodes at rest); when cells may erode, how many
+have (``eroded_cells``).
 """
 
 from __future__ import annotations

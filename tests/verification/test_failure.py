@@ -380,3 +380,25 @@ def test_eroding_a_linear_elastic_body_keeps_its_books_exact(shared_dir):
     energy = summary["energy"]
     assert energy["eroded_internal"] > 1e-3 * energy["initial"]
     assert energy["max_balance_error"] <= 1e-12
+
+
+def test_the_outputs_carry_damage_and_erosion(shared_dir):
+    """The punched plate's fields hold each cell's damage and eroded flag; its frames leave
+    the eroded cells out and draw the detached nodes (pictures: serial runs only, as the
+    demos' test)."""
+    pictures = MPI.COMM_WORLD.size == 1
+    raw = punch_scene()
+    raw["output"] |= {"fields": 2, "frames": 2 if pictures else 0, "color": "damage"}
+    sim = run(raw, shared_dir)
+    fields = sim.internal.cell_fields(sim.state)
+    assert np.array_equal(fields["eroded"], (~sim.internal.erosion.alive).astype(float))
+    assert np.all(fields["damage"][fields["eroded"] == 0.0] < 1.0)
+    MPI.COMM_WORLD.Barrier()
+    if MPI.COMM_WORLD.rank == 0:
+        xdmf = (shared_dir / "fields.xdmf").read_text()
+        assert 'Name="damage"' in xdmf and 'Name="eroded"' in xdmf
+    if pictures:
+        last = np.load(shared_dir / "frames" / "data" / "frame_0001.npz")
+        assert last["cell_eroded"].sum() == sim.history.summary["erosion"]["eroded_cells"]
+        assert last["detached"].sum() > 0
+        assert len(list((shared_dir / "frames").glob("frame_*.png"))) == 2
