@@ -7,10 +7,9 @@ the kinetic energy the plate does not absorb, v_r = (v_i^2 - v_bl^2)^(1/2): 265 
 400 m/s, the experiment's upper bound (a plug carried along lowers it). The demo's scene
 (demos/perforation_weldox.toml) at 3 mm at the impact (4 layers through the thickness,
 12,000 hexahedra; the demo's 1 mm gives 80,000) perforates the plate at 400 m/s with a
-residual velocity within 15 % of that (238 m/s seen: the model is within the scatter of a
-plug's share; docs/verification.md gives the finer meshes' figures). The projectile stays
-on its axis (a quarter model with symmetry conditions would push it sideways), cells
-erode, and the books close to round-off.
+residual velocity within 15 % of that (238 m/s seen; 251 m/s at 2 mm and 263 m/s at 1 mm,
+the demo's figures). The projectile stays on its axis (a quarter model with symmetry
+conditions would push it sideways), cells erode, and the books close to round-off.
 """
 
 import math
