@@ -248,22 +248,51 @@ def eroded_centroids(sim) -> np.ndarray:
     return every[np.lexsort(every.T[::-1])]
 
 
-def test_the_plate_erodes_alike_on_any_number_of_ranks(shared_dir, tmp_path):
-    """The punched plate: the eroded cells, their count at every step and the energies are
-    those of one rank (to 1e-10), and the books close to round-off."""
+def test_the_punched_plate_erodes_and_keeps_its_books(shared_dir):
+    """The punched plate: about half its cells erode, some nodes are left detached, and the
+    books close to round-off (on 2 ranks too; its answers are not compared with one rank's:
+    a detached node riding the sphere sits on it to round-off, and whether the sphere
+    catches it in a step is decided by the round-off of the sum over ranks)."""
     sim = run(punch_scene(), shared_dir)
     summary = sim.history.summary
     assert 30 <= summary["erosion"]["eroded_cells"] <= 100  # of 128
     assert summary["erosion"]["detached_nodes"] > 0
     assert summary["energy"]["max_balance_error"] <= 1e-12
+
+
+def neck_scene() -> dict:
+    """A steel bar (4 x 4 x 12 mm, 1 mm hexahedra) held at one end and pulled at the other
+    to 10 m/s over 0.1 ms: it necks, and the neck's whole cross-section (16 cells) fails at a
+    plastic strain of 0.25 at about 0.2 ms."""
+    ramp = [[1e-4 * x, 0.0, 0.0, 10.0 * (3 * x**2 - 2 * x**3)] for x in np.linspace(0, 1, 5)]
+    return {
+        "run": {"end_time": 3e-4},
+        "mesh": {"shape": "bar", "size": [4e-3, 4e-3, 12e-3], "element_size": 1e-3},
+        "material": STEEL
+        | {
+            "hardening_modulus": 1e8,
+            "failure": {"criterion": "plastic_strain", "plastic_strain": 0.25},
+        },
+        "boundary": [{"group": "bottom"}, {"group": "top", "velocity": ramp}],
+        "output": {"plot": False, "history_interval": 20},
+    }
+
+
+def test_the_same_cells_erode_on_any_number_of_ranks(shared_dir, tmp_path):
+    """The necking bar: the eroded cells, their count at every sample and the energies are
+    those of one rank (to 1e-10), and the books close to round-off."""
+    sim = run(neck_scene(), shared_dir)
+    summary = sim.history.summary
+    assert summary["erosion"]["eroded_cells"] == 16
+    assert summary["energy"]["max_balance_error"] <= 1e-12
     if MPI.COMM_WORLD.size > 1:
-        serial = run(punch_scene(), tmp_path, comm=MPI.COMM_SELF)
+        serial = run(neck_scene(), tmp_path, comm=MPI.COMM_SELF)
         mine, one = eroded_centroids(sim), eroded_centroids(serial)
         assert mine.shape == one.shape and np.abs(mine - one).max() <= 1e-12  # m: the same cells
         e, f = sim.history.energy, serial.history.energy
         assert e.shape == f.shape
-        assert np.array_equal(e[:, -1], f[:, -1])  # the eroded cells, step by step
-        assert np.abs(e[:, 1:-2] - f[:, 1:-2]).max() <= 1e-10 * summary["energy"]["initial"]
+        assert np.array_equal(e[:, -1], f[:, -1])  # the eroded cells, sample by sample
+        assert np.abs(e[:, 1:-2] - f[:, 1:-2]).max() <= 1e-10 * np.abs(f[:, 1:-2]).max()
 
 
 class StopAt:
