@@ -18,8 +18,9 @@
  * leaves the books with is added to energy[3]: what it holds (elastic, plastic and
  * hourglass energy) less the work its last force would do over the step just taken,
  * 1/2 du . f with du = dt^{n-1/2} v^{n-1/2}, with which the balance of a linear force
- * closes exactly.  Its plastic and hourglass work so far (p->cell_work) leave the live
- * totals energy[2] and energy[1].  The caller computes only the live cells from then on.
+ * closes exactly.  Its plastic and hourglass work so far (p->cell_work, kept per cell
+ * while cells may erode) leave the live totals energy[2] and energy[1].  The caller
+ * computes only the live cells from then on.
  */
 #ifndef RWALL_FAILURE_H
 #define RWALL_FAILURE_H
@@ -54,13 +55,20 @@ INLINE vec failure_strain(const element_params *p, const point_step *done, vec T
   return vmax(strain, VZERO + 1e-300);
 }
 
-/* The damage D of a point after the step `done`, at temperature T (K). */
-INLINE vec accumulate_damage(const element_params *p, vec D, const point_step *done, vec T)
+/* The damage of the batch's point at slot `slot` of the state (rows of `stride`) after the
+ * step `done`, at temperature T (K): read, raised and stored only when the step flowed
+ * plastically in some lane (the damage of a point changes only then, so that a cell
+ * whose points do not flow, which cannot fail, costs nothing); else 0. */
+INLINE vec accumulate_damage(const element_params *p, double *restrict state, int64_t stride,
+                             const batch_t *b, int slot, const point_step *done, vec T)
 {
   const ivec flowing = done->increment > 0.0;
-  if (!any_lane(flowing))
-    return D;
-  return D + vselect(flowing, done->increment / failure_strain(p, done, T), VZERO);
+  if (!p->failure || !any_lane(flowing))
+    return VZERO;
+  vec D = load_slot(state, stride, b, slot);
+  D += vselect(flowing, done->increment / failure_strain(p, done, T), VZERO);
+  store_slot(state, stride, b, slot, D);
+  return D;
 }
 
 /* The lanes that fail in this pass: `damage` (the largest of the cell's points) reached 1,
@@ -79,16 +87,22 @@ INLINE ivec failed_lanes(const element_params *p, vec damage, ivec inverted, vec
   return failed;
 }
 
-/* Add this step's plastic and hourglass work (J per lane) of the batch's cells to their
- * totals in p->cell_work, returned in *plastic_total and *hourglass_total. */
-INLINE void track_work(const element_params *p, const batch_t *b, vec plastic, vec hourglass,
-                       vec *plastic_total, vec *hourglass_total)
+/* Add this step's work (J per lane) to the batch's cells' totals in row `row` of
+ * p->cell_work (0: plastic, 1: hourglass), when some lane did any: a cell that does
+ * nothing costs nothing. */
+INLINE void track_work(const element_params *p, const batch_t *b, int row, vec work)
 {
-  double *row = p->cell_work;
-  *plastic_total = cell_values(row, b) + plastic;
-  *hourglass_total = cell_values(row + p->cell_stride, b) + hourglass;
-  set_cell_values(row, b, *plastic_total);
-  set_cell_values(row + p->cell_stride, b, *hourglass_total);
+  const ivec done = work != 0.0;
+  if (!p->cell_work || !any_lane(done))
+    return;
+  double *totals = p->cell_work + row * p->cell_stride;
+  set_cell_values(totals, b, cell_values(totals, b) + work);
+}
+
+/* The work (J) of the batch's cells so far in row `row` of p->cell_work. */
+INLINE vec work_so_far(const element_params *p, const batch_t *b, int row)
+{
+  return cell_values(p->cell_work + row * p->cell_stride, b);
 }
 
 /* The internal energy (J) a cell that holds `held` (J) leaves the books with when it is

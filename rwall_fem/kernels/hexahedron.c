@@ -179,13 +179,8 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       point_step done;
       dissipation += wm[q] * plastic_update(p, sigma[q], &eps_p, &T, dL, &done);
       store_point(state, stride, &b, POINT_SLOTS * q, sigma[q], eps_p, T);
-      if (p->failure)
-      {
-        const int slot = p->damage_slot + q;
-        const vec D = accumulate_damage(p, load_slot(state, stride, &b, slot), &done, T);
-        store_slot(state, stride, &b, slot, D);
-        damage = vmax(damage, D);
-      }
+      const int slot = p->damage_slot + q;
+      damage = vmax(damage, accumulate_damage(p, state, stride, &b, slot, &done, T));
     }
     /* f_I = sum_q w_q s_q g_Iq + (sum_q w_q p_q) (sum_q w_q g_Iq) / sum_q w_q */
     vec G[24], pressure = VZERO, elastic = VZERO;
@@ -223,12 +218,13 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       dte = p->calibration * characteristic_length(8, x, volume) / speed;
     }
     const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
-    vec plastic_total = VZERO, hourglass_total = VZERO;
-    if (p->cell_work)
-      track_work(p, &b, dissipation, VZERO, &plastic_total, &hourglass_total);
+    track_work(p, &b, 0, dissipation);
     if (any_lane(failed))
+    {
+      const vec plastic_total = work_so_far(p, &b, 0);
       erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 8), plastic_total,
             VZERO, fe, 8, energy, step);
+    }
     scatter_add(cells, 8, &b, fe, f);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 8, step);

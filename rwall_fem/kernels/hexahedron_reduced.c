@@ -303,15 +303,14 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
     }
     const ivec failed = failed_lanes(p, VZERO, inverted, dte, stored + hourglass_energy);
     /* the viscous form's dissipation accumulates; the other forms' energy is stored */
-    vec dissipated = VZERO, held = hourglass_energy, unused;
-    if (hourglass == HOURGLASS_VISCOUS && p->cell_work)
-      track_work(p, &b, VZERO, hourglass_energy, &unused, &held);
     if (hourglass == HOURGLASS_VISCOUS)
-      dissipated = held;
+      track_work(p, &b, 1, hourglass_energy);
     if (any_lane(failed))
     {
       vec du[24];
       increments(p, cells, 8, &b, du);
+      const vec dissipated = hourglass == HOURGLASS_VISCOUS ? work_so_far(p, &b, 1) : VZERO;
+      const vec held = hourglass == HOURGLASS_VISCOUS ? dissipated : hourglass_energy;
       erode(p, failed, &b, energy_left(stored + held, du, fe, 8), VZERO, dissipated, fe, 8,
             energy, step);
     }
@@ -369,12 +368,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     point_step done;
     const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL, &done);
     store_point(state, stride, &b, 0, sigma, eps_p, T);
-    vec damage = VZERO;
-    if (p->failure)
-    {
-      damage = accumulate_damage(p, load_slot(state, stride, &b, p->damage_slot), &done, T);
-      store_slot(state, stride, &b, p->damage_slot, damage);
-    }
+    const vec damage = accumulate_damage(p, state, stride, &b, p->damage_slot, &done, T);
     hex8r_geometry(x, &geo);
     const ivec inverted = geo.V <= 0.0;
     vec dte = VZERO + INFINITY;
@@ -429,12 +423,14 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
       hourglass_work += lane_sum(work, b.nb);
     }
     const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
-    vec plastic_total = VZERO, hourglass_total = VZERO;
-    if (p->cell_work)
-      track_work(p, &b, plastic, work, &plastic_total, &hourglass_total);
+    track_work(p, &b, 0, plastic);
+    track_work(p, &b, 1, work);
     if (any_lane(failed))
+    {
+      const vec plastic_total = work_so_far(p, &b, 0), hourglass_total = work_so_far(p, &b, 1);
       erode(p, failed, &b, energy_left(elastic + plastic_total + hourglass_total, du, fe, 8),
             plastic_total, hourglass_total, fe, 8, energy, step);
+    }
     scatter_add(cells, 8, &b, fe, f);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 8, step);

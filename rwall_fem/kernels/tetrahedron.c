@@ -142,12 +142,7 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     point_step done;
     const vec dissipation = plastic_update(p, sigma, &eps_p, &T, dL, &done);
     store_point(state, stride, &b, 0, sigma, eps_p, T);
-    vec damage = VZERO;
-    if (p->failure)
-    {
-      damage = accumulate_damage(p, load_slot(state, stride, &b, p->damage_slot), &done, T);
-      store_slot(state, stride, &b, p->damage_slot, damage);
-    }
+    const vec damage = accumulate_damage(p, state, stride, &b, p->damage_slot, &done, T);
     vec det;
     const vec volume = tet4_geometry_signed(x, g, &det);
     tet4_nodal_forces(volume, sigma, g, fe);
@@ -162,12 +157,13 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       dte = p->calibration * characteristic_length(4, x, volume) / speed;
     }
     const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
-    vec plastic_total = VZERO, hourglass_total = VZERO;
-    if (p->cell_work)
-      track_work(p, &b, plastic, VZERO, &plastic_total, &hourglass_total);
+    track_work(p, &b, 0, plastic);
     if (any_lane(failed))
+    {
+      const vec plastic_total = work_so_far(p, &b, 0);
       erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 4), plastic_total,
             VZERO, fe, 4, energy, step);
+    }
     scatter_add(cells, 4, &b, fe, f);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
