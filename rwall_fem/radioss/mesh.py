@@ -89,9 +89,9 @@ def write_msh(path: Path, node_ids: np.ndarray, coordinates: np.ndarray, cell: s
     partial = path.with_name(path.name + f".partial{os.getpid()}")
     with open(partial, "w", encoding="ascii") as out:
         out.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n")
-        out.write(f"{len(names) + 1}\n3 1 \"body\"\n")
+        out.write(f'{len(names) + 1}\n3 1 "body"\n')
         for tag, name in enumerate(names, start=1):
-            out.write(f"2 {tag} \"{name}\"\n")
+            out.write(f'2 {tag} "{name}"\n')
         out.write(f"$EndPhysicalNames\n$Nodes\n{len(used)}\n")
         table = np.column_stack([used.astype(float), coordinates[rows]])
         np.savetxt(out, table, fmt=["%d", "%.17g", "%.17g", "%.17g"])

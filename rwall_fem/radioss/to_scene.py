@@ -472,8 +472,10 @@ def _free_components_unloaded(w: Wall, free: list[int], where: str) -> None:
         if np.all(np.abs(normal[free]) <= 1e-12):
             return
     axes = "".join("XYZ"[i] for i in free)
-    raise DeckError(f"{where}: /IMPVEL on its node leaves {axes} free, where the wall's force "
-                    "acts: impose X, Y and Z (rwall_fem prescribes a wall's whole motion)")
+    raise DeckError(
+        f"{where}: /IMPVEL on its node leaves {axes} free, where the wall's force "
+        "acts: impose X, Y and Z (rwall_fem prescribes a wall's whole motion)"
+    )
 
 
 def _wall_fact(w: Wall, table: dict) -> str:
@@ -488,5 +490,7 @@ def _wall_fact(w: Wall, table: dict) -> str:
         nodes.append(f"+ group {w.add_group}")
     if sec.get("exclude"):
         nodes.append(f"- group {w.exclude_group}")
-    return (f"wall: /RWALL/{w.kind}/{w.id} ({w.where}) -> {table['kind']}, {how}, slide "
-            f"{table['slide']}, secondary nodes {' '.join(nodes)}")
+    return (
+        f"wall: /RWALL/{w.kind}/{w.id} ({w.where}) -> {table['kind']}, {how}, slide "
+        f"{table['slide']}, secondary nodes {' '.join(nodes)}"
+    )

@@ -56,9 +56,9 @@ class BarDeck:
 
     def q(self, value: float, quantity: str) -> float:
         """An SI value of ``quantity`` in the deck's units."""
-        m, l, t = self.sizes
+        mass, length, time = self.sizes
         a, b, c = DIM[quantity]
-        return value / (m**a * l**b * t**c)
+        return value / (mass**a * length**b * time**c)
 
     def node_id(self, i: int, j: int, k: int) -> int:
         return 1 + i + (self.nx + 1) * (j + (self.ny + 1) * k)

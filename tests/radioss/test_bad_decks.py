@@ -79,13 +79,22 @@ def missing_line(lines):
 
 CASES = {
     # name: (edit, the card's header or line text, what the message says)
-    "truncated line": (cut_brick, "/BRICK", r"truncated line: element 1 needs 8 node IDs, got 5"),
-    "field that does not parse": (bad_field, "/MAT/LAW1", r"field E \(columns 1-20\): cannot read '2.1.0e2"),
+    "truncated line": (
+        cut_brick, "/BRICK", r"truncated line: element 1 needs 8 node IDs, got 5"
+    ),
+    "field that does not parse": (
+        bad_field, "/MAT/LAW1", r"field E \(columns 1-20\): cannot read '2.1.0e2"
+    ),
     "ID that refers to nothing": (dangling_mat, "/PART", r"mat_ID 7 refers to no /MAT"),
     "part without a material": (no_material, "/PART", r"part 1 has no material"),
-    "unsupported card": (unsupported, "/INTER/TYPE7/1", r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN"),
+    "unsupported card": (
+        unsupported, "/INTER/TYPE7/1",
+        r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN",
+    ),
     "unsupported Isolid": (isolid, "/PROP", r"Isolid = 16: supported: 24"),
-    "truncated card": (missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"),
+    "truncated card": (
+        missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"
+    ),
 }  # fmt: skip
 
 
@@ -141,8 +150,6 @@ def test_output_cards_are_skipped_with_one_warning_each(shared_dir):
 
 
 @pytest.mark.serial
-@pytest.mark.skipif(".rad" not in open(sys.modules["rwall_fem.radioss"].__file__.replace(
-    "radioss/__init__.py", "cli.py")).read(), reason="needs the CLI wiring of docs/radioss.md")  # fmt: skip
 def test_command_line_exits_2_with_one_line(tmp_path):
     path = written(good(), tmp_path, no_material)
     done = subprocess.run([sys.executable, "-m", "rwall_fem", "check", str(path)],
