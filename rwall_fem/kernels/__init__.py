@@ -81,6 +81,8 @@ typedef struct {
   double step_floor;
   int32_t *below;
   double *below_step;
+  const int32_t *interface;
+  double *interface_force;
 } element_params;
 double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);
@@ -104,7 +106,8 @@ void hex8_cell_sizes(int64_t n, const int32_t *cells, const double *x, double *v
     + """
 void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
 void central_difference(int64_t n, double dt_v, double dt, const double *mass, const double *a,
-                        double *v, double *u, const double *f, double out[9]);
+                        double *v, double *u, const double *f, double out[9],
+                        const int32_t *labels, double *part_sums);
 """
     + "".join(
         f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"

@@ -62,6 +62,9 @@ typedef struct
   double step_floor;            /* s: the cells whose step is below it are listed in below */
   int32_t *below;               /* NULL, or room for every cell's index */
   double *below_step;           /* and for its step before mass scaling, s */
+  /* a body of parts (rwall_fem/body.py) */
+  const int32_t *interface;     /* NULL, or per cell its slot in interface_force (-1: none) */
+  double *interface_force;      /* the nodal forces (N) of the cells with a slot, 3 npe each */
 } element_params;
 
 /* Gather the 3 components of the npe nodes of cells c0 .. c0 + LANES - 1 into
@@ -183,6 +186,22 @@ INLINE vec cell_values(const double *restrict a, int64_t c0, int nb)
     for (int k = 0; k < LANES; ++k)
       v[k] = a[c0 + (k < nb ? k : 0)];
   return v;
+}
+
+/* Keep the nodal forces fe[3 I + i] of the cells of the batch that p->interface gives a
+ * slot (cells at the interface of two parts, whose nodes' forces the parts share). */
+INLINE void note_interface(const element_params *p, int64_t c0, int nb, int npe,
+                           const vec *restrict fe)
+{
+  if (!p->interface)
+    return;
+  for (int k = 0; k < nb; ++k)
+  {
+    const int32_t slot = p->interface[c0 + k];
+    if (slot >= 0)
+      for (int j = 0; j < 3 * npe; ++j)
+        p->interface_force[3 * npe * (int64_t)slot + j] = fe[j][k];
+  }
 }
 
 /* The sum of the first nb lanes. */

@@ -110,6 +110,7 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
     gather(cells, 8, c0, nb, u, ue);
     const vec w = hex8_cell(model, x, ue, fe, p, &jacobian, &modulus);
     scatter_add(cells, 8, c0, nb, fe, f);
+    note_interface(p, c0, nb, 8, fe);
     total += lane_sum(w, nb);
     const ivec inverted = jacobian <= 0.0;
     note_inverted(inverted, c0, nb, x, ue, 8, step);
@@ -200,6 +201,7 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     for (int I = 0; I < 24; ++I)
       fe[I] += mean_pressure * G[I];
     scatter_add(cells, 8, c0, nb, fe, f);
+    note_interface(p, c0, nb, 8, fe);
     stored += lane_sum(elastic, nb);
     dissipated += lane_sum(dissipation, nb);
     const ivec inverted = smallest <= 0.0;

@@ -294,6 +294,7 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
     hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p, &jacobian,
                &modulus, &volume);
     scatter_add(cells, 8, c0, nb, fe, f);
+    note_interface(p, c0, nb, 8, fe);
     total += lane_sum(stored, nb);
     hourglass_total += lane_sum(hourglass_energy, nb);
     const ivec inverted = jacobian <= 0.0;
@@ -403,6 +404,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
       hourglass_work += lane_sum(work, nb);
     }
     scatter_add(cells, 8, c0, nb, fe, f);
+    note_interface(p, c0, nb, 8, fe);
   }
   energy[0] += stored;
   energy[1] += hourglass_work;

@@ -89,6 +89,7 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
     gather(cells, 4, c0, nb, u, ue);
     const vec w = tet4_cell(model, x, ue, fe, p, &jacobian, &modulus);
     scatter_add(cells, 4, c0, nb, fe, f);
+    note_interface(p, c0, nb, 4, fe);
     total += lane_sum(w, nb);
     const ivec inverted = jacobian <= 0.0;
     note_inverted(inverted, c0, nb, x, ue, 4, step);
@@ -139,6 +140,7 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
     const vec volume = tet4_geometry_signed(x, g, &det);
     tet4_nodal_forces(volume, sigma, g, fe);
     scatter_add(cells, 4, c0, nb, fe, f);
+    note_interface(p, c0, nb, 4, fe);
     stored += lane_sum(volume * elastic_energy_density(p, sigma), nb);
     dissipated += lane_sum(mid_volume * dissipation, nb);
     const ivec inverted = det <= 0.0;

@@ -20,7 +20,10 @@ Each row of ``energy.csv`` also carries what LS-DYNA's GLSTAT and Radioss's ener
 report print: the total energy (the sum of the stored energies), the balance error in
 percent, and the time step of that step (s); with mass scaling also the mass added so
 far (kg and % of the body's), and its work (``mass_scaling_work``: the kinetic energy
-the added masses cost when they joined their nodes at rest).
+the added masses cost when they joined their nodes at rest); for a body of ``[[part]]``
+each part's energies as LS-DYNA's MATSUM prints them (``<part>.kinetic``,
+``<part>.internal``, ``<part>.hourglass``, ``<part>.plastic_work``; the body's, walls
+aside, are their sums).
 """
 
 from __future__ import annotations

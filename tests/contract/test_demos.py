@@ -20,6 +20,7 @@ COARSE = {  # scene -> overrides that keep it to a few seconds
     "every_key": ["mesh.element_size=0.005", "run.end_time=5e-5"],
     "taylor_rod": ["mesh.element_size=0.0008", "run.dt_scale=0.1", "run.end_time=1e-5"],
     "taylor_johnson_cook": ["mesh.element_size=0.001", "run.end_time=1e-5"],
+    "copper_nosed_striker": ["mesh.element_size=0.001", "run.end_time=1e-5"],
 }
 
 

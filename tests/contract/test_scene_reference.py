@@ -109,6 +109,15 @@ BEYOND = {
     "101_hourglass_coefficient_on_a_tetrahedral_mesh_file",
     "102_reduced_on_a_tetrahedral_mesh_file",
     "104_wall_points_overflow",
+    # The parts: what the mesh's regions tell, and what ties keys of several tables.
+    "84_part_unknown_region",
+    "85_part_region_left_out",
+    "86_part_name_twice",
+    "87_part_region_twice",
+    "88_parts_bonded_at_different_speeds",
+    "90_secondary_parts_unknown",
+    "91_front_length_of_the_whole_bar",
+    "94_part_without_cells",
 }
 
 
