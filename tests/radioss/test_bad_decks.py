@@ -98,10 +98,9 @@ CASES = {
 }  # fmt: skip
 
 
-@pytest.mark.parametrize("case", list(CASES))
-def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
-    edit, card, pattern = CASES[case]
-    path = written(good(), shared_dir, edit)
+def refused_in_one_line(path, card: str, pattern: str) -> None:
+    """Loading the deck ``path`` is refused in one line naming the file and a line of the
+    card whose header starts with ``card``, saying ``pattern``."""
     with pytest.raises(DeckError) as info:
         load_deck(path)
     message = str(info.value)
@@ -113,16 +112,69 @@ def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
     assert re.search(pattern, message), message
 
 
-def test_parts_of_two_materials_are_refused_naming_them(shared_dir):
-    d = good()
-    d.nz = 2
-    d.cards += ["/PART/2", "second", f"{1:10d}{2:10d}"]
-    d.elastic(2700.0, 70e9, 0.33, mid=2)
-    d.cards += ["/BRICK/2", f"{99:10d}" + "".join(f"{n:10d}" for n in (1, 2, 5, 4, 10, 11, 14, 13))]
-    path = written(d, shared_dir)
-    with pytest.raises(DeckError, match=r"parts 1 \(mat 1, prop 1\), 2 \(mat 2, prop 1\) differ "
-                       r"in material or property: .*\[\[part\]\], not built yet"):  # fmt: skip
-        load_deck(path)
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
+    edit, card, pattern = CASES[case]
+    refused_in_one_line(written(good(), shared_dir, edit), card, pattern)
+
+
+def two_parts(*velocities) -> BarDeck:
+    """The bar of good() in two bonded parts of one material: 2 (the bottom layer, "front")
+    and 1 (the top one, "the_bar"), with an /INIVEL (velocity, part IDs) each."""
+    d = BarDeck(units="kg-mm-ms", nz=2, front=1)
+    d.part(pid=1)
+    d.part(pid=2, title="front")
+    d.elastic(7850.0, 210e9, 0.3)
+    d.solid(24)
+    for k, (v, parts) in enumerate(velocities, start=1):
+        d.group(k, "PART", parts)
+        d.initial_velocity(v, k, iid=k)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0)
+    return d
+
+
+def split_part() -> BarDeck:
+    d = BarDeck(units="kg-mm-ms", nz=2)
+    d.part()
+    d.elastic(7850.0, 210e9, 0.3)
+    d.solid(24)
+    d.group(2, "NODE", d.face_nodes(0))
+    d.initial_velocity((0, 0, -5.0), 2)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0)
+    return d
+
+
+INITIAL = {
+    # name: (the deck, the card named, what the message says)
+    "/INIVEL on some nodes of a part": (
+        split_part, "/INIVEL/TRA/1",
+        r"/INIVEL/TRA: group 2 holds 9 of the 27 nodes of /PART/1 \(the_bar; node 10 is not "
+        r"in it\): an initial velocity is given to whole parts",
+    ),
+    "bonded parts at different velocities": (
+        lambda: two_parts(((0, 0, -5.0), [1]), ((0, 0, -3.0), [2])), "/INIVEL/TRA/2",
+        r"/PART/1 \(the_bar\) and /PART/2 \(front\) share 9 nodes \(node 10: they are "
+        r"bonded\) but would start at \[0, 0, -5\] and \[0, 0, -3\] m/s: bonded parts start "
+        "together",
+    ),
+    "a bonded part left at rest": (
+        lambda: two_parts(((0, 0, -5.0), [1])), "/INIVEL/TRA/1",
+        r"would start at \[0, 0, -5\] and \[0, 0, 0\] m/s",
+    ),
+    "a second velocity of a part": (
+        lambda: two_parts(((0, 0, -5.0), [1, 2]), ((0, 0, -3.0), [1])), "/INIVEL/TRA/2",
+        r"a second initial velocity of /PART/1 \(the_bar\): \[0, 0, -3\] m/s after "
+        r"\[0, 0, -5\] m/s at .*model_0000.rad:\d+",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(INITIAL))
+def test_initial_velocity_not_of_whole_parts_is_one_line(case, shared_dir):
+    """/INIVEL gives whole parts their velocity, and bonded parts start together: anything
+    else is refused naming the /INIVEL card."""
+    deck, card, pattern = INITIAL[case]
+    refused_in_one_line(written(deck(), shared_dir), card, pattern)
 
 
 class Lines(logging.Handler):
