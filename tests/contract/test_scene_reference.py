@@ -118,6 +118,7 @@ BEYOND = {
     "90_secondary_parts_unknown",
     "91_front_length_of_the_whole_bar",
     "94_part_without_cells",
+    "95_part_density_1e-300",
 }
 
 
