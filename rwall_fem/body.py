@@ -170,7 +170,9 @@ class Body:
         self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
         self.nodal_force = self.f.owned  # N, owned nodes
         self.books_work = not self.conservative
-        self.step = np.zeros(STEP_SLOTS)
+        # One part over all the owned cells: what its kernel notes of the steps is the body's.
+        self._alone = len(parts) == 1 and np.array_equal(parts[0].cells, np.arange(owned))
+        self.step = self.elements[0].step if self._alone else np.zeros(STEP_SLOTS)
         self.controlling_part = 0
         self._acceleration = None
         count = len(parts)
@@ -206,7 +208,8 @@ class Body:
                 [self._interface_work(k, self.v.array) for k in range(len(self.elements))]
             )
         self.f.scatter_reverse_add()
-        self._combine_steps()
+        if not self._alone:
+            self._combine_steps()
         if self._acceleration is None:
             lib, ffi = self.elements[0].lib, self.elements[0].ffi
             self._acceleration = functools.partial(

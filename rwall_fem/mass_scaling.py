@@ -92,8 +92,6 @@ class MassScaling:
         s.a[changed] *= keep
         s.set_mass(changed, after)
         self.body.part_masses[changed] += added[changed]
-        for wall in sim.walls:
-            wall.masses_changed(s)
         self.added += self.comm.allreduce(extra_total)
         self.cells += self.comm.allreduce(fresh)
         if self.added > self.max_fraction * self.body_mass:

@@ -254,18 +254,15 @@ class CentralDifference:
         self._pass = functools.partial(lib.central_difference, len(state.mass))
         self._arrays = (
             ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force),
-            ptr(self._out), ptr(labels, "int32_t *"), ptr(self._part_sums),
+            ptr(self._out), ptr(self._integral), ptr(state.momentum_integral),
+            ptr(labels, "int32_t *"), ptr(self._part_sums),
         )  # fmt: skip
 
     def __call__(self, state: State) -> None:
-        dt_v = state.dt_velocity
         if self._part_sums is not None:
             self._part_sums[:] = 0.0
-        self._pass(dt_v, state.dt, *self._arrays)
+        self._pass(state.dt_velocity, state.dt, *self._arrays)
         state.kinetic = self._out[0]
-        old, new = self._out[3:6], self._out[6:9]
-        state.momentum_integral[:] = self._integral + 0.5 * dt_v * old
-        self._integral += 0.5 * dt_v * (old + new)
         if self._internal is not None:
             self._internal.book(state, self._out[1], self._out[2])
 

@@ -120,10 +120,13 @@ class _StepSize:
         """The smallest estimate (s) over the ranks, and the largest number of inverted and
         of listed (mass-scaling) cells on a rank, from the latest kernel pass."""
         step = self.force.step
-        self._local[:] = (step[0], -step[5], -step[10])
-        self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
+        if self.comm.size == 1:
+            smallest, inverted, listed = float(step[0]), -float(step[5]), -float(step[10])
+        else:
+            self._local[:] = (step[0], -step[5], -step[10])
+            self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
+            smallest, inverted, listed = self._total.tolist()
         self._reductions += 1
-        smallest, inverted, listed = self._total.tolist()
         self.limit = smallest
         if inverted:
             self.stop_reason = self._inverted(s)

@@ -9,6 +9,9 @@
  *   out[0] = K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}   (the shadow kinetic energy)
  *   out[1] = sum f . v^{n-1/2}, out[2] = sum f . v^{n+1/2}   (when f is given)
  *   out[3..5] = sum m v^{n-1/2}, out[6..8] = sum m v^{n+1/2}   (the work of uniform gravity)
+ * and the momentum integral (kg m) of uniform gravity's work: with `integral` that of the
+ * finished steps, momentum = integral + dt^n/2 out[3..5] (up to the first half of this
+ * step), then integral += dt^n/2 (out[3..5] + out[6..8]);
  * (out[1] and out[2]: the mid-step booking of the internal work of materials without a
  * stored energy, and the energy correction of a varying step for the others); with
  * labels (a part per node, -1 at the interfaces of parts), the same two sums per part
@@ -68,8 +71,9 @@ INLINE void advance_node(int64_t i, double dt_v, double dt, const double *restri
 
 void central_difference(int64_t n, double dt_v, double dt, const double *restrict mass,
                         const double *restrict a, double *restrict v, double *restrict u,
-                        const double *restrict f, double out[9],
-                        const int32_t *restrict labels, double *restrict part_sums)
+                        const double *restrict f, double out[9], double integral[3],
+                        double momentum[3], const int32_t *restrict labels,
+                        double *restrict part_sums)
 {
   double kinetic = 0.0, first = 0.0, second = 0.0, before[3] = {0.0, 0.0, 0.0},
          after[3] = {0.0, 0.0, 0.0};
@@ -88,9 +92,12 @@ void central_difference(int64_t n, double dt_v, double dt, const double *restric
   out[0] = 0.5 * kinetic;
   out[1] = first;
   out[2] = second;
+  const double half = 0.5 * dt_v;
   for (int c = 0; c < 3; ++c)
   {
     out[3 + c] = before[c];
     out[6 + c] = after[c];
+    momentum[c] = integral[c] + half * before[c];
+    integral[c] += half * (before[c] + after[c]);
   }
 }

@@ -31,7 +31,7 @@ import numpy as np
 
 from rwall_fem import interrupts
 from rwall_fem.output import OutputError
-from rwall_fem.output.energy import EnergyBalance, initial_kinetic_energy
+from rwall_fem.output.energy import TINY, EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every
 from rwall_fem.output.summary import momentum, run_summary, write_summary
@@ -163,8 +163,7 @@ class History:
             self.balance.error,
             finite=self._sums.finite(),
             signals=signals,
-            step_work=energies.get("step_change_work", 0.0)
-            / max(self.balance.reference, np.finfo(float).tiny),
+            step_work=energies.get("step_change_work", 0.0) / max(self.balance.reference, TINY),
         )
 
     def _fill_agreement(self, local: dict, sim) -> None:
