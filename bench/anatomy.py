@@ -50,7 +50,8 @@ def main():
         sim = build_simulation(sc, comm, f"/tmp/rwall-bench-anatomy-{comm.size}")
         table = {}
         force = sim.internal
-        force._kernel = timer(table, "kernel", force._kernel)
+        for element in force.elements:  # the parts' element forces
+            element._kernel = timer(table, "kernel", element._kernel)
         force.accelerate = timer(table, "internal force", force.accelerate)
         for wall in sim.walls:
             wall.constrain = timer(table, "wall", wall.constrain)

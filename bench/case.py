@@ -141,7 +141,7 @@ def main():
                 s = sim.history.summary
                 times[f"{tech}:step/{every}"].append(s["wall_seconds"] / (s["steps"] + 1))
             force, state = sim.internal, sim.state
-            times[f"{tech}:kernel"].append(block(force._kernel, repeats))
+            times[f"{tech}:kernel"].append(block(force.elements[0]._kernel, repeats))
             accelerate = functools.partial(force.accelerate, state)
             times[f"{tech}:accelerate"].append(block(accelerate, repeats))
             summary[tech] = {

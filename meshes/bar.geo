@@ -10,6 +10,9 @@
 // and growing back to h over refine_radius (quadrangles recombined by Blossom for
 // hexahedra, triangles otherwise), and swept along z in layers graded by the same law
 // around refine_z.
+//
+// Regions (physical volumes): "body", and with front > 0 the first `front` metres from
+// z0 as the volume "front" (a striker's nose, a bimetal bar's first metal; sweep.geo).
 DefineConstant[
   x0 = {0, Name "Parameters/1Origin/x0"},
   y0 = {0, Name "Parameters/1Origin/y0"},
@@ -23,10 +26,12 @@ DefineConstant[
   refine_radius = {0.008, Min 1e-9, Name "Parameters/4Refinement/radius"},
   refine_x = {0.005, Name "Parameters/4Refinement/x"},
   refine_y = {0.005, Name "Parameters/4Refinement/y"},
-  refine_z = {0.05, Name "Parameters/4Refinement/z"}
+  refine_z = {0.05, Name "Parameters/4Refinement/z"},
+  front = {0, Min 0, Name "Parameters/5Regions/front length (0: none)"}
 ];
 
 Include "refine.geo";
+Include "sweep.geo";
 
 If (refine_size > 0)
   Point(1) = {x0, y0, z0, h};
@@ -40,37 +45,39 @@ If (refine_size > 0)
   Curve Loop(1) = {1, 2, 3, 4};
   Plane Surface(1) = {1};
   section = 1;
-  layer_start = z0;
-  layer_length = lz;
-  Call GradedLayers;
   If (hexahedra)
     Mesh.Algorithm = 6;
     Mesh.RecombinationAlgorithm = 1;
     Recombine Surface{1};
-    ez[] = Extrude {0, 0, lz} { Surface{1}; Layers{layer_counts[], layer_heights[]}; Recombine; };
-  Else
-    ez[] = Extrude {0, 0, lz} { Surface{1}; Layers{layer_counts[], layer_heights[]}; };
   EndIf
 Else
   // Number of element layers along each side: the smallest count with layers <= h.
   nx = Ceil(lx / h - 1e-9);
   ny = Ceil(ly / h - 1e-9);
-  nz = Ceil(lz / h - 1e-9);
   Point(1) = {x0, y0, z0, h};
   If (hexahedra)
     ex[] = Extrude {lx, 0, 0} { Point{1}; Layers{nx}; Recombine; };
     ey[] = Extrude {0, ly, 0} { Line{ex[1]}; Layers{ny}; Recombine; };
-    ez[] = Extrude {0, 0, lz} { Surface{ey[1]}; Layers{nz}; Recombine; };
   Else
     ex[] = Extrude {lx, 0, 0} { Point{1}; Layers{nx}; };
     ey[] = Extrude {0, ly, 0} { Line{ex[1]}; Layers{ny}; };
-    ez[] = Extrude {0, 0, lz} { Surface{ey[1]}; Layers{nz}; };
   EndIf
   section = ey[1];
 EndIf
+sweep_length = lz;
+first_length = front;
+last_length = 0;
+sweep_layers = 0;
+sweep_graded = 1;
+Call Sweep;
 
-// Named groups a scene can refer to (wall secondaries, clamps).
+// Named groups a scene can refer to (wall secondaries, clamps, parts).
 Physical Surface("bottom") = {section};               // z = z0
-Physical Surface("top") = {ez[0]};                    // z = z0 + lz
-Physical Surface("sides") = {ez[2], ez[3], ez[4], ez[5]};
-Physical Volume("body") = {ez[1]};
+Physical Surface("top") = {sweep_top};                // z = z0 + lz
+Physical Surface("sides") = {sweep_lateral[]};
+If (front > 0)
+  Physical Volume("front") = {sweep_volumes[0]};
+  Physical Volume("body") = {sweep_volumes[1]};
+Else
+  Physical Volume("body") = {sweep_volumes[0]};
+EndIf

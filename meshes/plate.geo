@@ -11,6 +11,11 @@
 // to h over refine_radius (quadrangles recombined by Blossom for hexahedra), then swept
 // through the thickness in `layers` equal layers; refine_z is not used (the layers through
 // the thickness stay uniform).
+//
+// Regions (physical volumes): "body", and with bottom_layer > 0 or top_layer > 0 the
+// layers of those thicknesses at z0 and at the top as the volumes "bottom_layer" and
+// "top_layer" (a pad, the skins of a sandwich; sweep.geo): `layers` are then shared among
+// the regions in proportion to their thicknesses (at least one each).
 DefineConstant[
   x0 = {0, Name "Parameters/1Origin/x0 (lowest corner)"},
   y0 = {0, Name "Parameters/1Origin/y0"},
@@ -25,15 +30,13 @@ DefineConstant[
   refine_radius = {0.02, Min 1e-9, Name "Parameters/4Refinement/radius"},
   refine_x = {0.05, Name "Parameters/4Refinement/x"},
   refine_y = {0.05, Name "Parameters/4Refinement/y"},
-  refine_z = {0, Name "Parameters/4Refinement/z (not used)"}
+  refine_z = {0, Name "Parameters/4Refinement/z (not used)"},
+  bottom_layer = {0, Min 0, Name "Parameters/5Regions/bottom layer (0: none)"},
+  top_layer = {0, Min 0, Name "Parameters/5Regions/top layer (0: none)"}
 ];
 
-nz = layers;
-If (nz < 1)
-  nz = Ceil(thickness / h - 1e-9);
-EndIf
-
 Include "refine.geo";
+Include "sweep.geo";
 
 If (refine_size > 0)
   Point(1) = {x0, y0, z0, h};
@@ -67,14 +70,15 @@ Else
   section = ey[1];
 EndIf
 
-If (hexahedra)
-  ez[] = Extrude {0, 0, thickness} { Surface{section}; Layers{nz}; Recombine; };
-Else
-  ez[] = Extrude {0, 0, thickness} { Surface{section}; Layers{nz}; };
-EndIf
+sweep_length = thickness;
+first_length = bottom_layer;
+last_length = top_layer;
+sweep_layers = layers;
+sweep_graded = 0;
+Call Sweep;
 
-// Named groups a scene can refer to (wall secondaries, clamps).
+// Named groups a scene can refer to (wall secondaries, clamps, parts).
 Physical Surface("bottom") = {section};               // z = z0
-Physical Surface("top") = {ez[0]};                    // z = z0 + thickness
-Physical Surface("sides") = {ez[2], ez[3], ez[4], ez[5]};
-Physical Volume("body") = {ez[1]};
+Physical Surface("top") = {sweep_top};                // z = z0 + thickness
+Physical Surface("sides") = {sweep_lateral[]};
+Call PlateRegions;

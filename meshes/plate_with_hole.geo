@@ -12,6 +12,11 @@
 // Refinement (refine_size > 0, see refine.geo): the in-plane size falls to refine_size at
 // (refine_x, refine_y) and grows back to h over refine_radius; refine_z is not used (the
 // layers through the thickness stay uniform).
+//
+// Regions (physical volumes): "body", and with bottom_layer > 0 or top_layer > 0 the
+// layers of those thicknesses at z0 and at the top as the volumes "bottom_layer" and
+// "top_layer" (a pad, the skins of a sandwich; sweep.geo): `layers` are then shared among
+// the regions in proportion to their thicknesses (at least one each).
 DefineConstant[
   x0 = {0, Name "Parameters/1Origin/x0 (lowest corner)"},
   y0 = {0, Name "Parameters/1Origin/y0"},
@@ -29,13 +34,11 @@ DefineConstant[
   refine_radius = {0.02, Min 1e-9, Name "Parameters/4Refinement/radius"},
   refine_x = {0.07, Name "Parameters/4Refinement/x"},
   refine_y = {0.05, Name "Parameters/4Refinement/y"},
-  refine_z = {0, Name "Parameters/4Refinement/z (not used)"}
+  refine_z = {0, Name "Parameters/4Refinement/z (not used)"},
+  bottom_layer = {0, Min 0, Name "Parameters/5Regions/bottom layer (0: none)"},
+  top_layer = {0, Min 0, Name "Parameters/5Regions/top layer (0: none)"}
 ];
 
-nz = layers;
-If (nz < 1)
-  nz = Ceil(thickness / h - 1e-9);
-EndIf
 cx = x0 + lx / 2 + hole_dx;
 cy = y0 + ly / 2 + hole_dy;
 
@@ -61,20 +64,32 @@ Curve Loop(2) = {5, 6, 7, 8};
 Plane Surface(1) = {1, 2};
 
 Include "refine.geo";
+Include "sweep.geo";
 
 If (hexahedra)
   Mesh.Algorithm = 6;
   Mesh.RecombinationAlgorithm = 1;
   Recombine Surface{1};
-  ez[] = Extrude {0, 0, thickness} { Surface{1}; Layers{nz}; Recombine; };
-Else
-  ez[] = Extrude {0, 0, thickness} { Surface{1}; Layers{nz}; };
 EndIf
+section = 1;
+sweep_length = thickness;
+first_length = bottom_layer;
+last_length = top_layer;
+sweep_layers = layers;
+sweep_graded = 0;
+Call Sweep;
 
-// Named groups a scene can refer to (wall secondaries, clamps). Extrude lists the lateral
-// faces in the order of the section's boundary curves: the outer loop, then the hole.
+// Named groups a scene can refer to (wall secondaries, clamps, parts). Extrude lists the
+// lateral faces of each region in the order of the section's boundary curves: the outer
+// loop (4), then the hole (4).
 Physical Surface("bottom") = {1};                     // z = z0
-Physical Surface("top") = {ez[0]};                    // z = z0 + thickness
-Physical Surface("sides") = {ez[2], ez[3], ez[4], ez[5]};
-Physical Surface("hole") = {ez[6], ez[7], ez[8], ez[9]};
-Physical Volume("body") = {ez[1]};
+Physical Surface("top") = {sweep_top};                // z = z0 + thickness
+sides[] = {};
+hole[] = {};
+For region In {0 : #sweep_volumes[] - 1}
+  sides[] += sweep_lateral[{8 * region : 8 * region + 3}];
+  hole[] += sweep_lateral[{8 * region + 4 : 8 * region + 7}];
+EndFor
+Physical Surface("sides") = {sides[]};
+Physical Surface("hole") = {hole[]};
+Call PlateRegions;

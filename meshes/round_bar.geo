@@ -10,6 +10,9 @@
 // Refinement (refine_size > 0, see refine.geo): the size falls to refine_size at the point
 // (refine_x, refine_y, refine_z) and grows back to h over refine_radius (m), in the section
 // and along the axis.
+//
+// Regions (physical volumes): "body", and with front > 0 the first `front` metres from
+// z0 as the volume "front" (a rod's nose of another metal; sweep.geo).
 DefineConstant[
   x0 = {0, Name "Parameters/1Origin/x0 (centre of the bottom face)"},
   y0 = {0, Name "Parameters/1Origin/y0"},
@@ -22,7 +25,8 @@ DefineConstant[
   refine_radius = {0.008, Min 1e-9, Name "Parameters/4Refinement/radius"},
   refine_x = {0.005, Name "Parameters/4Refinement/x"},
   refine_y = {0, Name "Parameters/4Refinement/y"},
-  refine_z = {0.05, Name "Parameters/4Refinement/z"}
+  refine_z = {0.05, Name "Parameters/4Refinement/z"},
+  front = {0, Min 0, Name "Parameters/5Regions/front length (0: none)"}
 ];
 
 Point(1) = {x0, y0, z0, h};
@@ -38,9 +42,7 @@ Curve Loop(1) = {1, 2, 3, 4};
 Plane Surface(1) = {1};
 
 Include "refine.geo";
-layer_start = z0;
-layer_length = length;
-Call GradedLayers;
+Include "sweep.geo";
 
 If (hexahedra)
   // Frontal-Delaunay, then Blossom recombination (its perfect matching leaves no triangle
@@ -48,13 +50,22 @@ If (hexahedra)
   Mesh.Algorithm = 6;
   Mesh.RecombinationAlgorithm = 1;
   Recombine Surface{1};
-  ez[] = Extrude {0, 0, length} { Surface{1}; Layers{layer_counts[], layer_heights[]}; Recombine; };
-Else
-  ez[] = Extrude {0, 0, length} { Surface{1}; Layers{layer_counts[], layer_heights[]}; };
 EndIf
+section = 1;
+sweep_length = length;
+first_length = front;
+last_length = 0;
+sweep_layers = 0;
+sweep_graded = 1;
+Call Sweep;
 
-// Named groups a scene can refer to (wall secondaries, clamps).
+// Named groups a scene can refer to (wall secondaries, clamps, parts).
 Physical Surface("bottom") = {1};                     // z = z0
-Physical Surface("top") = {ez[0]};                    // z = z0 + length
-Physical Surface("sides") = {ez[2], ez[3], ez[4], ez[5]};
-Physical Volume("body") = {ez[1]};
+Physical Surface("top") = {sweep_top};                // z = z0 + length
+Physical Surface("sides") = {sweep_lateral[]};
+If (front > 0)
+  Physical Volume("front") = {sweep_volumes[0]};
+  Physical Volume("body") = {sweep_volumes[1]};
+Else
+  Physical Volume("body") = {sweep_volumes[0]};
+EndIf

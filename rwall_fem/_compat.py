@@ -28,6 +28,12 @@ from pathlib import Path
 if "-no_signal_handler" not in os.environ.get("PETSC_OPTIONS", ""):
     os.environ["PETSC_OPTIONS"] = f"{os.environ.get('PETSC_OPTIONS', '')} -no_signal_handler"
 
+# SCOTCH 7 (Debian's, under DOLFINx 0.5) partitions with threads, and its threads make
+# the partition of a mesh differ from run to run (seen on 2 ranks: the halves swapped, in
+# one run out of three, whatever the mesh): a checkpoint is then another partition's, and
+# a resumed run refuses it. One thread gives the same partition every time.
+os.environ.setdefault("SCOTCH_PTHREAD_NUMBER", "1")
+
 if importlib.util.find_spec("dolfinx_solver") is not None:
     import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 

@@ -25,10 +25,20 @@ import numpy as np
 from mpi4py import MPI
 
 from rwall_fem import __version__, _compat
+from rwall_fem.body import (
+    Body,
+    Part,
+    PartError,
+    part_masses,
+    parts_of,
+    piece_overlaps,
+    shared_velocities,
+    technologies,
+)
 from rwall_fem.boundary import VelocityBoundary
 from rwall_fem.checkpoint import Checkpoints, body_digest, scene_keys
 from rwall_fem.effects import Gravity
-from rwall_fem.elements import ElementForce, GhostedField, Technology
+from rwall_fem.elements import GhostedField
 from rwall_fem.estimate import (
     LIFT_HINT,
     estimate,
@@ -36,7 +46,7 @@ from rwall_fem.estimate import (
     steps_above_limit,
     unphysical_material,
 )
-from rwall_fem.mechanics import critical_time_step, lumped_mass, shortest_edge
+from rwall_fem.mechanics import critical_time_step, shortest_edge
 from rwall_fem.meshing import (
     BodyMesh,
     MeshTooLarge,
@@ -146,13 +156,14 @@ def build_simulation(
     about = "" if sim.step_size.mode == "fixed" else "about "
     facts = [
         _mesh_fact(solid),
+        *([_parts_fact(solid, solid.comm)] if scene.parts else []),
         _step_fact(sim),
         f"effects: {', '.join(sim.effects)}; {about}{sim.planned_steps} steps to t = "
         f"{scene.run.end_time:.4g} s",
     ]
     for line in facts:
         log.info("%s", line)
-    warnings = _starter_warnings(sim, solid)
+    warnings = _starter_warnings(sim, solid) + piece_overlaps(sim.internal, solid.X, sim.comm)
     for line in warnings:
         log.warning("%s", line)
     sim.info["warnings"] = warnings
@@ -177,20 +188,21 @@ def build_simulation(
 @dataclass
 class _Solid:
     """The discretised body: its communicator and mesh, the P1/Q1 vector space, the owned
-    nodes' reference coordinates (m) and lumped masses (kg), its displacement and velocity
-    fields, its element technology with the linear elastic force of that technology (the
-    tangent at rest of every material), the stable step at rest (s) from the largest
-    eigenvalue, and the diagonal of its box (m)."""
+    nodes' reference coordinates (m) and lumped masses (kg, and per part), its
+    displacement and velocity fields, its parts with the linear elastic force of their
+    technologies (the tangent at rest of every material), the stable step at rest (s)
+    from the largest eigenvalue, and the diagonal of its box (m)."""
 
     comm: MPI.Comm
     body: BodyMesh
     V: object
     X: np.ndarray
     mass: np.ndarray
+    part_masses: np.ndarray
     u: GhostedField
     v: GhostedField
-    technology: Technology
-    elastic: ElementForce
+    parts: list[Part]
+    elastic: Body
     dt_stable: float
     size: float
 
@@ -200,8 +212,9 @@ class _Solid:
 
 
 def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _Solid:
-    """The body of the scene's ``[mesh]`` (or ``body``), with its mass, its element
-    technology and stable step; refused above ``max_cells`` cells (None: no limit)."""
+    """The body of the scene's ``[mesh]`` (or ``body``), with its parts, their mass and
+    element technologies and the stable step; refused above ``max_cells`` cells (None: no
+    limit)."""
     spec = scene.mesh
     if body is None and spec is None:
         raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
@@ -224,35 +237,35 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
         raise SceneError(
             f"{scene.source}: mesh: {cell} cells; allowed: tetrahedra or hexahedra (a volume)"
         )
-    element = scene.element
+    specs = scene.body_parts
     try:
-        technology = Technology.choose(
-            cell,
-            element.integration,
-            element.hourglass,
-            element.hourglass_coefficient,
-            plastic=scene.material.plastic,
-        )
-    except ValueError as err:  # e.g. reduced integration on a file of tetrahedra
-        raise SceneError(f"{scene.source}: {err} (the mesh has {cell} cells)") from None
+        chosen = technologies(specs, cell, explicit=bool(scene.parts))
+        parts = parts_of(specs, body, chosen, comm)
+    except PartError as err:
+        raise SceneError(f"{scene.source}: {err}") from None
     V = _compat.vector_space(body.msh)
     if spec is not None and spec.noise is not None:
         if spec.file is not None:  # a built-in shape's noise was checked with the scene
             _noise_is_small(scene, shortest_edge(V))
         perturb(body, *spec.noise)
     X = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local].copy()
-    try:
-        mass = lumped_mass(V, scene.material.density)
-    except ValueError as err:
-        raise SceneError(f"{scene.source}: mesh: {err}") from None
+    masses = part_masses(V, parts)
+    mass = masses.sum(axis=1)
+    lowest = comm.allreduce(float(mass.min(initial=np.inf)), op=MPI.MIN)
+    if not lowest > 0.0:
+        raise SceneError(
+            f"{scene.source}: mesh: lumped mass is not positive (min {lowest:g} kg): the "
+            f"element {cell} P1 is the only supported choice"
+        )
     u, v = GhostedField(V), GhostedField(V)
-    elastic = ElementForce(V, replace(scene.material, model="linear_elastic"), technology, u, v)
+    elastic = Body(V, [replace(p, material=replace(p.material, model="linear_elastic"))
+                       for p in parts], u, v, explicit=bool(scene.parts))  # fmt: skip
     dt_stable = _stable_step(scene, elastic, mass, X, comm)
     low, high = np.empty(3), np.empty(3)
     comm.Allreduce(X.min(axis=0, initial=np.inf), low, op=MPI.MIN)
     comm.Allreduce(X.max(axis=0, initial=-np.inf), high, op=MPI.MAX)
     size = float(np.linalg.norm(high - low))
-    return _Solid(comm, body, V, X, mass, u, v, technology, elastic, dt_stable, size)
+    return _Solid(comm, body, V, X, mass, masses, u, v, parts, elastic, dt_stable, size)
 
 
 def _noise_is_small(scene: Scene, edge: float) -> None:
@@ -267,7 +280,7 @@ def _noise_is_small(scene: Scene, edge: float) -> None:
         )
 
 
-def _stable_step(scene: Scene, elastic: ElementForce, mass, X, comm) -> float:
+def _stable_step(scene: Scene, elastic: Body, mass, X, comm) -> float:
     """The stable step (s) of :func:`critical_time_step`, or one line naming the material
     when the eigenvalue cannot be found (e.g. a density off by orders of magnitude)."""
     from petsc4py import PETSc
@@ -287,8 +300,26 @@ def _stable_step(scene: Scene, elastic: ElementForce, mass, X, comm) -> float:
 def _mesh_fact(solid: _Solid) -> str:
     return (
         f"mesh: {solid.body.num_cells} {solid.body.msh.topology.cell_type.name} cells, "
-        f"{solid.V.dofmap.index_map.size_global} nodes; {solid.technology.describe()}"
+        f"{solid.V.dofmap.index_map.size_global} nodes; {_technology(solid.parts)}"
     )
+
+
+def _technology(parts: list[Part]) -> str:
+    """The element technology, part by part when the parts differ."""
+    kinds = {part.technology.describe() for part in parts}
+    if len(kinds) == 1:
+        return kinds.pop()
+    return "; ".join(f"{part.name}: {part.technology.describe()}" for part in parts)
+
+
+def _parts_fact(solid: _Solid, comm) -> str:
+    """A line per part: its material, cells and mass."""
+    lines = []
+    for k, part in enumerate(solid.parts):
+        cells = comm.allreduce(len(part.cells))
+        mass = comm.allreduce(float(solid.part_masses[:, k].sum()))
+        lines.append(f"{part.name} ({part.material.model}, {cells} cells, {mass:.6g} kg)")
+    return "parts: " + "; ".join(lines)
 
 
 def _step_fact(sim: Simulation) -> str:
@@ -311,13 +342,18 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     they act."""
     comm = solid.comm
     internal = solid.elastic
-    if scene.material.model != "linear_elastic":
-        internal = ElementForce(solid.V, scene.material, solid.technology, solid.u, solid.v)
+    if any(part.material.model != "linear_elastic" for part in solid.parts):
+        internal = Body(solid.V, solid.parts, solid.u, solid.v, explicit=bool(scene.parts))
+    internal.part_masses = solid.part_masses.copy()
+    if reason := shared_velocities(internal, comm):
+        raise SceneError(f"{scene.source}: part: {reason}")
     body_mass = comm.allreduce(float(solid.mass.sum()))
     steps = step_size(scene, internal, solid.dt_stable, V=solid.V, body_mass=body_mass,
                       limits=limits)  # fmt: skip
     state = State(X=solid.X, mass=solid.mass, dt=steps.initial, u=solid.u.owned, v=solid.v.owned)
-    state.v[:] = scene.initial.velocity
+    held = internal.held[: solid.owned] > 0
+    for k, part in enumerate(solid.parts):
+        state.v[held[:, k]] = part.velocity
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
@@ -333,7 +369,7 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
             "git_hash": comm.bcast(git_hash() if comm.rank == 0 else None, root=0),
             "dolfinx_version": _compat.DOLFINX_VERSION,
             "cell": solid.body.msh.topology.cell_type.name,
-            "element": solid.technology.describe(),
+            "element": _technology(solid.parts),
             "cells": solid.body.num_cells,
             "nodes": solid.V.dofmap.index_map.size_global,
             "mass": body_mass,
@@ -376,7 +412,7 @@ def _add_recorders(
             count=scene.output.fields,
             end_time=scene.run.end_time,
             V=solid.V,
-            material=scene.material,
+            parts=solid.parts,
         )
         sim.recorders.append(fields)
     if scene.output.frames:
@@ -385,9 +421,10 @@ def _add_recorders(
 
         color, fields = scene.output.color, sorted(sim.internal.cell_fields(sim.state))
         if color not in COLORS and color not in fields:
+            models = ", ".join(sorted({part.material.model for part in solid.parts}))
             raise SceneError(
                 f"{scene.source}: output.color: {color!r} is not a field of this body "
-                f"({', '.join(fields) or 'no cell fields'} for {scene.material.model}); "
+                f"({', '.join(fields) or 'no cell fields'} for {models}); "
                 f"use one of {', '.join(COLORS)}"
             )
         frames = Frames(
@@ -396,9 +433,10 @@ def _add_recorders(
             end_time=scene.run.end_time,
             V=solid.V,
             walls=sim.walls,
-            speed=float(np.linalg.norm(scene.initial.velocity)),
+            speed=max(float(np.linalg.norm(part.velocity)) for part in solid.parts),
             gravity=scene.gravity,
             color=color,
+            parts=[part.name for part in solid.parts] if scene.parts else (),
         )
         sim.recorders.append(frames)
 
@@ -442,8 +480,8 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
 
 def _erodes(scene: Scene) -> bool:
     """Whether cells of the body may erode: a failure criterion, or erosion below dt_min."""
-    failure = getattr(scene.material, "failure", None)
-    return failure is not None or scene.run.dt_min_action == "erode"
+    failing = any(getattr(p.material, "failure", None) for p in scene.body_parts)
+    return failing or scene.run.dt_min_action == "erode"
 
 
 def _filter_fits(spec: WallSpec, where: str, dt: float) -> None:
@@ -480,7 +518,8 @@ def _secondary_nodes(
 ) -> np.ndarray:
     """Owned secondary nodes (``docs/theory.md``, "Secondary nodes"): boundary nodes by
     default (every node of a body whose cells may erode); or nodes with 0 <= d <=
-    search_distance at the start, plus named sets; minus excluded sets."""
+    search_distance at the start, plus named sets, plus every node of the named parts;
+    minus excluded sets."""
     V, body, owned = solid.V, solid.body, solid.owned
     sec = spec.secondary
     for key, names in (("add", sec.add), ("exclude", sec.exclude)):
@@ -491,11 +530,14 @@ def _secondary_nodes(
                     f"{where}.secondary.{key}: unknown node set {name!r}; the mesh has: {known}"
                 )
     selected = np.zeros(owned, dtype=bool)
-    if sec.search_distance is None and not sec.add:
+    if sec.search_distance is None and not sec.add and not sec.parts:
         if erodes:  # erosion bares the inside: every node may meet the wall
             selected[:] = True
         else:
             selected[_owned(boundary_nodes(V), owned)] = True
+    names = [part.name for part in solid.parts]
+    for name in sec.parts:  # the scene checked the names
+        selected |= solid.elastic.held[:owned, names.index(name)] > 0
     if sec.search_distance is not None:
         d = shape.distance(state.X)
         selected |= (d >= -_ROUND_OFF * solid.size) & (d <= sec.search_distance)

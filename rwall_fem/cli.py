@@ -4,7 +4,9 @@
   scene, or with ``--resume`` continue the run whose checkpoint is in DIR;
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
 - ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
-- ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`).
+- ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`);
+- ``rwall-fem convert NAME_0000.rad DIR``: a Radioss deck as a scene and its mesh
+  (:mod:`rwall_fem.radioss`); ``run`` and ``check`` also take a deck as they take a scene.
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
 mistake on the command line, a checkpoint that does not fit the scene, code the C
@@ -55,7 +57,7 @@ def _command(argv: list[str] | None) -> int:
     run = commands.add_parser("run", help="run a scene")
     check = commands.add_parser("check", help="validate a scene and print what would run")
     for sub in (run, check):
-        sub.add_argument("scene", help="scene file (TOML)")
+        sub.add_argument("scene", help="scene file (TOML), or a Radioss deck NAME_0000.rad")
         sub.add_argument(
             "--set",
             dest="overrides",
@@ -83,6 +85,11 @@ def _command(argv: list[str] | None) -> int:
         default=COLORS[0],
         help=f"{', '.join(COLORS)}, or a cell field of the body such as plastic_strain",
     )
+    convert = commands.add_parser(
+        "convert", help="write a Radioss deck as a scene (TOML) and its mesh (gmsh)"
+    )
+    convert.add_argument("deck", help="the starter file NAME_0000.rad (NAME_0001.rad beside it)")
+    convert.add_argument("directory", help="where NAME.toml and NAME.msh go")
     study = commands.add_parser("study", help="accuracy against wall time, on exact references")
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
@@ -107,6 +114,8 @@ def _command(argv: list[str] | None) -> int:
         try:
             if args.command == "study":
                 code = _study(args.out, args.quick, comm)
+            elif args.command == "convert":
+                code = _convert(args.deck, args.directory, comm)
             elif args.command == "check":
                 code = _check(args.scene, args.overrides, comm, args.lift_limits)
             else:
@@ -220,9 +229,8 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
     from rwall_fem.build import build_simulation, run_in_folder
     from rwall_fem.checkpoint import latest_checkpoint
     from rwall_fem.output.run_log import CycleLines, cycle_schedule
-    from rwall_fem.scene import load_scene
 
-    scene = load_scene(scene_file, overrides)
+    scene = _load(scene_file, overrides, comm)
     if resume:  # before meshing, and before the folder is made
         latest_checkpoint(Path(out) if out is not None else scene.output.directory, comm)
     sim = build_simulation(scene, comm, out, limits=not lift_limits)
@@ -236,6 +244,35 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
             sim.recorders.append(CycleLines(sys.stderr, schedule))
     run_in_folder(sim, functools.partial(_say_how_it_ended, quiet=quiet), resume=resume)
     return sim.history.summary
+
+
+def _load(scene_file, overrides, comm):
+    """The scene of a TOML file, or of a Radioss deck (:mod:`rwall_fem.radioss`)."""
+    from rwall_fem.radioss import is_deck, load_deck
+    from rwall_fem.scene import load_scene
+
+    if is_deck(scene_file):
+        return load_deck(scene_file, overrides, comm)
+    return load_scene(scene_file, overrides)
+
+
+def _convert(deck: str, directory: str, comm) -> int:
+    """``rwall-fem convert``: rank 0 writes the scene and its mesh; a refusal reaches every
+    rank."""
+    from rwall_fem.radioss import DeckError, convert
+
+    outcome = None
+    if comm.rank == 0:
+        try:
+            outcome = str(convert(deck, directory))
+        except DeckError as err:
+            outcome = err
+    outcome = comm.bcast(outcome, root=0)
+    if isinstance(outcome, DeckError):
+        raise outcome
+    if comm.rank == 0:
+        print(f"rwall-fem: wrote {outcome} and its mesh")
+    return 0
 
 
 def _study(out: str, quick: bool, comm) -> int:
@@ -281,9 +318,8 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
 
     from rwall_fem.build import build_simulation
     from rwall_fem.estimate import estimate
-    from rwall_fem.scene import load_scene
 
-    scene = load_scene(scene_file, overrides)
+    scene = _load(scene_file, overrides, comm)
     guess = estimate(scene, comm.size)  # on every rank: it may refuse the scene
     if comm.rank == 0:
         print(f"rwall-fem: estimate before meshing: {guess.describe()}")

@@ -149,13 +149,17 @@ class GhostedField:
 
 
 class ElementForce:
-    """Internal force f_int(u) (N) of a body, cell by cell; an effect that *sets* ``state.a``.
+    """Internal force f_int(u) (N) of one material and element technology over some cells,
+    cell by cell (a part of the body, :mod:`rwall_fem.body`; all the owned cells unless
+    ``cells``, their local indices, is given).
 
     ``u`` and ``v`` are the body's displacement and velocity fields, shared with the
     :class:`~rwall_fem.solver.State` (``v`` is read by the viscous hourglass form and by
     the elasto-plastic laws, whose strain increment over a step is dt v^{n-1/2}).
+    :meth:`compute` adds the force into ``f``, a field it may share with the body's other
+    parts; :meth:`accelerate` (a force alone: it owns its field) also sets ``state.a``.
 
-    Energies (J, this rank) after each :meth:`accelerate`: ``stored_energy``, the elastic
+    Energies (J, this rank) after each :meth:`compute`: ``stored_energy``, the elastic
     energy at u^n; ``hourglass_energy``, stored (physical and stiffness forms of elastic
     bodies) or the hourglass work so far (viscous form, elasto-plastic bodies);
     ``plastic_work``, the plastic dissipation so far. An elasto-plastic body keeps its
@@ -175,7 +179,17 @@ class ElementForce:
     which, and the energies gain ``"eroded_internal"`` (``kernels/failure.h``).
     """
 
-    def __init__(self, V, material, technology: Technology, u: GhostedField, v: GhostedField):
+    def __init__(
+        self,
+        V,
+        material,
+        technology: Technology,
+        u: GhostedField,
+        v: GhostedField,
+        *,
+        cells: np.ndarray | None = None,
+        f: GhostedField | None = None,
+    ):
         model = material.model
         self.plastic = material.plastic
         if model not in MODELS and not self.plastic:
@@ -184,14 +198,17 @@ class ElementForce:
         self.technology = technology
         self.conservative = technology.conservative and not self.plastic
         self.u, self.v = u, v
-        self.f = GhostedField(V)
+        self.f = f if f is not None else GhostedField(V)
         self.V, self._probe = V, None  # the fields of forces(), made at its first call
         self.ffi, self.lib = ffi, lib = load()
         tdim = V.mesh.topology.dim
-        num_cells = V.mesh.topology.index_map(tdim).size_local
+        owned = V.mesh.topology.index_map(tdim).size_local
+        # Its cells: local indices among the rank's owned cells.
+        self.cell_ids = np.arange(owned, dtype=np.int32) if cells is None else np.asarray(cells)
         self.X = np.ascontiguousarray(V.tabulate_dof_coordinates(), dtype=np.float64)
-        self.cells = _oriented(np.array(_compat.cell_nodes(V)[:num_cells], dtype=np.int32), self.X)
-        self.num_cells = num_cells
+        nodes = np.array(_compat.cell_nodes(V)[:owned][self.cell_ids], dtype=np.int32)
+        self.cells = _oriented(nodes, self.X)
+        self.num_cells = len(self.cell_ids)
         self.params = ffi.new("element_params *")
         lmbda, mu = material.lame
         self.params.lmbda, self.params.mu = lmbda, mu
@@ -218,7 +235,7 @@ class ElementForce:
             self._erode()
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
         self._accelerate = None
-        self.nodal_force = self.f.owned  # N, owned nodes
+        self.interface_force = None  # the nodal forces of its cells at an interface of parts
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -396,6 +413,11 @@ class ElementForce:
         return float(self._energy[2])
 
     @property
+    def eroded_energy(self) -> float:
+        """Internal energy (J) the eroded cells of this rank took with them so far."""
+        return float(self._energy[3])
+
+    @property
     def smallest_step(self) -> float:
         """The smallest stable step estimate (s) of this rank's cells at the latest force
         computation (scaled by the mass-scaling factors), inf if it has no cell."""
@@ -408,13 +430,13 @@ class ElementForce:
         return int(self.step[5])
 
     def cell_position(self, cell: int) -> np.ndarray:
-        """The centroid (m) of the owned ``cell`` (local index) at X + u."""
+        """The centroid (m) of its ``cell`` (an index into its cells) at X + u."""
         nodes = self.cells[cell]
         return (self.X[nodes] + self.u.array[nodes]).mean(axis=0)
 
     def describe_cell(self, cell: int) -> str:
-        """The state of the owned ``cell`` in words: its volume against its volume at rest
-        and, when the law has them, its plastic strain and temperature."""
+        """The state of its ``cell`` (an index into its cells) in words: its volume against
+        its volume at rest and, when the law has them, its plastic strain and temperature."""
         volume, _ = self.cell_sizes(self.X + self.u.array)
         words = [f"volume {volume[cell] / self.volume0[cell]:.3g} of its initial"]
         if self.plastic:
@@ -424,32 +446,8 @@ class ElementForce:
                 words.append(f"temperature {points[:, 7, cell].mean():.4g} K")
         return ", ".join(words)
 
-    def energies(self, state) -> dict[str, float]:
-        """This rank's energies (J) at step n: ``"internal"``, the elastic strain energy (or,
-        without a stored energy, the internal work less the hourglass energy and the
-        internal energy of eroded cells), and ``"hourglass"`` when the elements have
-        hourglass control, both of the live cells; for an elasto-plastic body also the
-        parts of the internal energy, ``"elastic"`` and ``"plastic_work"``; when cells can
-        erode, the internal energy the eroded cells took with them, ``"eroded_internal"``,
-        and the kinetic energy of the detached nodes, ``"eroded_kinetic"``."""
-        hourglass, eroded = self.hourglass_energy, float(self._energy[3])
-        internal = (
-            self.stored_energy if self.conservative else state.internal_work - hourglass - eroded
-        )
-        energies = {"internal": internal}
-        if "hourglass" in self.energy_names:
-            energies["hourglass"] = hourglass
-        if self.plastic:
-            energies |= {"elastic": self.stored_energy, "plastic_work": self.plastic_work}
-        if self.erosion is not None:
-            energies |= {
-                "eroded_internal": eroded,
-                "eroded_kinetic": self.erosion.kinetic_energy(state),
-            }
-        return energies
-
     def cell_fields(self, state) -> dict[str, np.ndarray]:
-        """Values per owned cell for the outputs: for an elasto-plastic body the equivalent
+        """Values per cell of its own for the outputs: for an elasto-plastic body the equivalent
         plastic strain ``"plastic_strain"`` and the von Mises stress ``"von_mises_stress"``
         (Pa), means over its integration points, and with a failure criterion the damage
         ``"damage"``, the largest of its points' (1: failed); when cells can erode,
@@ -475,7 +473,7 @@ class ElementForce:
 
     @property
     def damage(self) -> np.ndarray:
-        """The damage D of every integration point (rows) of the owned cells (columns)."""
+        """The damage D of every integration point (rows) of its cells (columns)."""
         start = self.params.damage_slot
         return self.history[start : start + self.points]
 
@@ -483,19 +481,26 @@ class ElementForce:
         """The equivalent plastic strain of every integration point of the owned cells."""
         return self.history[POINT_SLOTS - 2 : self.points * POINT_SLOTS : POINT_SLOTS]
 
-    def accelerate(self, state) -> None:
-        """Set ``state.a = -f_int(u^n) / m`` on the owned nodes; estimate the cells' stable
-        steps, find the inverted cells and erode the failed ones on the way (:attr:`step`)."""
-        self.u.scatter_forward()
+    def track_interface(self, slots: np.ndarray) -> None:
+        """Keep, at every :meth:`compute`, the nodal forces (N) of the cells with a slot
+        (``slots``: per cell its row of :attr:`interface_force`, or -1): cells at an
+        interface of parts, whose nodes' forces the parts share (:mod:`rwall_fem.body`)."""
+        self._slots = np.ascontiguousarray(slots, dtype=np.int32)
+        count = int(self._slots.max(initial=-1)) + 1
+        self.interface_force = np.zeros((count, self.cells.shape[1], 3))
+        self.params.interface = self.ffi.cast("int32_t *", self._slots.ctypes.data)
+        self.params.interface_force = self.ffi.cast("double *", self.interface_force.ctypes.data)
+
+    def compute(self, state) -> None:
+        """Add the internal force f_int(u^n) of its cells into :attr:`f` (owned and ghost
+        rows, before the reverse scatter); estimate the cells' stable steps and find the
+        inverted cells on the way (:attr:`step`). ``u`` (and ``v``) must be scattered
+        forward."""
         # The step just taken, dt^{n-1/2}: the elasto-plastic increment u^n - u^{n-1} is
         # dt^{n-1/2} v^{n-1/2} (0 at the first step: the state is the initial one).
         self.params.dt = state.dt_previous
         if self.conservative:
             self._energy[1] = 0.0
-        # The velocities: of the strain increments, of the viscous hourglass form, and what
-        # an eroded cell did last (failure.h), on the ghost nodes too.
-        if not self.conservative or self.erosion is not None:
-            self.v.scatter_forward()
         self._energy[0] = 0.0
         estimate = self.estimate_every_step or not self._estimated
         self.params.estimate = estimate
@@ -503,10 +508,17 @@ class ElementForce:
         if estimate:
             self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
             self._estimated = True
-        self.f.array.fill(0.0)
         self._kernel()
         if self.step[11]:
             self._remove_eroded()
+
+    def accelerate(self, state) -> None:
+        """A force alone: set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
+        self.u.scatter_forward()
+        if not self.conservative or self.erosion is not None:
+            self.v.scatter_forward()
+        self.f.array.fill(0.0)
+        self.compute(state)
         self.f.scatter_reverse_add()
         if self._accelerate is None:
             self._accelerate = functools.partial(

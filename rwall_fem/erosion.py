@@ -23,7 +23,7 @@ from dolfinx import la
 
 from rwall_fem import _compat
 
-__all__ = ["ErodedCells"]
+__all__ = ["ErodedCells", "ErodedParts"]
 
 
 class ErodedCells:
@@ -76,18 +76,6 @@ class ErodedCells:
         self._pending.clear()
         self.holding -= self._count(eroded)
 
-    @property
-    def detached(self) -> np.ndarray:
-        """The owned nodes that no live cell holds any more."""
-        return np.flatnonzero(self.holding <= 0.0)
-
-    def kinetic_energy(self, state) -> float:
-        """1/2 m |v|^2 (J) of this rank's detached nodes at the velocity of the latest update
-        (``state``'s): the eroded kinetic energy, a part of the kinetic energy."""
-        nodes = self.detached
-        v = state.v[nodes]
-        return 0.5 * float(np.sum(state.mass[nodes] * np.einsum("ij,ij->i", v, v)))
-
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """Which cells are alive, their work so far and the live cells of each node."""
         return {"alive": self.alive, "work": self.work, "holding": self.holding}
@@ -98,3 +86,59 @@ class ErodedCells:
         self.holding[:] = arrays["holding"]
         self._pending.clear()
         self.live = None if self.alive.all() else np.flatnonzero(self.alive).astype(np.int32)
+
+
+class ErodedParts:
+    """The eroded cells of a body of parts, over its owned cells: each part's
+    :class:`ErodedCells` (the ``forces`` of the parts whose cells may erode have one), read
+    through the parts' ``cells`` (local indices of owned cells). ``held`` is, per owned
+    node and part, how many of the part's cells hold it (the cells of a part that cannot
+    erode hold their nodes for good). A node is detached when no live cell of any part
+    holds it."""
+
+    def __init__(self, parts, forces, held: np.ndarray, owned_cells: int):
+        self._parts = list(zip((part.cells for part in parts), forces, strict=True))
+        self._held = held
+        self._owned_cells = owned_cells
+
+    def _eroding(self):
+        return [(cells, force.erosion) for cells, force in self._parts if force.erosion]
+
+    @property
+    def count(self) -> int:
+        """How many of the owned cells have eroded."""
+        return sum(e.count for _, e in self._eroding())
+
+    @property
+    def alive(self) -> np.ndarray:
+        """Per owned cell, whether it is alive."""
+        alive = np.ones(self._owned_cells, dtype=bool)
+        for cells, e in self._eroding():
+            alive[cells] = e.alive
+        return alive
+
+    @property
+    def detached(self) -> np.ndarray:
+        """The owned nodes that no live cell holds any more."""
+        holding = np.zeros(len(self._held))
+        for k, (_, force) in enumerate(self._parts):
+            holding += self._held[:, k] if force.erosion is None else force.erosion.holding
+        return np.flatnonzero(holding <= 0.0)
+
+    def kinetic_energy(self, state) -> float:
+        """1/2 m |v|^2 (J) of this rank's detached nodes at the velocity of the latest update
+        (``state``'s): the eroded kinetic energy, a part of the kinetic energy."""
+        nodes = self.detached
+        v = state.v[nodes]
+        return 0.5 * float(np.sum(state.mass[nodes] * np.einsum("ij,ij->i", v, v)))
+
+    def largest_damage(self) -> float | None:
+        """The largest damage of a live cell's point (this rank), None when no part has a
+        failure criterion."""
+        damaged = [(f.damage, f.erosion) for _, f in self._parts if f.failure is not None]
+        if not damaged:
+            return None
+        return max(
+            float(damage[:, e.alive].max(initial=0.0) if e else damage.max(initial=0.0))
+            for damage, e in damaged
+        )

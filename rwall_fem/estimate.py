@@ -85,7 +85,7 @@ def estimate(scene: Scene, ranks: int = 1) -> Estimate:
     memory = ranks * _RANK_BYTES + cells * _CELL_BYTES[mesh.cell]
     dt = scene.run.dt
     if dt is None:
-        speed = scene.material.p_wave_speed
+        speed = _fastest(scene)[1].material.p_wave_speed
         if not math.isfinite(speed):
             raise unphysical_material(scene, "the wave speed overflows")
         dt = scene.run.dt_scale * _STEP_FACTOR[mesh.cell] * _shortest(mesh) / speed
@@ -129,12 +129,28 @@ def steps_above_limit(scene: Scene, steps: float, dt: float, about: str = "") ->
 def unphysical_material(scene: Scene, reason: str) -> SceneError:
     """The error of a material whose numbers give no stable step (``reason``): a density
     or a modulus off by orders of magnitude, most often in other units than SI."""
-    m = scene.material
+    key, part = _fastest(scene)
+    m = part.material
     return SceneError(
-        f"{scene.source}: material: the stable time step cannot be computed ({reason}); "
+        f"{scene.source}: {key}: the stable time step cannot be computed ({reason}); "
         f"density = {m.density:g} kg/m^3 and young = {m.young:g} Pa give a wave speed of "
         f"{m.p_wave_speed:.3g} m/s: check their units"
     )
+
+
+def _fastest(scene: Scene):
+    """The key and resolved part (:attr:`~rwall_fem.scene.Scene.body_parts`) of the
+    material with the fastest waves (a speed that is not a number first): the one that
+    sets the step."""
+    parts = scene.body_parts
+
+    def speed(k: int) -> float:
+        c = parts[k].material.p_wave_speed
+        return math.inf if math.isnan(c) else c
+
+    k = max(range(len(parts)), key=speed)
+    own = scene.parts and scene.parts[k].material is not None
+    return (f"part[{k}].material" if own else "material"), parts[k]
 
 
 def _bytes(n: float) -> str:

@@ -6,8 +6,8 @@ f = int P(F) : grad(w) dX, F = I + grad(u), and the strain energy int psi(F) dX;
 :func:`strain_energy_density` is the same law in UFL, the reference the tests
 compare the kernels against and the field output's stress. At u = 0 both models
 have the small-strain stiffness, so the initial stable step is that of the linear
-model; :class:`~rwall_fem.stable_step.TangentStepMonitor` re-estimates it in the current
-configuration.
+model; the kernels re-estimate it at every step from the law's acoustic tensor at the
+current strain (``kernels/materials.h``, :mod:`rwall_fem.time_step`).
 """
 
 from __future__ import annotations

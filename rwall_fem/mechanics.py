@@ -61,11 +61,13 @@ def stress(u, material: Material):
     return 2.0 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(len(u))
 
 
-def lumped_mass(V, density: float) -> np.ndarray:
-    """Row-sum lumped nodal masses (kg) of the owned nodes of ``V``, shape (n,).
+def lumped_mass(V, density, *, positive: bool = True) -> np.ndarray:
+    """Row-sum lumped nodal masses (kg) of the owned nodes of ``V``, shape (n,), of the
+    ``density`` (kg/m^3: a number, or a function of the cells, e.g. piecewise constant).
 
     Row sum equals vertex quadrature (HRZ) for P1 tetrahedra and Q1 hexahedra,
-    so every mass is positive; anything else is refused.
+    so every mass is positive; anything else is refused (unless not ``positive``: the
+    masses of a part of the body, zero away from it).
     """
     w = ufl.TestFunction(V)
     ones = ufl.as_vector([1.0] * V.mesh.geometry.dim)
@@ -73,6 +75,8 @@ def lumped_mass(V, density: float) -> np.ndarray:
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     mass = b.array.reshape(-1, V.dofmap.index_map_bs)[:, 0].copy()
     b.destroy()
+    if not positive:
+        return mass
     lowest = V.mesh.comm.allreduce(mass.min(initial=np.inf), op=MPI.MIN)
     if not lowest > 0.0:
         raise ValueError(

@@ -1,8 +1,10 @@
 """Bodies from gmsh: the built-in shapes (``meshes/*.geo``) or a user's .msh/.geo file.
 
 The mesh is generated (or read) on rank 0 and distributed by DOLFINx. Named
-gmsh physical groups travel with it as facet tags so that scenes can refer to
-boundary node sets by name.
+gmsh physical groups travel with it: surfaces as facet tags, so that scenes can refer to
+boundary node sets by name, and volumes as cell tags, so that a scene's parts can name
+the regions they are made of (the built-in shapes have "body", and "front", or
+"bottom_layer" and "top_layer", when asked for).
 """
 
 from __future__ import annotations
@@ -39,11 +41,15 @@ __all__ = [
 
 @dataclass
 class BodyMesh:
-    """A distributed mesh with its named facet groups (name -> facet tag value)."""
+    """A distributed mesh with its named facet groups (name -> facet tag value) and its
+    named regions (name -> cell tag value; a body of your own without them is one
+    region)."""
 
     msh: object
     facet_tags: object = None
     groups: dict[str, int] = field(default_factory=dict)
+    cell_tags: object = None
+    volumes: dict[str, int] = field(default_factory=dict)
 
     @property
     def num_cells(self) -> int:
@@ -83,6 +89,10 @@ def body_mesh(comm: MPI.Comm, spec, max_cells: float | None = None) -> BodyMesh:
     common["max_cells"] = max_cells
     if spec.refine_point is not None:
         common["refine"] = Refinement(spec.refine_point, spec.refine_size, spec.refine_radius)
+    if spec.shape in ("bar", "round_bar"):
+        common["front"] = spec.front_length
+    else:
+        common["layers_at"] = (spec.bottom_layer, spec.top_layer)
     if spec.shape == "bar":
         return bar_mesh(comm, spec.origin, spec.size, **common)
     if spec.shape == "round_bar":
@@ -111,14 +121,17 @@ def bar_mesh(
     axis=(0.0, 0.0, 1.0),
     refine: Refinement | None = None,
     max_cells: float | None = None,
+    front: float = 0.0,
 ) -> BodyMesh:
     """Rectangular bar ``meshes/bar.geo``: the box ``origin`` + [0, size] (m), turned about
     ``origin`` so that its own z axis points along ``axis``.
 
     ``cell`` is "hexahedron" or "tetrahedron"; layers are at most ``element_size`` (m) thick.
     Structured unless ``refine`` is given (then an unstructured section swept in graded layers).
+    Regions: "body", and with ``front`` > 0 the first ``front`` metres along its own z,
+    "front".
     """
-    params = dict(zip(("lx", "ly", "lz"), size, strict=True))
+    params = dict(zip(("lx", "ly", "lz"), size, strict=True)) | {"front": front}
     return _swept_body(comm, "bar.geo", params, origin, axis, element_size, cell, refine, max_cells)
 
 
@@ -132,14 +145,17 @@ def round_bar_mesh(
     axis=(0.0, 0.0, 1.0),
     refine: Refinement | None = None,
     max_cells: float | None = None,
+    front: float = 0.0,
 ) -> BodyMesh:
     """Cylinder ``meshes/round_bar.geo`` of ``radius`` and ``length`` (m): its own z axis from
     ``origin`` (the centre of its bottom face) turned onto ``axis``.
 
     The disc is meshed at ``element_size`` (quadrangles or triangles) and swept along the
     axis in layers at most ``element_size`` thick: hexahedra, or prisms split into tetrahedra.
+    Regions: "body", and with ``front`` > 0 the first ``front`` metres of its length,
+    "front".
     """
-    params = {"radius": radius, "length": length}
+    params = {"radius": radius, "length": length, "front": front}
     return _swept_body(
         comm, "round_bar.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
@@ -155,13 +171,17 @@ def plate_mesh(
     layers: int = 0,
     refine: Refinement | None = None,
     max_cells: float | None = None,
+    layers_at: tuple[float, float] = (0.0, 0.0),
 ) -> BodyMesh:
     """Plate ``meshes/plate.geo``: the box ``origin`` + [0, size] (m) with the thickness
     ``size[2]`` along its own z, turned about ``origin`` so that its own z points along ``axis``.
 
     ``layers`` elements through the thickness (0: the fewest at most ``element_size`` thick).
+    Regions: "body", and the layers of thicknesses ``layers_at`` (m; 0: none) at its bottom
+    and top faces, "bottom_layer" and "top_layer".
     """
     params = dict(zip(("lx", "ly", "thickness"), size, strict=True)) | {"layers": layers}
+    params |= dict(zip(("bottom_layer", "top_layer"), layers_at, strict=True))
     return _swept_body(
         comm, "plate.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
@@ -179,6 +199,7 @@ def plate_with_hole_mesh(
     layers: int = 0,
     refine: Refinement | None = None,
     max_cells: float | None = None,
+    layers_at: tuple[float, float] = (0.0, 0.0),
 ) -> BodyMesh:
     """:func:`plate_mesh` with a circular through-hole (``meshes/plate_with_hole.geo``) of
     ``hole_radius`` (m), its centre ``hole_offset`` (m, own x and y) from the plate's centre.
@@ -187,6 +208,7 @@ def plate_with_hole_mesh(
     """
     params = dict(zip(("lx", "ly", "thickness"), size, strict=True))
     params |= {"hole_radius": hole_radius, "layers": layers}
+    params |= dict(zip(("bottom_layer", "top_layer"), layers_at, strict=True))
     params |= dict(zip(("hole_dx", "hole_dy"), hole_offset, strict=True))
     return _swept_body(
         comm, "plate_with_hole.geo", params, origin, axis, element_size, cell, refine, max_cells
@@ -273,7 +295,7 @@ def _sigint_kept():
 
 def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
     gmsh = gmsh_module()
-    groups, error, cells = None, None, 0
+    groups, volumes, error, cells = None, None, None, 0
     if comm.rank == 0:
         argv = [""]
         for name, value in (parameters or {}).items():
@@ -281,7 +303,7 @@ def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
         gmsh.initialize(argv, readConfigFiles=False)
         keep()
         try:
-            groups = _gmsh_model(Path(path))
+            groups, volumes = _gmsh_model(Path(path))
             cells = sum(len(tags) for tags in gmsh.model.mesh.getElements(3)[1])
         except _GmshError as err:
             error = f"{Path(path).name}: {err}"
@@ -290,26 +312,27 @@ def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
         except Exception as err:  # gmsh raises plain Exceptions, naming the file
             error = " ".join(str(err).replace(f"'{path}', ", "").split())
             error = f"{Path(path).name}: gmsh cannot read it: {error}"
-    groups, error, cells = comm.bcast((groups, error, cells), root=0)
+    groups, volumes, error, cells = comm.bcast((groups, volumes, error, cells), root=0)
     if error or (max_cells is not None and cells > max_cells):
         if comm.rank == 0:
             gmsh.finalize()
         raise ValueError(error) if error else MeshTooLarge(cells)
     try:
-        msh, _, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+        msh, cell_tags, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
     finally:
         if comm.rank == 0:
             gmsh.finalize()
-    return BodyMesh(msh, facet_tags, groups)
+    return BodyMesh(msh, facet_tags, groups, cell_tags, volumes)
 
 
 class _GmshError(Exception):
     """What is wrong with the model gmsh read, in one line."""
 
 
-def _gmsh_model(path: Path) -> dict[str, int]:
+def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int]]:
     """Open ``path`` in the current gmsh session, mesh it in 3-D if it holds no volume
-    cells, and return its named surface groups; raises on anything DOLFINx cannot take."""
+    cells, and return its named surface groups and volumes (name -> tag; one volume "body"
+    when it names none); raises on anything DOLFINx cannot take."""
     import gmsh
 
     _looks_like_gmsh(path)
@@ -332,14 +355,37 @@ def _gmsh_model(path: Path) -> dict[str, int]:
     }
     if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
         # DOLFINx reads only cells that belong to a physical group.
-        gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
+        tag = gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
+        gmsh.model.setPhysicalName(3, tag, "body")
+    volumes = {
+        gmsh.model.getPhysicalName(3, tag) or f"3:{tag}": tag
+        for dim, tag in gmsh.model.getPhysicalGroups()
+        if dim == 3
+    }
+    _regions_are_disjoint(volumes)
     kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)]
     if len(kinds) > 1:
         raise _GmshError(
             f"mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
             " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
         )
-    return groups
+    return groups, volumes
+
+
+def _regions_are_disjoint(volumes: dict[str, int]) -> None:
+    """Every volume entity is in at most one physical volume: DOLFINx reads each physical
+    volume's cells, so a cell in two would be two cells."""
+    import gmsh
+
+    owner: dict[int, str] = {}
+    for name, tag in volumes.items():
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(3, tag):
+            if int(entity) in owner:
+                raise _GmshError(
+                    f"the physical volumes '{owner[int(entity)]}' and '{name}' share volume "
+                    f"{int(entity)}: a cell can be in one region only"
+                )
+            owner[int(entity)] = name
 
 
 def _looks_like_gmsh(path: Path) -> None:

@@ -98,8 +98,6 @@ class State:
     dt_previous: float = 0.0  # s
     last: bool = False
     kinetic: float = 0.0  # K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} of the latest update, J
-    internal_work: float = 0.0  # of an internal force without stored energy, up to step n, J
-    step_correction: float = 0.0  # what a varying step took out of K + U, up to step n, J
     # The momentum booked at mid-step velocities up to step n, sum over steps of
     # dt^k/2 (P^{k-1/2} + P^{k+1/2}) with P = sum m v (first half only of step n), kg m:
     # what the work of uniform gravity needs.
@@ -133,7 +131,7 @@ class State:
             "v": self.v,
             "mass": self.mass,
             "clock": np.array([self.step, self.t, self.dt, self.dt_previous, self.last]),
-            "booked": np.array([self.kinetic, self.internal_work, self.step_correction]),
+            "booked": np.array([self.kinetic]),
             "momentum_integral": self.momentum_integral,
         }
 
@@ -143,7 +141,7 @@ class State:
         self.set_mass(slice(None), arrays["mass"])
         step, self.t, self.dt, self.dt_previous, last = arrays["clock"].tolist()
         self.step, self.last = int(step), bool(last)
-        self.kinetic, self.internal_work, self.step_correction = arrays["booked"].tolist()
+        (self.kinetic,) = arrays["booked"].tolist()
         self.momentum_integral[:] = arrays["momentum_integral"]
 
 
@@ -161,14 +159,21 @@ class InternalForce(Force, Protocol):
     ``energy_names`` are the energies it stores (``("internal",)``, and e.g. ``"hourglass"``),
     ``energy_parts`` parts of them reported beside them (e.g. ``"plastic_work"``);
     :meth:`energies` gives them all (J) on this rank's share of the body at step n.
-    ``nodal_force`` is the latest force (N, owned nodes); ``conservative`` says whether it
-    has a stored energy: if not, the update books its work in ``state.internal_work``.
+    ``nodal_force`` is the latest force (N, owned nodes). When ``books_work`` (a force
+    without a stored energy, or one with it and a varying step), the update sums its work
+    at mid-step velocities and hands the sums to :meth:`book`.
     """
 
     energy_names: tuple[str, ...]
     energy_parts: tuple[str, ...]
     conservative: bool
+    books_work: bool
     nodal_force: np.ndarray
+
+    def book(self, state: State, first: float, second: float) -> None:
+        """After the update of step n: sum f . v^{n-1/2} and sum f . v^{n+1/2} (W) of its
+        force on this rank's owned nodes."""
+        ...
 
     def energies(self, state: State) -> dict[str, float]: ...
 
@@ -223,65 +228,49 @@ class CentralDifference:
     """The update of a step in one compiled pass (``kernels/update.c``):
     v^{n+1/2} = v^{n-1/2} + dt^n a^n and u^{n+1} = u^n + dt^{n+1/2} v^{n+1/2}, booking on
     the way the shadow kinetic energy K^n in ``state.kinetic`` and the momentum integral in
-    ``state.momentum_integral``, and what the internal ``force`` (N, owned nodes) needs:
-
-    - a force without a stored energy (``stored`` False): its work at mid-step velocities
-      in ``state.internal_work`` (J, this rank: both halves of every step before n and the
-      first half of step n, as every work is booked);
-    - a force with one, when the step varies (``corrects``): ``state.step_correction``
-      (J), sum over steps of (dt^{k+1/2} - dt^{k-1/2})/4 f^k . (v^{k-1/2} - v^{k+1/2})
-      (the v^{n+1/2} half of step n at step n + 1), the energy the step's changes take
-      out of K^n + U(u^n): with it, a linear force's books close exactly whatever the
-      steps (``docs/theory.md``), and its opposite is booked as the step change's work.
+    ``state.momentum_integral``; when the ``internal`` force books its work, the pass sums
+    f . v^{n-1/2} and f . v^{n+1/2} (all owned nodes, and part by part after its
+    ``labels`` into its ``part_sums``) and hands them to its :meth:`~InternalForce.book`.
     """
 
-    def __init__(self, state: State, force: np.ndarray | None = None, *, stored: bool = False):
+    def __init__(self, state: State, internal=None):
         from rwall_fem.kernels import load
 
         ffi, lib = load()
         self._out = np.zeros(9)
-        self._done = 0.0  # work or correction of the finished steps, J
         self._integral = np.zeros(3)  # momentum integral of the finished steps, kg m
 
-        def ptr(array):
-            return ffi.cast("double *", array.ctypes.data) if array is not None else ffi.NULL
+        def ptr(array, kind="double *"):
+            return ffi.cast(kind, array.ctypes.data) if array is not None else ffi.NULL
 
         for name in ("u", "v", "a"):
             if not getattr(state, name).flags.c_contiguous:
                 raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
-        self._force = force is not None
-        self._stored = stored
-        self.corrects = stored and force is not None
+        books = internal is not None and getattr(internal, "books_work", False)
+        self._internal = internal if books else None
+        force = internal.nodal_force if books else None
+        labels = getattr(internal, "labels", None) if books else None
+        self._part_sums = internal.part_sums if labels is not None else None
         self._pass = functools.partial(lib.central_difference, len(state.mass))
         self._arrays = (
-            ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force), ptr(self._out)
+            ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force),
+            ptr(self._out), ptr(self._integral), ptr(state.momentum_integral),
+            ptr(labels, "int32_t *"), ptr(self._part_sums),
         )  # fmt: skip
 
     def __call__(self, state: State) -> None:
-        dt_v = state.dt_velocity
-        self._pass(dt_v, state.dt, *self._arrays)
-        kinetic, before, after = self._out[:3]
-        state.kinetic = kinetic
-        old, new = self._out[3:6], self._out[6:9]
-        state.momentum_integral[:] = self._integral + 0.5 * dt_v * old
-        self._integral += 0.5 * dt_v * (old + new)
-        if not self._force:
-            return
-        if self._stored:
-            change = 0.25 * (state.dt - (state.dt_previous or state.dt))
-            state.step_correction = self._done + change * before
-            self._done += change * (before - after)
-        else:
-            state.internal_work = self._done + 0.5 * dt_v * before
-            self._done += 0.5 * dt_v * (before + after)
+        if self._part_sums is not None:
+            self._part_sums[:] = 0.0
+        self._pass(state.dt_velocity, state.dt, *self._arrays)
+        state.kinetic = self._out[0]
+        if self._internal is not None:
+            self._internal.book(state, self._out[1], self._out[2])
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The booked work or correction (J) and momentum integral (kg m) of the finished
-        steps."""
-        return {"done": np.array(self._done), "integral": self._integral}
+        """The momentum integral of the finished steps (kg m)."""
+        return {"integral": self._integral}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
-        self._done = float(arrays["done"])
         self._integral[:] = arrays["integral"]
 
 
@@ -317,10 +306,9 @@ class Simulation:
             self.step_size = FixedStep(self.state.dt)
         if self.update is None:
             # A stored energy needs the step's correction only where the step varies.
-            stored = self.internal.conservative
-            needed = not stored or self.step_size.varies
-            force = self.internal.nodal_force if needed else None
-            self.update = CentralDifference(self.state, force, stored=stored)
+            if self.step_size.varies and hasattr(self.internal, "book"):
+                self.internal.books_work = True
+            self.update = CentralDifference(self.state, self.internal)
 
     @property
     def planned_steps(self) -> int:

@@ -99,7 +99,7 @@ class _StepSize:
     """What both step sizes share: the reduction of the kernels' estimates over the ranks,
     the inverted-cell stop, the records, and going on to the next step.
 
-    ``force`` is the body's :class:`~rwall_fem.elements.ElementForce` (None: no estimates,
+    ``force`` is the body's :class:`~rwall_fem.body.Body` (None: no estimates,
     a step given by the caller), its estimates calibrated by ``calibration`` (what its
     kernels apply); ``initial`` (s) is the step at the start.
     """
@@ -121,10 +121,14 @@ class _StepSize:
         of listed (mass-scaling) cells on a rank, from the latest kernel pass; after a pass
         that eroded cells on some rank, the nodes they held are counted again."""
         step = self.force.step
-        self._local[:] = (step[0], -step[5], -step[10], -step[11])
-        self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
+        if self.comm.size == 1:
+            smallest, inverted, listed, eroded = (float(step[0]), -float(step[5]),
+                                                  -float(step[10]), -float(step[11]))  # fmt: skip
+        else:
+            self._local[:] = (step[0], -step[5], -step[10], -step[11])
+            self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
+            smallest, inverted, listed, eroded = self._total.tolist()
         self._reductions += 1
-        smallest, inverted, listed, eroded = self._total.tolist()
         self.limit = smallest
         if inverted:
             self.stop_reason = self._inverted(s)
@@ -150,11 +154,11 @@ class _StepSize:
         step = self.force.step
         return step[2:5] if step[0] == smallest else None
 
-    def controlling_cell(self, describe: bool = False) -> tuple[float, list, str] | None:
-        """The calibrated estimate (s) of the cell that controls the step, where it is now
-        (m) and, if ``describe``, its state in words (collective, but a second call at the
-        same step, as from a recorder on rank 0 alone after the run log, reads the first's
-        answer); None without estimates."""
+    def controlling_cell(self, describe: bool = False) -> tuple | None:
+        """(the calibrated estimate (s) of the cell that controls the step, where it is now
+        (m), its state in words if ``describe``, its part's name for a body of parts or
+        None), collective; but a second call at the same step, as from a recorder on rank
+        0 alone after the run log, reads the first's answer. None without estimates."""
         key = (self._reductions, describe)
         if self._cell is not None and self._cell[0] == key:
             return self._cell[1]
@@ -163,9 +167,10 @@ class _StepSize:
         step = self.force.step
         held = None
         if step[0] == self.limit:
-            cell = int(step[1])
-            text = self.force.describe_cell(cell) if describe else ""
-            held = (self.force.cell_position(cell).tolist(), text)
+            cell, body = int(step[1]), self.force
+            text = body.describe_cell(cell) if describe else ""
+            part = body.parts[body.controlling_part].name if body.explicit else None
+            held = (body.cell_position(cell).tolist(), text, part)
         found = next((h for h in self.comm.allgather(held) if h is not None), None)
         answer = None if found is None else (self.limit, *found)
         self._cell = (key, answer)
@@ -321,8 +326,8 @@ class AdaptiveStep(_StepSize):
 
 
 def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bool = True):
-    """The step size of ``scene``'s ``[run]`` for the body's internal ``force`` (an
-    :class:`~rwall_fem.elements.ElementForce` on the space ``V``), whose exact stable
+    """The step size of ``scene``'s ``[run]`` for the body's internal ``force`` (a
+    :class:`~rwall_fem.body.Body` on the space ``V``), whose exact stable
     step at rest is ``dt_stable`` (s) and mass ``body_mass`` (kg); ``limits`` False lifts
     ``run.max_steps``. Raises :class:`~rwall_fem.scene.SceneError` for a ``run.dt`` above
     the stable limit, or a ``run.dt_min`` that would stop the run at its first step."""
@@ -330,10 +335,10 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
     from rwall_fem.scene import SceneError
 
     run, comm = scene.run, V.mesh.comm
-    ratio = force.calibrate(dt_stable)  # the exact limit over the estimate L / c, at rest
     fixed = run.time_step == "fixed"
-    if fixed:
-        force.params.calibration = ratio  # the limit at rest is the exact one
+    # The exact limit over the estimate L / c at rest; a fixed step's limit at rest is the
+    # exact one, an adaptive step's never more.
+    ratio = force.calibrate(dt_stable, cap=not fixed)
     at_rest = comm.allreduce(float(force.steps_at_rest().min(initial=math.inf)), op=MPI.MIN)
     if fixed:
         if run.dt is not None and run.dt > dt_stable:
@@ -344,23 +349,20 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
         dt = run.dt if run.dt is not None else round_down(run.dt_scale * dt_stable)
         if dt > at_rest:  # only the damped hourglass modes can be below the stiffness's limit
             raise SceneError(
-                f"{scene.source}: element.hourglass_coefficient: the viscous hourglass form at "
-                f"{force.params.hourglass_coefficient:g} damps its modes so much that they "
-                f"need a step of at most {at_rest:.4g} s, below the fixed step {dt:.4g} s; "
-                "lower the coefficient (LS-DYNA's QM is 0.1 by default) or use "
-                "run.time_step = 'adaptive', which takes it into account"
+                f"{scene.source}: element.hourglass_coefficient: the viscous hourglass form "
+                f"damps its modes so much that they need a step of at most {at_rest:.4g} s, "
+                f"below the fixed step {dt:.4g} s; lower the coefficient (LS-DYNA's QM is "
+                "0.1 by default) or use run.time_step = 'adaptive', which takes it into account"
             )
         step = FixedStep(dt, force, ratio, comm)
         step.at_rest = dt_stable / ratio
         return step
-    calibration = force.params.calibration
+    calibration = force.calibration
     initial = round_down(run.dt_scale * at_rest)
     mass_scaling = None
     if run.dt_min_action == "mass_scaling":
-        mass_scaling = MassScaling(
-            force, V, scene.material.density, body_mass, run.max_added_mass,
-            run.dt_min / run.dt_scale,
-        )  # fmt: skip
+        floor = run.dt_min / run.dt_scale
+        mass_scaling = MassScaling(force, V, body_mass, run.max_added_mass, floor)
     elif run.dt_min > initial:
         outcome = "erode every cell" if run.dt_min_action == "erode" else "stop"
         raise SceneError(

@@ -181,6 +181,22 @@ class Probe:
         self.distances = np.array(self.distances)
 
 
+class StopAt:
+    """Recorder that, at ``step``, asks the run to stop as SIGTERM does."""
+
+    def __init__(self, step):
+        self.step = step
+
+    def due(self, s):
+        return s.step == self.step
+
+    def record(self, sim, s):
+        sim.stop_requests.add("SIGTERM")
+
+    def close(self, sim):
+        pass
+
+
 def run_probed(raw, directory, comm=MPI.COMM_WORLD):
     """Like :func:`run`, with a :class:`Probe` attached; returns (simulation, probe)."""
     sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, directory)

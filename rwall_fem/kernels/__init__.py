@@ -1,7 +1,8 @@
 """Compiled element kernels: C compiled at first use through cffi and cached.
 
 The C sources beside this file (one per element family, with the formulas in
-their header comments) are compiled into one extension module the first time a
+their header comments; ``update.c`` and ``wall.c`` for the per-node passes of a step,
+the update and the rigid walls) are compiled into one extension module the first time a
 process needs them, the way FFCx compiles forms, and cached per user under
 ``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
 ``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
@@ -51,7 +52,8 @@ __all__ = [
 log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
-           "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c")  # fmt: skip
+           "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
+           "wall.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -95,6 +97,8 @@ typedef struct {
   double *cell_work;
   int64_t cell_stride;
   const double *velocity;
+  const int32_t *interface;
+  double *interface_force;
 } element_params;
 double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);
@@ -118,7 +122,31 @@ void hex8_cell_sizes(int64_t n, const int32_t *cells, const double *x, double *v
     + """
 void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
 void central_difference(int64_t n, double dt_v, double dt, const double *mass, const double *a,
-                        double *v, double *u, const double *f, double out[9]);
+                        double *v, double *u, const double *f, double out[9],
+                        double integral[3], double momentum[3], const int32_t *labels,
+                        double *part_sums);
+typedef struct {
+  int kind;
+  double point[3], normal[3], dual[6], widths[2], axis[3], radius, fallback[3];
+} wall_shape;
+double numpy_sum(int64_t n, const double *a);
+int64_t wall_find(int64_t n, const int64_t *near, const double *X, const double *u,
+                  const double *v, const double *a, const double *mass, double dt_v, double dt,
+                  const wall_shape *s, const double offset[3], const double next[3],
+                  const double velocity[3], int64_t *hits, int64_t *nodes, double *m,
+                  double *normals, double *vs, double *v_old, double *target);
+void wall_impulses(int64_t k, int slide, double friction, double alpha, const double *m,
+                   const double *n, const double *vs, const double velocity[3],
+                   const double *target, const double *kept, double *normal,
+                   double *tangential, uint8_t *slip);
+double wall_work(int64_t k, const int64_t *nodes, const double *impulse, const double *v,
+                 const double velocity[3], double *scratch);
+void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
+                const double *tangential, double dt_v, double *a, double out[9]);
+double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const double *u,
+                      const wall_shape *s, const double offset[3], double *clearance);
+void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
+                        double out[2]);
 """
     + "".join(
         f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"

@@ -121,6 +121,7 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
       erode(p, failed, &b, energy_left(w, du, fe, 8), VZERO, VZERO, fe, 8, energy, step);
     }
     scatter_add(cells, 8, &b, fe, f);
+    note_interface(p, &b, 8, fe);
     total += lane_sum(vselect(failed, VZERO, w), b.nb);
     note_inverted(inverted & ~failed, &b, x, ue, 8, step);
     if (p->estimate)
@@ -226,6 +227,7 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
             VZERO, fe, 8, energy, step);
     }
     scatter_add(cells, 8, &b, fe, f);
+    note_interface(p, &b, 8, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
     if (p->estimate)

@@ -315,6 +315,7 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
             energy, step);
     }
     scatter_add(cells, 8, &b, fe, f);
+    note_interface(p, &b, 8, fe);
     total += lane_sum(vselect(failed, VZERO, stored), b.nb);
     hourglass_total += lane_sum(
         hourglass == HOURGLASS_VISCOUS ? hourglass_energy : vselect(failed, VZERO, hourglass_energy),
@@ -432,6 +433,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
             plastic_total, hourglass_total, fe, 8, energy, step);
     }
     scatter_add(cells, 8, &b, fe, f);
+    note_interface(p, &b, 8, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
     if (p->estimate)

@@ -99,6 +99,7 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
       erode(p, failed, &b, energy_left(w, du, fe, 4), VZERO, VZERO, fe, 4, energy, step);
     }
     scatter_add(cells, 4, &b, fe, f);
+    note_interface(p, &b, 4, fe);
     total += lane_sum(vselect(failed, VZERO, w), b.nb);
     note_inverted(inverted & ~failed, &b, x, ue, 4, step);
     if (p->estimate)
@@ -165,6 +166,7 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
             VZERO, fe, 4, energy, step);
     }
     scatter_add(cells, 4, &b, fe, f);
+    note_interface(p, &b, 4, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
     if (p->estimate)

@@ -9,8 +9,13 @@
  *   out[0] = K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2}   (the shadow kinetic energy)
  *   out[1] = sum f . v^{n-1/2}, out[2] = sum f . v^{n+1/2}   (when f is given)
  *   out[3..5] = sum m v^{n-1/2}, out[6..8] = sum m v^{n+1/2}   (the work of uniform gravity)
+ * and the momentum integral (kg m) of uniform gravity's work: with `integral` that of the
+ * finished steps, momentum = integral + dt^n/2 out[3..5] (up to the first half of this
+ * step), then integral += dt^n/2 (out[3..5] + out[6..8]);
  * (out[1] and out[2]: the mid-step booking of the internal work of materials without a
- * stored energy, and the energy correction of a varying step for the others).
+ * stored energy, and the energy correction of a varying step for the others); with
+ * labels (a part per node, -1 at the interfaces of parts), the same two sums per part
+ * over the nodes of that part alone, in part_sums[2 part] and part_sums[2 part + 1].
  */
 #include "batch.h"
 
@@ -32,9 +37,11 @@ void internal_acceleration(int64_t n, const double *restrict f, const double *re
 INLINE void advance_node(int64_t i, double dt_v, double dt, const double *restrict mass,
                          const double *restrict a, double *restrict v, double *restrict u,
                          const double *restrict f, double *kinetic, double *first,
-                         double *second, double before[3], double after[3])
+                         double *second, double before[3], double after[3],
+                         const int32_t *restrict labels, double *restrict part_sums)
 {
   const double m = mass[i];
+  double mine[2] = {0.0, 0.0};
   for (int c = 0; c < 3; ++c)
   {
     const int64_t j = 3 * i + c;
@@ -42,34 +49,55 @@ INLINE void advance_node(int64_t i, double dt_v, double dt, const double *restri
     *kinetic += m * old * next;
     if (f)
     {
-      *first += f[j] * old;
-      *second += f[j] * next;
+      mine[0] += f[j] * old;
+      mine[1] += f[j] * next;
     }
     before[c] += m * old;
     after[c] += m * next;
     v[j] = next;
     u[j] += dt * next;
   }
+  if (f)
+  {
+    *first += mine[0];
+    *second += mine[1];
+    if (labels && labels[i] >= 0)
+    {
+      part_sums[2 * labels[i]] += mine[0];
+      part_sums[2 * labels[i] + 1] += mine[1];
+    }
+  }
 }
 
 void central_difference(int64_t n, double dt_v, double dt, const double *restrict mass,
                         const double *restrict a, double *restrict v, double *restrict u,
-                        const double *restrict f, double out[9])
+                        const double *restrict f, double out[9], double integral[3],
+                        double momentum[3], const int32_t *restrict labels,
+                        double *restrict part_sums)
 {
   double kinetic = 0.0, first = 0.0, second = 0.0, before[3] = {0.0, 0.0, 0.0},
          after[3] = {0.0, 0.0, 0.0};
-  if (f)
+  if (f && labels)
     for (int64_t i = 0; i < n; ++i)
-      advance_node(i, dt_v, dt, mass, a, v, u, f, &kinetic, &first, &second, before, after);
+      advance_node(i, dt_v, dt, mass, a, v, u, f, &kinetic, &first, &second, before, after,
+                   labels, part_sums);
+  else if (f)
+    for (int64_t i = 0; i < n; ++i)
+      advance_node(i, dt_v, dt, mass, a, v, u, f, &kinetic, &first, &second, before, after,
+                   NULL, NULL);
   else
     for (int64_t i = 0; i < n; ++i)
-      advance_node(i, dt_v, dt, mass, a, v, u, NULL, &kinetic, &first, &second, before, after);
+      advance_node(i, dt_v, dt, mass, a, v, u, NULL, &kinetic, &first, &second, before, after,
+                   NULL, NULL);
   out[0] = 0.5 * kinetic;
   out[1] = first;
   out[2] = second;
+  const double half = 0.5 * dt_v;
   for (int c = 0; c < 3; ++c)
   {
     out[3 + c] = before[c];
     out[6 + c] = after[c];
+    momentum[c] = integral[c] + half * before[c];
+    integral[c] += half * (before[c] + after[c]);
   }
 }

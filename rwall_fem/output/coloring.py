@@ -1,7 +1,8 @@
 """What colours the body in the frames: the values, their colour range, unit and labels.
 
-The body is coloured by a nodal quantity (:data:`COLORS`) or by a cell field
-the run stored (e.g. ``plastic_strain``). One range serves every frame and
+The body is coloured by a nodal quantity (:data:`COLORS`), by a cell field
+the run stored (e.g. ``plastic_strain``), or by part (``part``: one colour per
+part of a body of ``[[part]]``, labelled with their names). One range serves every frame and
 fits the scene: a nodal quantity spans the 95th percentile of its magnitude
 over all nodes and frames (the spikes at a wave front or under a ball
 saturate, the bulk of the motion spans the range), velocities at least the
@@ -31,6 +32,11 @@ CELL_FIELDS = {
     "von_mises_stress": ("von Mises stress", "Pa"),
     "damage": ("damage D", ""),
 }
+# The colours of the parts (matplotlib's "tab10"), in the order of the parts, cycled.
+PART_COLORS = (
+    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
+)  # fmt: skip
 # Unit prefixes: (size of the unit in SI, name), largest first.
 PREFIXES = {
     "m": ((1.0, "m"), (1e-3, "mm"), (1e-6, "µm")),
@@ -46,25 +52,42 @@ HALF_INTERVALS = {1.0: 2, 1.2: 2, 1.5: 3, 2.0: 2, 3.0: 3, 4.0: 2, 5.0: 2, 6.0: 3
 @dataclass(frozen=True)
 class Coloring:
     """How the body is coloured: ``values`` per frame (in ``title``'s unit) on the points or
-    (``per_cell``) the cells, the colour range ``clim`` and map ``cmap``, and the colour
-    bar's ``n_labels`` labels written with ``fmt``."""
+    (``per_cell``) the cells, the colour range ``clim`` and map ``cmap`` (a name, or the
+    list of the colours of categories), and the colour bar's ``n_labels`` labels written
+    with ``fmt``, or for categories their ``names``, one under each colour."""
 
     title: str
     per_cell: bool
     values: list[np.ndarray]
     clim: tuple[float, float]
-    cmap: str
+    cmap: str | list[str]
     n_labels: int
     fmt: str
+    names: tuple[str, ...] = ()
 
 
-def coloring(color: str, frames: list[dict], points, walls, up, speed: float) -> Coloring:
-    """The colouring ``color`` (one of :data:`COLORS` or a stored cell field) of the
-    ``frames`` (dicts with ``u``, ``v`` (m, m/s), ``offsets`` and ``cell_<name>``) of a
-    body at ``points`` (m), with its ``walls`` (shapes), ``up`` and initial ``speed`` (m/s).
+def coloring(
+    color: str, frames: list[dict], points, walls, up, speed: float, parts: tuple[str, ...] = ()
+) -> Coloring:
+    """The colouring ``color`` (one of :data:`COLORS`, a stored cell field, or ``part``) of
+    the ``frames`` (dicts with ``u``, ``v`` (m, m/s), ``offsets`` and ``cell_<name>``) of a
+    body at ``points`` (m), with its ``walls`` (shapes), ``up``, initial ``speed`` (m/s)
+    and the names of its ``parts`` (a body of ``[[part]]``).
 
     Raises ValueError (one line) for a colouring that the frames cannot give.
     """
+    if color == "part" and parts and "cell_part" in frames[0]:
+        count = len(parts)
+        return Coloring(
+            title="part",
+            per_cell=True,
+            values=[f["cell_part"] for f in frames],
+            clim=(-0.5, count - 0.5),
+            cmap=[PART_COLORS[k % len(PART_COLORS)] for k in range(count)],
+            n_labels=count,
+            fmt="",
+            names=tuple(parts),
+        )
     if color in COLORS:
         values = [_nodal(color, f, points, walls, up) for f in frames]
         if color == "normal_velocity":

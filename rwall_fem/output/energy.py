@@ -22,16 +22,21 @@ report print: the total energy (the sum of the stored energies), the balance err
 percent, and the time step of that step (s); with mass scaling also the mass added so
 far (kg and % of the body's), and its work (``mass_scaling_work``: the kinetic energy
 the added masses cost when they joined their nodes at rest); when cells may erode, how many
-have (``eroded_cells``).
+have (``eroded_cells``); for a body of ``[[part]]`` each part's energies as LS-DYNA's
+MATSUM prints them (``<part>.kinetic``, ``<part>.internal``, ``<part>.hourglass``,
+``<part>.plastic_work``; the body's, walls and eroded energies aside, are their sums).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 __all__ = ["EnergyBalance", "initial_kinetic_energy"]
+
+TINY = float(np.finfo(float).tiny)  # the smallest normal double: E_ref is never below it
 
 
 def initial_kinetic_energy(state, walls, comm) -> float:
@@ -69,25 +74,26 @@ class EnergyBalance:
         self.initial = initial  # E0, J
         self.reference = initial  # E_ref so far, J
         self.max_error = 0.0  # largest finite |balance error| so far
-        self.latest: dict[str, float] | None = None  # the latest sample, by column
+        self.error: float | None = None  # balance error of the latest sample (None: none yet)
+        self._row: tuple | None = None  # the latest sample
 
     @property
-    def error(self) -> float | None:
-        """Balance error of the latest sample (None before the first)."""
-        return None if self.latest is None else self.latest["balance_error"]
+    def latest(self) -> dict[str, float] | None:
+        """The latest sample, by column (None before the first)."""
+        return None if self._row is None else dict(zip(self.columns, self._row, strict=True))
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """E0, E_ref and the largest error so far, and the latest sample (empty: none)."""
-        latest = () if self.latest is None else tuple(self.latest.values())
         return {
             "books": np.array([self.initial, self.reference, self.max_error]),
-            "latest": np.array(latest, dtype=float),
+            "latest": np.array(self._row or (), dtype=float),
         }
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self.initial, self.reference, self.max_error = arrays["books"].tolist()
-        latest = arrays["latest"].tolist()
-        self.latest = dict(zip(self.columns, latest, strict=True)) if latest else None
+        latest = tuple(arrays["latest"].tolist())
+        self._row = latest or None
+        self.error = self.latest["balance_error"] if latest else None
 
     def sample(
         self, t: float, energies: Mapping[str, float], dt: float, extras: Mapping | None = None
@@ -99,12 +105,12 @@ class EnergyBalance:
         balance = stored
         for name in self.works:
             balance -= energies[name]
-        error = (balance - self.initial) / max(self.reference, np.finfo(float).tiny)
-        if np.isfinite(error):  # a NaN or Inf step says nothing of the balance before it
+        error = (balance - self.initial) / max(self.reference, TINY)
+        if math.isfinite(error):  # a NaN or Inf step says nothing of the balance before it
             self.max_error = max(self.max_error, abs(error))
         row = (
             t, *(energies[name] for name in (*self.stored, *self.parts, *self.works)), error,
             stored, 100.0 * error, dt, *((extras or {})[name] for name in self.extras),
         )  # fmt: skip
-        self.latest = dict(zip(self.columns, row, strict=True))
+        self.error, self._row = error, row
         return row

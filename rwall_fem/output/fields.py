@@ -2,10 +2,10 @@
 
 Each snapshot holds the displacement (m) and the velocity (m/s) at the nodes
 and every cell field of the internal force (``sim.internal.cell_fields``, e.g.
-the equivalent plastic strain) as piecewise constants (DG0). Unless the
-internal force gives a ``von_mises_stress``, the von Mises stress (Pa) is
+the equivalent plastic strain, and the part of each cell of a body of parts) as
+piecewise constants (DG0). The von Mises stress (Pa) of the elastic parts is
 computed here from the Cauchy stress: Hooke's law for linear elasticity,
-sigma = P F^T / J for the hyperelastic models.
+sigma = P F^T / J for the hyperelastic models; the elasto-plastic parts give theirs.
 
 DOLFINx writes the data collectively (XDMF with HDF5), so parallel runs give
 one file; its XML, though, holds one time series per function, and DOLFINx
@@ -46,10 +46,11 @@ DOLFINX_POINTER = (
 
 
 class Fields:
-    """Recorder that writes ``count`` field snapshots of the body (space ``V``) at times
-    spread evenly over [0, ``end_time``] (s), into ``directory``."""
+    """Recorder that writes ``count`` field snapshots of the body (space ``V``, its
+    ``parts``: :class:`~rwall_fem.body.Part`) at times spread evenly over
+    [0, ``end_time``] (s), into ``directory``."""
 
-    def __init__(self, directory: Path, *, count: int, end_time: float, V, material):
+    def __init__(self, directory: Path, *, count: int, end_time: float, V, parts):
         self.steps = Times(count, end_time)
         self.path = Path(directory) / "fields.xdmf"
         msh = V.mesh
@@ -58,7 +59,12 @@ class Fields:
         self._Q = _compat.scalar_space(msh)
         num_cells = msh.topology.index_map(msh.topology.dim).size_local
         self._cell_dofs = _compat.cell_nodes(self._Q)[:num_cells, 0]  # owned cell -> DG0 dof
-        self._material, self._mises = material, None  # compiled at its first use
+        # The elastic parts' von Mises stress, from the displacement: (cells' DG0 dofs,
+        # its expression, compiled at its first use) per part.
+        self._elastic = [(self._cell_dofs[p.cells], p.material) for p in parts
+                         if not p.material.plastic]  # fmt: skip
+        self._mises: list | None = None
+        self._scratch = None
         self._cells: dict[str, fem.Function] = {}
         self._file = None
         self._count = 0  # snapshots recorded
@@ -84,16 +90,26 @@ class Fields:
             field.x.array[: values.size] = values.ravel()
             field.x.scatter_forward()
         cell_fields = sim.internal.cell_fields(s)
-        if "von_mises_stress" not in cell_fields:
-            if self._mises is None:
-                self._mises = _compat.expression(_von_mises(self.u, self._material), self._Q)
-            self._cell_function("von_mises_stress").interpolate(self._mises)
         for name, values in cell_fields.items():
             field = self._cell_function(name)
             field.x.array[self._cell_dofs] = values
             field.x.scatter_forward()
+        if self._elastic:
+            self._elastic_mises()
         for field in (self.u, self.v, *self._cells.values()):
             self._file.write_function(field, s.t)
+
+    def _elastic_mises(self) -> None:
+        """The von Mises stress of the elastic parts' cells, from the displacement."""
+        if self._mises is None:
+            self._mises = [_compat.expression(_von_mises(self.u, m), self._Q)
+                           for _, m in self._elastic]  # fmt: skip
+            self._scratch = fem.Function(self._Q)
+        field = self._cell_function("von_mises_stress")
+        for (dofs, _), expression in zip(self._elastic, self._mises, strict=True):
+            self._scratch.interpolate(expression)
+            field.x.array[dofs] = self._scratch.x.array[dofs]
+        field.x.scatter_forward()
 
     def _cell_function(self, name: str) -> fem.Function:
         """The DG0 function that holds the cell field ``name``, made at its first use."""

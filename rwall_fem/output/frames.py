@@ -36,7 +36,8 @@ class Frames:
 
     ``speed`` (m/s), the initial speed, is the least colour range of the velocity
     colourings; ``gravity`` (m/s^2, or None) says where up is; ``color`` is one of
-    :data:`rwall_fem.output.coloring.COLORS` or a cell field of the internal force.
+    :data:`rwall_fem.output.coloring.COLORS` or a cell field of the internal force;
+    ``parts``, the names of the parts of a body of ``[[part]]`` (the ``part`` colouring).
     """
 
     def __init__(
@@ -50,12 +51,13 @@ class Frames:
         speed: float,
         gravity=None,
         color: str = "normal_velocity",
+        parts: tuple[str, ...] = (),
     ):
         self.steps = Times(count, end_time)
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
-        self.walls, self.color = walls, color
+        self.walls, self.color, self.parts = walls, color, tuple(parts)
         self._field = fem.Function(V)
         self._count = 0
         self._failed = False  # a frame could not be written (rank 0): no more are
@@ -112,6 +114,7 @@ class Frames:
             speed=self._speed,
             gravity=self._gravity,
             walls=json.dumps(walls_info),
+            **({"parts": json.dumps(self.parts)} if self.parts else {}),
         )
 
     def record(self, sim, s) -> None:

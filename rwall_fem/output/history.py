@@ -31,7 +31,7 @@ import numpy as np
 
 from rwall_fem import interrupts
 from rwall_fem.output import OutputError
-from rwall_fem.output.energy import EnergyBalance, initial_kinetic_energy
+from rwall_fem.output.energy import TINY, EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every
 from rwall_fem.output.summary import momentum, run_summary, write_summary
@@ -64,17 +64,21 @@ class History:
         self.mass_scaling = getattr(sim.step_size, "mass_scaling", None)
         scaled = self.mass_scaling is not None
         self.erosion = getattr(sim.internal, "erosion", None)  # cells that may erode
-        self.step_changes = sim.update.corrects  # a stored energy with a varying step
+        self.step_changes = getattr(sim.internal, "corrects", False)  # a varying step's
         works = ["external_work", "wall_work"]
         works += ["mass_scaling_work"] if scaled else []
         works += ["step_change_work"] if self.step_changes else []
+        # A body of [[part]]s: the energies of each part, which add up to the body's.
+        explicit = getattr(sim.internal, "explicit", False)
+        self.part_columns = sim.internal.part_columns() if explicit else ()
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm),
             stored=("kinetic", *sim.internal.energy_names),
             parts=sim.internal.energy_parts,
             works=works,
             extras=(("added_mass", "added_mass_percent") if scaled else ())
-            + (("eroded_cells",) if self.erosion is not None else ()),
+            + (("eroded_cells",) if self.erosion is not None else ())
+            + self.part_columns,
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
@@ -86,7 +90,7 @@ class History:
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
-            | {"step_change_work": (), "eroded_cells": ()}
+            | {"step_change_work": (), "eroded_cells": (), "parts": (len(self.part_columns),)}
             | {"signals": (len(SIGNALS),), "seconds": (), "failed": ()}
             | self.wall_table.sums,
         )
@@ -124,9 +128,12 @@ class History:
             local["wall_work"][i] = w.normal_work, w.friction_work
         if self.mass_scaling is not None:
             local["mass_scaling_work"][...] = self.mass_scaling.work
-        local["step_change_work"][...] = -s.step_correction
+        if self.step_changes:
+            local["step_change_work"][...] = sim.internal.step_change_work()
         if self.erosion is not None:
             local["eroded_cells"][...] = self.erosion.count
+        if self.part_columns:
+            local["parts"][:] = sim.internal.part_values(s)
         # Sent with the sums, so that every rank stops at the same step when any got a signal.
         self._fill_agreement(local, sim)
         self.wall_table.fill(local)
@@ -143,12 +150,12 @@ class History:
                 energies["kinetic"] += kinetic
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
-        extras = {}
+        extras = dict(zip(self.part_columns, total["parts"].tolist(), strict=True))
         if self.step_changes:
             energies["step_change_work"] = float(total["step_change_work"])
         if self.mass_scaling is not None:
             energies["mass_scaling_work"] = float(total["mass_scaling_work"])
-            extras = {
+            extras |= {
                 "added_mass": self.mass_scaling.added,
                 "added_mass_percent": self.mass_scaling.added_percent,
             }
@@ -163,8 +170,7 @@ class History:
             self.balance.error,
             finite=self._sums.finite(),
             signals=signals,
-            step_work=energies.get("step_change_work", 0.0)
-            / max(self.balance.reference, np.finfo(float).tiny),
+            step_work=energies.get("step_change_work", 0.0) / max(self.balance.reference, TINY),
         )
 
     def _fill_agreement(self, local: dict, sim) -> None:

@@ -57,7 +57,8 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     points = mesh["points"]
     up = up_direction(mesh.get("gravity"), walls)
     try:
-        paint = coloring(color, frames, points, walls, up, float(mesh["speed"]))
+        parts = tuple(json.loads(str(mesh["parts"]))) if "parts" in mesh else ()
+        paint = coloring(color, frames, points, walls, up, float(mesh["speed"]), parts)
     except ValueError as err:
         raise RenderError(str(err)) from None
     body = np.concatenate([points + f["u"] for f in frames])
@@ -89,6 +90,7 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
                 scalars=paint.title,
                 clim=paint.clim,
                 cmap=paint.cmap,
+                n_colors=len(paint.names) or 256,
                 show_edges=edges,
                 edge_color="#404040",
                 line_width=0.5,
@@ -208,9 +210,13 @@ def _colour_bar(plotter, paint) -> None:
     plotter.scalar_bar.SetBarRatio(1.0)  # the bar fills its box
     (left, bottom), width = np.multiply(BAR[:2], WINDOW), BAR[2] * WINDOW[0]
     (low, high), n = paint.clim, paint.n_labels
-    for i in range(n):
-        value = low + (high - low) * i / (n - 1) + 0.0  # + 0.0: no "-0"
-        _centred_text(plotter, paint.fmt % value, left + width * i / (n - 1), bottom - 20, 10)
+    if paint.names:  # categories: each name under the middle of its colour
+        labels = [(name, (i + 0.5) / n) for i, name in enumerate(paint.names)]
+    else:  # + 0.0: no "-0"
+        labels = [(paint.fmt % (low + (high - low) * i / (n - 1) + 0.0), i / (n - 1))
+                  for i in range(n)]  # fmt: skip
+    for text, at in labels:
+        _centred_text(plotter, text, left + width * at, bottom - 20, 10)
     _centred_text(plotter, paint.title, WINDOW[0] / 2, bottom + BAR[3] * WINDOW[1] + 6, 11)
 
 
@@ -251,8 +257,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--color",
         default=COLORS[0],
-        help=f"{', '.join(COLORS)}, or a cell field of the body such as plastic_strain "
-        f"(default {COLORS[0]})",
+        help=f"{', '.join(COLORS)}, a cell field of the body such as plastic_strain, or part "
+        f"(a body of parts) (default {COLORS[0]})",
     )
     args = parser.parse_args(argv)
     with interrupts.handling() as say:

@@ -50,7 +50,8 @@ def _cycle_line(sim, s, elapsed: float) -> str:
     if cell is None:
         return line
     where = ", ".join(f"{c:.4g}" for c in cell[1])
-    return f"{line} {cell[0]:>11.4e}  at ({where}) m"
+    part = f" in part {cell[3]}" if cell[3] else ""
+    return f"{line} {cell[0]:>11.4e}  at ({where}) m{part}"
 
 
 class CycleLines:

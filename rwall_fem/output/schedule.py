@@ -1,7 +1,7 @@
 """When a recorder samples: every k-th step, or at times spread over the run.
 
 The step varies, so outputs asked for at times are written at the first step at or after
-each time (Radioss's /ANIM/DT, LS-DYNA's ``*DATABASE`` intervals), the last one at the run's
+each time (Radioss's ``/ANIM/DT``, LS-DYNA's ``*DATABASE`` intervals), the last one at the run's
 last step; outputs never change the steps.
 """
 

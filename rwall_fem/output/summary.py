@@ -9,9 +9,11 @@ reached (s) and ``end_time``, ``dt`` (the last step, s) and ``time_step``: the s
 mode, calibration, first, smallest and largest steps (s), where and when the smallest
 was, and with mass scaling the mass added (kg and %) and its work (J),
 the energies of the last sample, when cells can erode how many did and the nodes they
-left detached (``erosion``), and per wall its impulses, works, contacts and the
-secondary nodes that started behind it (``initially_penetrated``, ``deepest_penetration``
-in m: kept there by the wall, as Radioss's starter warns).
+left detached (``erosion``), for a body of ``[[part]]`` each part's (``parts``: its
+material, cells, mass, momentum, energies, largest plastic strain and deformed bounds),
+and per wall its impulses, works, contacts and the secondary nodes that started behind
+it (``initially_penetrated``, ``deepest_penetration`` in m: kept there by the wall, as
+Radioss's starter warns).
 """
 
 from __future__ import annotations
@@ -74,6 +76,7 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         "deformed_bounds": deformed_bounds(s, comm),
         **_plasticity(sim.internal, comm),
         **_erosion(sim.internal, comm),
+        **_parts(sim, latest, comm),
         "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
         "boundaries": [
             {
@@ -120,10 +123,47 @@ def _erosion(internal, comm) -> dict:
         "eroded_cells": comm.allreduce(erosion.count),
         "detached_nodes": comm.allreduce(len(erosion.detached)),
     }
-    if internal.failure is not None:
-        damage = internal.damage[:, erosion.alive]
-        entry["max_damage"] = comm.allreduce(float(damage.max(initial=0.0)), MPI.MAX)
+    damage = erosion.largest_damage()
+    if damage is not None:
+        entry["max_damage"] = comm.allreduce(damage, MPI.MAX)
     return {"erosion": entry}
+
+
+def _parts(sim, latest: dict, comm) -> dict:
+    """``parts``: for a body of ``[[part]]``, each part's material, cells, mass (kg),
+    momentum (kg m/s), energies of the last sample (J), largest plastic strain and the
+    bounds (m) of its nodes at the latest step; nothing for a body of one part."""
+    body = sim.internal
+    if not getattr(body, "explicit", False):
+        return {}
+    s = sim.state
+    momenta = comm.allreduce(body.part_momenta(s))
+    owned = len(s.mass)
+    x = s.X + s.u - s.dt * s.v  # u^n: as deformed_bounds
+    entries = []
+    for k, (part, force) in enumerate(zip(body.parts, body.elements, strict=True)):
+        held = body.held[:owned, k] > 0
+        low, high = np.empty(3), np.empty(3)
+        comm.Allreduce(x[held].min(axis=0, initial=np.inf), low, op=MPI.MIN)
+        comm.Allreduce(x[held].max(axis=0, initial=-np.inf), high, op=MPI.MAX)
+        prefix = f"{part.name}."
+        entry = {
+            "name": part.name,
+            "material": part.material.model,
+            "cells": comm.allreduce(len(part.cells)),
+            "mass": comm.allreduce(float(body.part_masses[:, k].sum())),
+            "momentum": momenta[k].tolist(),
+            "energy": {
+                name.removeprefix(prefix): value
+                for name, value in latest.items()
+                if name.startswith(prefix)
+            },
+        }
+        if force.plastic:
+            strain = float(force.plastic_strains().max(initial=0.0))
+            entry["max_plastic_strain"] = comm.allreduce(strain, MPI.MAX)
+        entries.append(entry | {"deformed_bounds": [low.tolist(), high.tolist()]})
+    return {"parts": entries}
 
 
 def _wall(w, peak_contacts: int, comm) -> dict:

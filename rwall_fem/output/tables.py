@@ -1,16 +1,17 @@
 """CSV files that stream to disk and that a killed run leaves readable.
 
-Rank 0 turns each row into its line as it comes and keeps at most ``PENDING_LINES``
-lines (or what :meth:`CsvTable.flush` has not yet written): memory stays flat
-however long the run. The pending lines go to the file in one write followed by a
-flush, so the file only ever holds whole lines. Other ranks keep nothing (the rows
-are sums over ranks, the same everywhere). A resumed run keeps the rows up to its
-checkpoint (:meth:`CsvTable.resume`).
+Rank 0 keeps the rows as they come, at most ``PENDING_LINES`` of them (or what
+:meth:`CsvTable.flush` has not yet written): memory stays flat however long the run.
+The pending rows are turned into lines together (one ``repr`` of them all) and go to
+the file in one write followed by a flush, so the file only ever holds whole lines.
+Other ranks keep nothing (the rows are sums over ranks, the same everywhere). A resumed
+run keeps the rows up to its checkpoint (:meth:`CsvTable.resume`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,7 +22,7 @@ from rwall_fem.output import OutputError
 
 __all__ = ["PENDING_LINES", "CsvTable"]
 
-PENDING_LINES = 1000  # lines kept before they are written, whatever the time since the last
+PENDING_LINES = 1000  # rows kept before they are written, whatever the time since the last
 
 
 class CsvTable:
@@ -36,12 +37,12 @@ class CsvTable:
         self._closed = False
 
     def append(self, row: Sequence) -> None:
-        """Add a row (numbers); it is written at the next :meth:`flush`, or now when
-        ``PENDING_LINES`` lines are waiting."""
+        """Add a row (numbers: integers are written as such, others as floats); it is
+        written at the next :meth:`flush`, or now when ``PENDING_LINES`` rows are waiting."""
         self.count += 1
         if self.comm.rank != 0:
             return
-        self._pending.append(_line(row))
+        self._pending.append(row)
         if len(self._pending) >= PENDING_LINES:
             with contextlib.suppress(OutputError):  # kept in :attr:`error`
                 self.flush()
@@ -64,7 +65,7 @@ class CsvTable:
                 self._file.write(",".join(self.columns) + "\n")
                 self._file.flush()
             whole = self._file.tell()
-            self._file.write("".join(self._pending))
+            self._file.write(_lines(self._pending))
             self._file.flush()
         except OSError as err:
             self._give_up(whole)
@@ -163,7 +164,13 @@ def _number(text: str) -> int | float:
     return int(text) if text.lstrip("-").isdigit() else float(text)
 
 
-def _line(row) -> str:
-    """A CSV line of the numbers in ``row``: integers as such, floats as their shortest
-    exact decimal."""
-    return ",".join(repr(x) if isinstance(x, int) else repr(float(x)) for x in row) + "\n"
+def _lines(rows: list[Sequence]) -> str:
+    """The CSV lines of ``rows`` of numbers: integers as such, floats as their shortest
+    exact decimal (``repr``). Rows of Python ints and floats alone, as the history
+    makes them, are turned into text by one ``repr`` of them all."""
+    if not rows:
+        return ""
+    rows = [list(row) for row in rows]
+    if not set(map(type, itertools.chain.from_iterable(rows))) <= {int, float}:
+        rows = [[x if isinstance(x, int) else float(x) for x in row] for row in rows]
+    return repr(rows)[2:-2].replace("], [", "\n").replace(", ", ",") + "\n"

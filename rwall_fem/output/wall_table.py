@@ -36,7 +36,8 @@ class WallTable:
     def __init__(self, walls):
         self.walls = walls
         n = len(walls)
-        self.sums = {"normal_impulse": (n, 3), "tangential_impulse": (n, 3), "contacts": (n,)}
+        # Per wall: the normal and the tangential impulse (N s), and the contacts.
+        self.sums = {"impulses": (n, 6), "contacts": (n,)}
         self.peak_contacts = np.zeros(n, dtype=int)  # most nodes treated in one step
         self._last_impulses = np.zeros((n, 6))  # normal and tangential, N s
         self._last_time = None  # s
@@ -60,27 +61,34 @@ class WallTable:
     def fill(self, local: dict) -> None:
         """Write this rank's impulses (N s) and contact counts into the ``local`` sums."""
         for i, w in enumerate(self.walls):
-            local["normal_impulse"][i] = w.normal_impulse
-            local["tangential_impulse"][i] = w.tangential_impulse
+            local["impulses"][i, :3] = w.normal_impulse
+            local["impulses"][i, 3:] = w.tangential_impulse
             local["contacts"][i] = w.contacts
 
     def rows(self, state, total: dict) -> list[tuple]:
-        """The rows of step ``state.step`` from the sums over ranks ``total``."""
+        """The rows of step ``state.step`` from the sums over ranks ``total`` (in Python
+        floats: a few walls of a few values each)."""
         if self._last_time is None:
             interval = state.dt_velocity  # s: the first step's impulses act over it
         else:
             interval = state.t - self._last_time  # s since the previous sample
         self._last_time = state.t
         rows = []
-        for i, w in enumerate(self.walls):
-            impulses = np.concatenate([total["normal_impulse"][i], total["tangential_impulse"][i]])
-            contacts = int(total["contacts"][i])
+        for i, (w, impulses, last, contacts) in enumerate(
+            zip(self.walls, total["impulses"].tolist(), self._last_impulses.tolist(),
+                total["contacts"].tolist(), strict=True)
+        ):  # fmt: skip
+            if interval:
+                forces = [
+                    (now - before) / interval for now, before in zip(impulses, last, strict=True)
+                ]
+            else:  # the time did not advance (a step below its resolution): inf or nan
+                forces = ((np.array(impulses) - last) / interval).tolist()
+            force = [forces[c] + forces[c + 3] for c in range(3)]
+            impulse = [impulses[c] + impulses[c + 3] for c in range(3)]
+            contacts = int(contacts)
             self.peak_contacts[i] = max(self.peak_contacts[i], contacts)
-            forces = (impulses - self._last_impulses[i]) / interval
-            self._last_impulses[i] = impulses
-            force, impulse = forces[:3] + forces[3:], impulses[:3] + impulses[3:]
-            rows.append(
-                (state.t, i, *force, *impulse, *forces, *impulses, contacts,
-                 *w.position, *w.motion.velocity)
-            )  # fmt: skip
+            motion = (*w.position.tolist(), *w.motion.velocity.tolist())
+            rows.append((state.t, i, *force, *impulse, *forces, *impulses, contacts, *motion))
+        self._last_impulses[:] = total["impulses"]
         return rows

@@ -4,7 +4,8 @@ A deck is read into a :class:`~rwall_fem.radioss.model.Deck` in SI units
 (:func:`read_deck`: :mod:`~rwall_fem.radioss.reader` cuts it into cards,
 :mod:`~rwall_fem.radioss.starter` and :mod:`~rwall_fem.radioss.engine` read them),
 which becomes the raw table of a scene and a gmsh mesh file
-(:mod:`~rwall_fem.radioss.to_scene`, :mod:`~rwall_fem.radioss.mesh`). From there
+(:mod:`~rwall_fem.radioss.to_scene`, with :mod:`~rwall_fem.radioss.materials` and
+:mod:`~rwall_fem.radioss.parts`; :mod:`~rwall_fem.radioss.mesh`). From there
 everything is a scene's: :func:`load_deck` validates it as a TOML file is validated,
 and :func:`convert` writes the TOML and the mesh for users who continue in that format.
 

@@ -1,4 +1,5 @@
-"""The mesh of a deck as a gmsh file: its elements, and its node groups as face groups.
+"""The mesh of a deck as a gmsh file: its elements, in regions (the parts: gmsh physical
+volumes), and its node groups as face groups.
 
 rwall_fem refers to node sets by the name of a gmsh physical surface group (a facet
 tag of the DOLFINx mesh): a set is the nodes of its faces. A /GRNOD becomes the faces
@@ -8,8 +9,10 @@ DOLFINx keeps one tag per facet, so groups that share faces are written as their
 disjoint pieces ("atoms": the faces of the same groups), and a group is the list of its
 atoms' names (``grnod_3``, ``grnod_3_7`` for the faces in both 3 and 7).
 
-The file is MSH 2.2 text, with the deck's node IDs as gmsh node tags and coordinates
-in metres written with 17 significant digits (exactly the numbers the deck gives, in SI).
+The file is MSH 2.2 text, with coordinates in metres written with 17 significant digits
+(exactly the numbers the deck gives, in SI). Its node tags number the nodes of the
+elements 1, 2, ... in the order of their IDs: DOLFINx 0.5 reads only tags without gaps,
+and decks often number each part's nodes from its own start.
 """
 
 from __future__ import annotations
@@ -20,7 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FaceGroups", "face_groups", "write_msh"]
+__all__ = ["WRITER", "FaceGroups", "face_groups", "write_msh"]
+
+# What the files of write_msh are: part of the name of a deck's mesh in the cache, so that
+# a change of the writer writes the meshes anew.
+WRITER = "MSH 2.2; a physical volume per region; node tags 1..N"
 
 # The faces of gmsh's (and Radioss's) hexahedron and tetrahedron, by local node index.
 _FACES = {
@@ -78,10 +85,11 @@ def face_groups(cell: str, cells: np.ndarray, groups: dict[int, np.ndarray]) -> 
 
 
 def write_msh(path: Path, node_ids: np.ndarray, coordinates: np.ndarray, cell: str,
-              cells: np.ndarray, groups: FaceGroups) -> None:  # fmt: skip
-    """Write the nodes of ``cells`` (m), the cells (physical volume ``body``) and the face
-    groups (physical surfaces named as the atoms) as MSH 2.2 text to ``path``, atomically."""
-    used = np.unique(cells)
+              regions: dict[str, np.ndarray], groups: FaceGroups) -> None:  # fmt: skip
+    """Write the nodes of the cells (m), the cells of each region (name -> cells: a
+    physical volume of that name) and the face groups (physical surfaces named as the
+    atoms) as MSH 2.2 text to ``path``, atomically."""
+    used = np.unique(np.concatenate(list(regions.values())))
     order = np.argsort(node_ids)
     rows = order[np.searchsorted(node_ids[order], used)]
     names = list(groups.atoms)
@@ -89,22 +97,31 @@ def write_msh(path: Path, node_ids: np.ndarray, coordinates: np.ndarray, cell: s
     partial = path.with_name(path.name + f".partial{os.getpid()}")
     with open(partial, "w", encoding="ascii") as out:
         out.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n")
-        out.write(f"{len(names) + 1}\n3 1 \"body\"\n")
+        out.write(f"{len(names) + len(regions)}\n")
+        for tag, name in enumerate(regions, start=1):
+            out.write(f'3 {tag} "{name}"\n')
         for tag, name in enumerate(names, start=1):
-            out.write(f"2 {tag} \"{name}\"\n")
+            out.write(f'2 {tag} "{name}"\n')
         out.write(f"$EndPhysicalNames\n$Nodes\n{len(used)}\n")
-        table = np.column_stack([used.astype(float), coordinates[rows]])
+        table = np.column_stack([np.arange(1.0, len(used) + 1), coordinates[rows]])
         np.savetxt(out, table, fmt=["%d", "%.17g", "%.17g", "%.17g"])
-        count = len(cells) + sum(len(f) for f in groups.atoms.values())
+        count = sum(len(c) for c in regions.values()) + sum(len(f) for f in groups.atoms.values())
         out.write(f"$EndNodes\n$Elements\n{count}\n")
         number = 1
         for tag, name in enumerate(names, start=1):
             faces = groups.atoms[name]
-            _elements(out, number, _GMSH_TYPE[faces.shape[1]], tag, faces)
+            _elements(out, number, _GMSH_TYPE[faces.shape[1]], tag, _tags(used, faces))
             number += len(faces)
-        _elements(out, number, _GMSH_TYPE[cell], 1, cells)
+        for tag, cells in enumerate(regions.values(), start=1):
+            _elements(out, number, _GMSH_TYPE[cell], tag, _tags(used, cells))
+            number += len(cells)
         out.write("$EndElements\n")
     os.replace(partial, path)
+
+
+def _tags(used: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """The gmsh node tags of the node IDs ``ids``: their places in ``used`` (sorted), from 1."""
+    return np.searchsorted(used, ids) + 1
 
 
 def _elements(out, first: int, kind: int, tag: int, nodes: np.ndarray) -> None:

@@ -1,9 +1,10 @@
 """A deck read whole becomes the raw table of a scene, the same keys a TOML file holds,
 and its mesh a gmsh file: from here on everything is shared with TOML scenes.
 
-One body for now: several /PART make one body when they share /MAT and /PROP; parts of
-different materials or properties need the scene's parts (``[[part]]``), not built yet,
-and are refused in one line naming them.
+Parts that share /MAT and /PROP and start at one velocity are one body, the scene's
+``[material]``, ``[element]`` and ``[initial]``; otherwise every /PART is a ``[[part]]``
+(:mod:`~rwall_fem.radioss.parts`), a region of the mesh of its name, and what all the
+parts share is still the scene's table, what differs each part's own.
 """
 
 from __future__ import annotations
@@ -15,8 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rwall_fem.radioss.mesh import FaceGroups, face_groups, write_msh
+from rwall_fem.radioss.materials import element_table, material_table
+from rwall_fem.radioss.mesh import WRITER, FaceGroups, face_groups, write_msh
 from rwall_fem.radioss.model import Deck, Prescribed, Wall
+from rwall_fem.radioss.parts import DeckPart, deck_parts, initial_velocities, uniform_velocity
 from rwall_fem.radioss.reader import DeckError
 
 __all__ = ["SceneParts", "scene_of"]
@@ -28,55 +31,32 @@ _SHAPE = {"PLANE": "plane", "CYL": "cylinder", "SPHER": "sphere", "PARAL": "para
 
 @dataclass
 class SceneParts:
-    """The raw scene table, the mesh to write (cell type, cells, face groups), and lines
-    saying what the deck became (for ``rwall-fem check``)."""
+    """The raw scene table, the mesh to write (cell type, regions: name -> cells, face
+    groups), and lines saying what the deck became (for ``rwall-fem check``)."""
 
     raw: dict
     cell: str
-    cells: np.ndarray
+    regions: dict[str, np.ndarray]
     groups: FaceGroups
     facts: list[str]
 
     def mesh_key(self, deck: Deck) -> str:
         """A digest of everything the mesh file holds (its name in the cache)."""
-        digest = hashlib.sha256()
-        for array in (deck.node_ids, deck.coordinates, self.cells):
+        digest = hashlib.sha256(WRITER.encode())
+        for array in (deck.node_ids, deck.coordinates):
             digest.update(np.ascontiguousarray(array).tobytes())
-        for name, faces in self.groups.atoms.items():
-            digest.update(name.encode() + np.ascontiguousarray(faces).tobytes())
+        for dim, named in ((3, self.regions), (2, self.groups.atoms)):
+            for name, cells in named.items():
+                digest.update(f"{dim} {name}".encode() + np.ascontiguousarray(cells).tobytes())
         return digest.hexdigest()[:24]
 
     def write_mesh(self, deck: Deck, path: Path) -> None:
-        write_msh(path, deck.node_ids, deck.coordinates, self.cell, self.cells, self.groups)
+        write_msh(path, deck.node_ids, deck.coordinates, self.cell, self.regions, self.groups)
 
 
 def scene_of(deck: Deck) -> SceneParts:
     """The scene the deck describes (mesh file key left for the caller to fill)."""
-    parts = [p for p in deck.parts.values()]
-    for part in parts:
-        if part.mat not in deck.materials:
-            raise DeckError(f"{part.where}: /PART/{part.id}: mat_ID {part.mat} refers to no /MAT")
-        if part.prop not in deck.properties:
-            raise DeckError(
-                f"{part.where}: /PART/{part.id}: prop_ID {part.prop} refers to no /PROP"
-            )
-    if not deck.bodies:
-        raise DeckError(f"{deck.starter}: no elements (/BRICK or /TETRA4)")
-    for body in deck.bodies:
-        if body.part not in deck.parts:
-            body.card.fail(f"part_ID {body.part} refers to no /PART")
-    _check_element_nodes(deck)
-    used = sorted({b.part for b in deck.bodies})
-    kinds = {(deck.parts[p].mat, deck.parts[p].prop) for p in used}
-    if len(kinds) > 1:
-        listed = ", ".join(
-            f"{p} (mat {deck.parts[p].mat}, prop {deck.parts[p].prop})" for p in used
-        )
-        raise DeckError(
-            f"{deck.starter}: parts {listed} differ in material or property: a body of several "
-            "materials or properties needs the scene's parts ([[part]], not built yet); give "
-            "them one /MAT and one /PROP to run them as one body"
-        )
+    _check_references(deck)
     cells_by_kind = {b.cell for b in deck.bodies}
     if len(cells_by_kind) > 1:
         raise DeckError(
@@ -85,31 +65,33 @@ def scene_of(deck: Deck) -> SceneParts:
         )
     cell = cells_by_kind.pop()
     cells = np.concatenate([b.nodes for b in deck.bodies])
+    parts = deck_parts(deck)
+    used = {p.part.id for p in parts}
     for part in deck.parts.values():
         if part.id not in used:
             deck.warnings.append(f"{part.where}: /PART/{part.id}: has no elements")
-    mat_id, prop_id = kinds.pop()
     body_nodes = np.unique(cells)
     mains = {w.main_node for w in deck.walls if w.main_node}
     _resolve_groups(deck, cells, body_nodes, mains)
+    initial_velocities(deck, parts, mains)
+    separate = len({(p.part.mat, p.part.prop) for p in parts}) > 1 or not uniform_velocity(parts)
 
     facts = [
         f"units: input {deck.input_units.describe()}, work {deck.work_units.describe()} "
         "(converted to SI)",
-        f"body: parts {', '.join(map(str, used))}: {len(cells)} {cell} cells, "
-        f"{len(body_nodes)} nodes",
     ]
-    material, material_fact = _material(deck, mat_id)
-    element, element_fact = _element(deck, prop_id, cell, material, cells)
-    facts += [material_fact, element_fact]
+    if separate:
+        body = _parts(deck, parts, cell, facts)
+        regions = {p.name: p.cells for p in parts}
+    else:
+        body = _one_body(deck, parts, cell, cells, facts)
+        regions = {"body": cells}
     raw: dict = {
         "run": {"end_time": deck.end_time},
         "mesh": {},
-        "material": material,
+        **body,
         "output": {"directory": f"results/{_slug(deck.run_name)}", "history_interval": 1},
     }
-    if element:
-        raw["element"] = element
     if deck.dt_scale is not None:
         raw["run"]["dt_scale"] = deck.dt_scale
     if deck.dt_min is not None:
@@ -128,7 +110,9 @@ def scene_of(deck: Deck) -> SceneParts:
             "step (rwall_fem's history interval counts steps)"
         )
 
-    group_nodes = {gid: g.nodes for gid, g in deck.groups.items() if _used_group(deck, gid)}
+    by_parts = _groups_as_parts(deck, parts) if separate else {}
+    group_nodes = {gid: g.nodes for gid, g in deck.groups.items()
+                   if _used_group(deck, gid, by_parts)}  # fmt: skip
     atoms, unreached = face_groups(cell, cells, {
         gid: np.intersect1d(nodes, body_nodes) for gid, nodes in group_nodes.items()
     })  # fmt: skip
@@ -140,10 +124,6 @@ def scene_of(deck: Deck) -> SceneParts:
                 f"{g.where}: /GRNOD/{g.kind}/{gid}: nodes {shown} lie on no element face whose "
                 "nodes are all in the group: rwall_fem's node sets are unions of element faces"
             )
-    velocity = _initial_velocity(deck, body_nodes, mains)
-    if velocity is not None:
-        raw["initial"] = {"velocity": list(velocity)}
-        facts.append(f"initial velocity: {_vec(velocity)} m/s")
     gravity = _gravity(deck, body_nodes)
     if gravity is not None:
         raw["gravity"] = {"acceleration": list(gravity)}
@@ -153,7 +133,7 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["boundary"] = boundaries
         facts += [f"boundary on {b['group']}: components {b.get('components', 'xyz')}"
                   for b in boundaries]  # fmt: skip
-    walls = [_wall(deck, w, atoms, wall_velocity.get(w.main_node)) for w in deck.walls]
+    walls = [_wall(deck, w, atoms, by_parts, wall_velocity.get(w.main_node)) for w in deck.walls]
     if walls:
         raw["wall"] = walls
         for w, table in zip(deck.walls, walls, strict=True):
@@ -163,7 +143,110 @@ def scene_of(deck: Deck) -> SceneParts:
         + (f", dt scale {deck.dt_scale:g}" if deck.dt_scale is not None else "")
         + (f", {raw['output']['frames']} frames" if "frames" in raw["output"] else "")
     )
-    return SceneParts(raw, cell, cells, atoms, facts)
+    return SceneParts(raw, cell, regions, atoms, facts)
+
+
+def _check_references(deck: Deck) -> None:
+    """Every part's /MAT and /PROP, every element's /PART and nodes exist; there are
+    elements."""
+    for part in deck.parts.values():
+        if part.mat not in deck.materials:
+            raise DeckError(f"{part.where}: /PART/{part.id}: mat_ID {part.mat} refers to no /MAT")
+        if part.prop not in deck.properties:
+            raise DeckError(
+                f"{part.where}: /PART/{part.id}: prop_ID {part.prop} refers to no /PROP"
+            )
+    if not deck.bodies:
+        raise DeckError(f"{deck.starter}: no elements (/BRICK or /TETRA4)")
+    for body in deck.bodies:
+        if body.part not in deck.parts:
+            body.card.fail(f"part_ID {body.part} refers to no /PART")
+    _check_element_nodes(deck)
+
+
+def _one_body(deck: Deck, parts: list[DeckPart], cell: str, cells, facts: list[str]) -> dict:
+    """The tables of a body whose parts share /MAT, /PROP and their initial velocity:
+    [material], [element] and [initial]."""
+    facts.append(
+        f"body: parts {', '.join(str(p.part.id) for p in parts)}: {len(cells)} {cell} cells, "
+        f"{len(np.unique(cells))} nodes"
+    )
+    material, material_fact = material_table(deck, parts[0].part.mat)
+    element, element_fact = element_table(deck, parts[0].part.prop, cell, material, cells)
+    facts += [material_fact, element_fact]
+    tables = {"material": material}
+    if element:
+        tables["element"] = element
+    if deck.initial:
+        tables["initial"] = {"velocity": list(parts[0].start)}
+        facts.append(f"initial velocity: {_vec(parts[0].start)} m/s")
+    return tables
+
+
+def _parts(deck: Deck, parts: list[DeckPart], cell: str, facts: list[str]) -> dict:
+    """The tables of a body of parts: one [[part]] per /PART, each the region of its name;
+    the material, element and initial velocity that every part has are the scene's
+    [material], [element] and [initial], the others each part's own."""
+    nodes = np.unique(np.concatenate([p.nodes for p in parts]))
+    facts.append(
+        f"body: {sum(len(p.cells) for p in parts)} {cell} cells, {len(nodes)} nodes, in "
+        f"{len(parts)} parts ([[part]], each the region of its name in the mesh)"
+    )
+    materials: dict[int, dict] = {}
+    elements: dict[tuple[int, int], dict] = {}
+    for mid in dict.fromkeys(p.part.mat for p in parts):
+        materials[mid], fact = material_table(deck, mid)
+        facts.append(f"{fact} ({_names([p for p in parts if p.part.mat == mid])})")
+    for key in dict.fromkeys((p.part.prop, p.part.mat) for p in parts):
+        mine = [p for p in parts if (p.part.prop, p.part.mat) == key]
+        cells = np.concatenate([p.cells for p in mine])
+        elements[key], fact = element_table(deck, key[0], cell, materials[key[1]], cells)
+        facts.append(f"{fact} ({_names(mine)})")
+    material = [materials[p.part.mat] for p in parts]
+    element = [elements[(p.part.prop, p.part.mat)] for p in parts]
+    velocity = [p.start for p in parts]
+    tables: dict = {}
+    shared_material = all(m == material[0] for m in material)
+    shared_element = all(e == element[0] for e in element)
+    shared_velocity = uniform_velocity(parts)
+    if shared_material:
+        tables["material"] = material[0]
+    if shared_element and element[0]:
+        tables["element"] = element[0]
+    if shared_velocity and deck.initial:
+        tables["initial"] = {"velocity": list(velocity[0])}
+    tables["part"] = []
+    for k, p in enumerate(parts):
+        table: dict = {"name": p.name}
+        if not shared_material:
+            table["material"] = material[k]
+        if not shared_element and element[k]:
+            table["element"] = element[k]
+        if not shared_velocity and p.velocity is not None:
+            table["initial"] = {"velocity": list(p.velocity)}
+        tables["part"].append(table)
+        facts.append(
+            f"part {p.name}: /PART/{p.part.id} ({p.part.where}): {len(p.cells)} cells, "
+            f"{len(p.nodes)} nodes, /MAT {p.part.mat}, /PROP {p.part.prop}, initial velocity "
+            f"{_vec(p.start)} m/s" + (f" ({p.given})" if p.given else "")
+        )
+    return tables
+
+
+def _names(parts: list[DeckPart]) -> str:
+    return ("part " if len(parts) == 1 else "parts ") + ", ".join(p.name for p in parts)
+
+
+def _groups_as_parts(deck: Deck, parts: list[DeckPart]) -> dict[int, list[str]]:
+    """The /GRNOD/PART groups that walls take as their grnd_ID1, as the names of their
+    parts (``secondary.parts``: every node of those parts' elements, as the group's)."""
+    names = {p.part.id: p.name for p in parts}
+    out = {}
+    for w in deck.walls:
+        g = deck.groups.get(w.add_group)
+        if g is not None and g.kind == "PART":
+            out[w.add_group] = [names[pid] for pid in g.items.tolist() if pid in names]
+    return out
 
 
 def _slug(name: str) -> str:
@@ -217,110 +300,17 @@ def _group(deck: Deck, gid: int, where: str, what: str):
     return deck.groups[gid]
 
 
-def _used_group(deck: Deck, gid: int) -> bool:
-    """Whether a group must be written to the mesh (a wall, /BCS or /IMPVEL uses it)."""
-    uses = [w.add_group for w in deck.walls] + [w.exclude_group for w in deck.walls]
+def _used_group(deck: Deck, gid: int, by_parts: dict[int, list[str]]) -> bool:
+    """Whether a group must be written to the mesh (a wall, /BCS or /IMPVEL uses it, other
+    than as the parts ``by_parts``)."""
+    uses = [w.add_group for w in deck.walls if w.add_group not in by_parts]
+    uses += [w.exclude_group for w in deck.walls]
     uses += [g for _, g, _ in deck.clamps] + [p.group for p in deck.velocities]
     return gid in uses
 
 
-def _material(deck: Deck, mid: int) -> tuple[dict, str]:
-    m = deck.materials[mid]
-    table = {"density": m["density"], "young": m["young"], "poisson": m["poisson"]}
-    head = f"material: /MAT/{m['law']}/{mid} ({m['where']})"
-    if m["law"] == "LAW1":
-        return {"model": "linear_elastic", **table}, f"{head} -> linear_elastic"
-    if m["law"] == "LAW36":
-        fct = deck.functions.get(m["curve"])
-        if fct is None:
-            raise DeckError(f"{m['curve_where']}: /MAT/LAW36/{mid}: fct_ID1 {m['curve']} "
-                            "refers to no /FUNCT")  # fmt: skip
-        if fct.x[0] != 0.0 or len(fct.x) > 64 or np.any(fct.y <= 0):
-            raise DeckError(f"{fct.where}: /FUNCT/{fct.id}: a hardening curve starts at plastic "
-                            "strain 0, has at most 64 points and positive stresses")  # fmt: skip
-        rows = [[float(x), float(y * m["curve_scale"])] for x, y in zip(fct.x, fct.y, strict=True)]
-        if fct.y[-1] != fct.y[-2]:
-            deck.warnings.append(
-                f"{fct.where}: /FUNCT/{fct.id}: rwall_fem holds the yield stress after the last "
-                f"point (plastic strain {fct.x[-1]:g}); Radioss extends the last slope"
-            )
-        material = {"model": "elastic_plastic", **table, "hardening": "table",
-                    "hardening_curve": rows}  # fmt: skip
-        return material, f"{head} -> elastic_plastic, tabulated hardening ({len(rows)} points)"
-    a, b, n = m["a"], m["b"], m["n"]
-    if "c" in m or "t_melt" in m:
-        material = {"model": "johnson_cook", **table, "yield_stress": a,
-                    "hardening_coefficient": b, "hardening_exponent": n}  # fmt: skip
-        if "c" in m:
-            material |= {"strain_rate_coefficient": m["c"], "reference_strain_rate": m["rate0"]}
-        if "t_melt" in m:
-            material["heating"] = {
-                "softening_exponent": m["m"], "melting_temperature": m["t_melt"],
-                "specific_heat": m["heat"] / m["density"], "room_temperature": m["t_room"],
-                "taylor_quinney": 1.0,
-            }  # fmt: skip
-        return material, f"{head} -> johnson_cook"
-    if n == 1.0:
-        material = {"model": "elastic_plastic", **table, "hardening": "linear",
-                    "yield_stress": a, "hardening_modulus": b}  # fmt: skip
-        return material, f"{head} -> elastic_plastic, linear hardening"
-    material = {"model": "elastic_plastic", **table, "hardening": "power", "yield_stress": a,
-                "hardening_coefficient": b, "hardening_exponent": n}  # fmt: skip
-    return material, f"{head} -> elastic_plastic, power hardening"
-
-
-def _element(deck: Deck, pid: int, cell: str, material: dict, cells) -> tuple[dict, str]:
-    p = deck.properties[pid]
-    head = f"property: /PROP/SOLID/{pid} Isolid {p['isolid']} ({p['where']})"
-    if cell == "tetrahedron":
-        return {}, f"{head} -> P1 tetrahedra (Itetra4 0)"
-    element = dict(p["element"])
-    plastic = material["model"] in ("elastic_plastic", "johnson_cook")
-    if p["isolid"] == 24 and plastic and p["icpre"] == 0:
-        deck.warnings.append(
-            f"{p['line']}: /PROP/SOLID/{pid}: Icpre 0 on an elasto-plastic body: rwall_fem's "
-            "physical hourglass control has no volumetric part on plastic bodies (as Icpre 1)"
-        )
-    if p["isolid"] == 2 and not _parallelepipeds(deck, cells):
-        deck.warnings.append(
-            f"{p['line']}: /PROP/SOLID/{pid}: Isolid 2 (Hallquist's hourglass modes) is read "
-            "as Isolid 1 (orthogonal Flanagan-Belytschko modes): they differ on cells that "
-            "are not parallelepipeds"
-        )
-    text = ", ".join(f"{k} {v}" for k, v in element.items())
-    return element, f"{head} -> {text}"
-
-
-def _parallelepipeds(deck: Deck, cells) -> bool:
-    """Whether every hexahedron is a parallelepiped (no hourglass part in its shape)."""
-    x = deck.coordinates[deck.node_positions(cells.ravel())].reshape(len(cells), 8, 3)
-    h = np.array([[1, -1, 1, -1, 1, -1, 1, -1], [1, 1, -1, -1, -1, -1, 1, 1],
-                  [1, -1, -1, 1, -1, 1, 1, -1], [-1, 1, -1, 1, 1, -1, 1, -1]])  # fmt: skip
-    size = np.ptp(x, axis=1).max()
-    return bool(np.abs(np.einsum("ai,cid->cad", h, x)).max() <= 1e-9 * size)
-
-
 def _covers(group_nodes, body_nodes) -> bool:
     return bool(np.isin(body_nodes, group_nodes).all())
-
-
-def _initial_velocity(deck: Deck, body_nodes, mains):
-    chosen = None
-    for velocity, gid, where in deck.initial:
-        g = _group(deck, gid, where, "/INIVEL/TRA: Gnod_id")
-        if set(g.nodes.tolist()) & mains:
-            raise DeckError(f"{where}: /INIVEL/TRA: group {gid} holds the main node of a "
-                            "/RWALL: its velocity is the wall's VX0 VY0 VZ0")  # fmt: skip
-        if not _covers(g.nodes, body_nodes):
-            raise DeckError(
-                f"{where}: /INIVEL/TRA: group {gid} holds only some nodes of the body: an "
-                "initial velocity per part needs the scene's parts ([[part]], not built yet)"
-            )
-        if chosen is not None and not np.allclose(chosen, velocity, rtol=0, atol=0):
-            raise DeckError(f"{where}: /INIVEL/TRA: a second initial velocity of the same "
-                            "nodes")  # fmt: skip
-        chosen = velocity
-    return chosen
 
 
 def _function_on_run(deck: Deck, p: Prescribed) -> tuple[np.ndarray, np.ndarray]:
@@ -398,7 +388,8 @@ def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
     return out, on_walls
 
 
-def _wall(deck: Deck, w: Wall, atoms: FaceGroups, imposed: list[Prescribed] | None) -> dict:
+def _wall(deck: Deck, w: Wall, atoms: FaceGroups, by_parts: dict[int, list[str]],
+          imposed: list[Prescribed] | None) -> dict:  # fmt: skip
     name = f"/RWALL/{w.kind}/{w.id}"
     where = f"{w.where}: {name}"
     table: dict = {"kind": _SHAPE[w.kind]}
@@ -437,8 +428,11 @@ def _wall(deck: Deck, w: Wall, atoms: FaceGroups, imposed: list[Prescribed] | No
             g = _group(deck, gid, w.where, f"{name}: {what}")
             if w.main_node and w.main_node in g.nodes:
                 raise DeckError(f"{where}: {what} {gid} holds the wall's own main node")
-            secondary[key] = atoms.of[gid]
-    if not secondary.get("add") and "search_distance" not in secondary:
+            if gid in by_parts and key == "add":
+                secondary["parts"] = by_parts[gid]
+            else:
+                secondary[key] = atoms.of[gid]
+    if not (secondary.get("add") or secondary.get("parts") or "search_distance" in secondary):
         raise DeckError(f"{where}: no secondary nodes (Dsearch is 0 and no grnd_ID1): the wall "
                         "would act on nothing; give Dsearch or grnd_ID1")  # fmt: skip
     table["secondary"] = secondary
@@ -472,8 +466,10 @@ def _free_components_unloaded(w: Wall, free: list[int], where: str) -> None:
         if np.all(np.abs(normal[free]) <= 1e-12):
             return
     axes = "".join("XYZ"[i] for i in free)
-    raise DeckError(f"{where}: /IMPVEL on its node leaves {axes} free, where the wall's force "
-                    "acts: impose X, Y and Z (rwall_fem prescribes a wall's whole motion)")
+    raise DeckError(
+        f"{where}: /IMPVEL on its node leaves {axes} free, where the wall's force "
+        "acts: impose X, Y and Z (rwall_fem prescribes a wall's whole motion)"
+    )
 
 
 def _wall_fact(w: Wall, table: dict) -> str:
@@ -486,7 +482,11 @@ def _wall_fact(w: Wall, table: dict) -> str:
         nodes.append(f"within {sec['search_distance']:g} m")
     if sec.get("add"):
         nodes.append(f"+ group {w.add_group}")
+    if sec.get("parts"):
+        nodes.append(f"+ group {w.add_group} (the parts {', '.join(sec['parts'])})")
     if sec.get("exclude"):
         nodes.append(f"- group {w.exclude_group}")
-    return (f"wall: /RWALL/{w.kind}/{w.id} ({w.where}) -> {table['kind']}, {how}, slide "
-            f"{table['slide']}, secondary nodes {' '.join(nodes)}")
+    return (
+        f"wall: /RWALL/{w.kind}/{w.id} ({w.where}) -> {table['kind']}, {how}, slide "
+        f"{table['slide']}, secondary nodes {' '.join(nodes)}"
+    )

@@ -30,7 +30,8 @@ def _value(v) -> str:
 
 def toml_text(raw: dict, header: str = "") -> str:
     """``raw`` as TOML: scalars first, then tables (``[a]``, ``[a.b]``) and arrays of
-    tables (``[[wall]]``, with their own tables inline); ``header``: comment lines."""
+    tables (``[[part]]``, their own tables after them: ``[part.material]``); ``header``:
+    comment lines."""
     lines = [f"# {line}" if line else "#" for line in header.splitlines()]
 
     def table(name: str, content: dict) -> None:
@@ -51,5 +52,9 @@ def toml_text(raw: dict, header: str = "") -> str:
         elif isinstance(value, list) and value and isinstance(value[0], dict):
             for item in value:
                 lines.append(f"\n[[{key}]]")
-                lines.extend(f"{k} = {_value(v)}" for k, v in item.items())
+                lines.extend(f"{k} = {_value(v)}" for k, v in item.items()
+                             if not isinstance(v, dict))  # fmt: skip
+                for k, v in item.items():
+                    if isinstance(v, dict):
+                        table(f"{key}.{k}", v)
     return "\n".join(lines).lstrip("\n") + "\n"

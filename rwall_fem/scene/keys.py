@@ -30,6 +30,7 @@ __all__ = [
     "Curve",
     "Each",
     "Flag",
+    "Identifier",
     "Integer",
     "Invalid",
     "Key",
@@ -43,6 +44,7 @@ __all__ = [
     "Text",
     "Variants",
     "Vector",
+    "did_you_mean",
     "Velocity",
     "key",
     "keys_of",
@@ -299,6 +301,30 @@ class Text(ValueType):
 
     def json(self):
         return {"type": "string", "minLength": 1}
+
+
+@dataclass(frozen=True)
+class Identifier(ValueType):
+    """A name that heads columns of the outputs (``what`` it names): a letter, then up to 63
+    letters, digits, ``_`` or ``-``."""
+
+    what: str
+    type_text = "string"
+    PATTERN = r"[A-Za-z][A-Za-z0-9_-]{0,63}"
+
+    def read(self, value, ctx):
+        if not isinstance(value, str) or not re.fullmatch(self.PATTERN, value):
+            raise Invalid(
+                f"must be {self.what}: a letter, then up to 63 letters, digits, '_' or '-'; "
+                f"got {show(value)}"
+            )
+        return value
+
+    def allowed_text(self):
+        return "a letter, then up to 63 letters, digits, `_`, `-`"
+
+    def json(self):
+        return {"type": "string", "pattern": f"^{self.PATTERN}$"}
 
 
 @dataclass(frozen=True)
@@ -623,7 +649,8 @@ def _default(f: dataclasses.Field) -> Any:
     return f.default
 
 
-def _hint(name: str, allowed) -> str:
+def did_you_mean(name: str, allowed) -> str:
+    """' (did you mean 'x'?)' with the closest of ``allowed`` to ``name``, or nothing."""
     close = (
         difflib.get_close_matches(name, allowed, n=1)
         or [a for a in allowed if name and (a.startswith(name) or name.startswith(a))][:1]
@@ -652,7 +679,8 @@ def read_table(cls, raw: Any, ctx: Context, extra: dict | None = None) -> Any:
         if name not in keys:
             name = str(name)  # a dict from Python may have other keys than strings
             ctx.fail(
-                join(path, name), f"unknown key{_hint(name, keys)}; allowed: {', '.join(keys)}"
+                join(path, name),
+                f"unknown key{did_you_mean(name, keys)}; allowed: {', '.join(keys)}",
             )
     if spec.one_of and len(raw) != 1:
         ctx.fail(path, f"give exactly one of {', '.join(keys)}")

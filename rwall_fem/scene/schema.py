@@ -18,6 +18,7 @@ from rwall_fem.scene.keys import (
     Curve,
     Each,
     Flag,
+    Identifier,
     Integer,
     Letters,
     MeshFile,
@@ -28,6 +29,7 @@ from rwall_fem.scene.keys import (
     Variants,
     Vector,
     Velocity,
+    did_you_mean,
     key,
     rule,
     table,
@@ -38,6 +40,7 @@ __all__ = [
     "PLASTIC_MODELS",
     "MESH_SHAPES",
     "SHAPE_KEYS",
+    "SHAPE_REGIONS",
     "BoundarySpec",
     "Element",
     "Failure",
@@ -47,6 +50,7 @@ __all__ = [
     "MeshSpec",
     "Motion",
     "Output",
+    "PartSpec",
     "RunSettings",
     "Scene",
     "Secondary",
@@ -95,9 +99,11 @@ FAILURE_KEYS = {
 
 # The keys of each mesh shape besides "shape", "noise" and the refinement keys.
 MESH_SHAPES = {
-    "bar": ("origin", "size", "axis", "element_size", "cell"),
-    "round_bar": ("origin", "radius", "length", "axis", "element_size", "cell"),
-    "plate": ("origin", "size", "layers", "axis", "element_size", "cell"),
+    "bar": ("origin", "size", "axis", "element_size", "cell", "front_length"),
+    "round_bar": ("origin", "radius", "length", "axis", "element_size", "cell", "front_length"),
+    "plate": (
+        "origin", "size", "layers", "axis", "element_size", "cell", "bottom_layer", "top_layer",
+    ),
     "plate_with_hole": (
         "origin",
         "size",
@@ -107,7 +113,17 @@ MESH_SHAPES = {
         "axis",
         "element_size",
         "cell",
+        "bottom_layer",
+        "top_layer",
     ),
+}  # fmt: skip
+# The regions (gmsh physical volumes) of each built-in shape: always "body"; the others
+# when their key is above 0 (meshes/sweep.geo).
+SHAPE_REGIONS = {
+    "bar": {"front": "front_length"},
+    "round_bar": {"front": "front_length"},
+    "plate": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
+    "plate_with_hole": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
 }
 _REFINE_KEYS = ("refine_point", "refine_size", "refine_radius")
 
@@ -319,6 +335,28 @@ class MeshSpec:
         Real(low=0.0), None, required=True, unit="m", doc="target edge length"
     )
     cell: str = key(Choice(("hexahedron", "tetrahedron")), "hexahedron", doc="the cell type")
+    front_length: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="m",
+        doc="bars: the first length along their own z, from origin, is the region 'front' "
+        "(the rest: 'body'), a part of its own with [[part]]",
+        default_doc="0: one region, 'body'",
+    )
+    bottom_layer: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="m",
+        doc="plates: a layer of this thickness at their bottom face is the region 'bottom_layer'",
+        default_doc="0: none",
+    )
+    top_layer: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="m",
+        doc="plates: a layer of this thickness at their top face is the region 'top_layer'",
+        default_doc="0: none",
+    )
     refine_point: tuple[float, float, float] | None = key(
         Vector(), None, unit="m", doc="centre of a zone of smaller cells, in scene coordinates"
     )
@@ -401,6 +439,33 @@ def _body_box(v) -> tuple[tuple[float, ...], tuple[float, ...]]:
         r = v["radius"]
         return (-r, -r, 0.0), (r, r, v["length"])
     return (0.0, 0.0, 0.0), v["size"]
+
+
+@rule(MeshSpec)
+def _regions_fit(v, raw, fail):
+    """A bar's front_length is shorter than the bar; a plate's bottom_layer and top_layer
+    leave some of its thickness, and a given layers count is at least one per region."""
+    shape = v["shape"]
+    if shape in ("bar", "round_bar"):
+        length = v["size"][2] if shape == "bar" else v["length"]
+        if v["front_length"] >= length:
+            fail(
+                "front_length",
+                f"{v['front_length']:g} m is not shorter than the bar ({length:g} m)",
+            )
+    elif shape in ("plate", "plate_with_hole"):
+        thickness = v["size"][2]
+        layers = [v["bottom_layer"], v["top_layer"]]
+        if sum(layers) >= thickness:
+            key_ = "top_layer" if v["top_layer"] else "bottom_layer"
+            fail(
+                key_,
+                f"bottom_layer + top_layer = {sum(layers):g} m leave nothing of the plate's "
+                f"thickness ({thickness:g} m)",
+            )
+        regions = 1 + sum(x > 0 for x in layers)
+        if 0 < v["layers"] < regions:
+            fail("layers", f"{v['layers']} is fewer than one per region ({regions})")
 
 
 @rule(MeshSpec)
@@ -721,6 +786,9 @@ class Secondary:
         default_doc="no limit",
     )
     add: tuple[str, ...] = key(Names(), (), doc="named node sets (gmsh physical groups) to include")
+    parts: tuple[str, ...] = key(
+        Names(), (), doc="the nodes of these parts (Radioss's grnd_ID of a /GRNOD/PART)"
+    )
     exclude: tuple[str, ...] = key(Names(), (), doc="named node sets to leave out; exclusion wins")
 
 
@@ -845,6 +913,45 @@ def _points_span_the_shape(v, raw, fail):
             fail("corner2", "sides corner1 - point and corner2 - point are parallel")
 
 
+# --- [[part]] -------------------------------------------------------------------------
+
+
+@table(
+    "A part of the body (Radioss /PART, LS-DYNA *PART): regions of the mesh with their "
+    "material, element technology and initial velocity. Without [[part]] the whole body is "
+    "one part of the scene's [material], [element] and [initial]."
+)
+@dataclass(frozen=True)
+class PartSpec:
+    name: str = key(
+        Identifier("a part name"),
+        doc="how outputs and walls (secondary.parts) call it; unique in the scene",
+    )
+    volumes: tuple[str, ...] = key(
+        Names(),
+        (),
+        doc="the regions it is made of: named gmsh physical volumes (a built-in shape's "
+        "'body', 'front', 'bottom_layer', 'top_layer')",
+        default_doc="[name]",
+    )
+    material: Material | None = key(
+        Sub(Material), None, doc="its material", default_doc="the scene's [material]"
+    )
+    element: Element | None = key(
+        Sub(Element), None, doc="its element technology", default_doc="the scene's [element]"
+    )
+    initial: Initial | None = key(
+        Sub(Initial), None, doc="its initial velocity", default_doc="the scene's [initial]"
+    )
+
+
+@rule(PartSpec)
+def _volumes_default_to_the_name(v, raw, fail):
+    """volumes defaults to [name]."""
+    if not v["volumes"]:
+        v["volumes"] = (v["name"],)
+
+
 # --- [output] -----------------------------------------------------------------------
 
 
@@ -873,10 +980,10 @@ class Output:
         default_doc="about 20 lines over the run",
     )
     color: str = key(
-        Choice(("normal_velocity", "speed", "displacement", "plastic_strain", "damage")),
+        Choice(("normal_velocity", "speed", "displacement", "plastic_strain", "damage", "part")),
         "normal_velocity",
         doc="what colours the frames (plastic_strain: elasto-plastic bodies; damage: bodies "
-        "with a failure criterion)",
+        "with a failure criterion; part: a body of [[part]], one colour each)",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
     checkpoint_steps: int = key(
@@ -936,7 +1043,12 @@ class Scene:
         doc="the body",
         default_doc="a body given to the API",
     )
-    material: Material = key(Sub(Material), doc="the elastic law")
+    material: Material | None = key(
+        Sub(Material),
+        None,
+        doc="the body's material (with [[part]]: of the parts that give none)",
+        default_doc="required without [[part]]",
+    )
     element: Element = key(Sub(Element), factory=Element, doc="element technology")
     initial: Initial = key(Sub(Initial), factory=Initial, doc="the initial velocity")
     gravity: tuple[float, float, float] | None = key(
@@ -949,7 +1061,27 @@ class Scene:
         Each(BoundarySpec), (), toml="boundary", doc="prescribed velocities of node sets"
     )
     walls: tuple[WallSpec, ...] = key(Each(WallSpec), (), toml="wall", doc="the rigid walls")
+    parts: tuple[PartSpec, ...] = key(
+        Each(PartSpec), (), toml="part", doc="the parts of the body", default_doc="one: the body"
+    )
     output: Output = key(Sub(Output), factory=Output, doc="pictures, fields, histories")
+
+    @property
+    def body_parts(self) -> tuple[PartSpec, ...]:
+        """The parts with the scene's defaults filled in; without [[part]], one part named
+        "body" of every cell (``volumes`` empty)."""
+        if not self.parts:
+            return (PartSpec("body", (), self.material, self.element, self.initial),)
+        return tuple(
+            PartSpec(
+                p.name,
+                p.volumes,
+                p.material or self.material,
+                p.element or self.element,
+                p.initial or self.initial,
+            )
+            for p in self.parts
+        )
 
 
 _TETRAHEDRA = {
@@ -967,22 +1099,83 @@ _FULL_ONLY = {
 }
 
 
-@rule(Scene, json=[{"if": _TETRAHEDRA, "then": {"properties": {"element": _FULL_ONLY}}}])
+@rule(
+    Scene,
+    json=[
+        {"if": _TETRAHEDRA, "then": {"properties": {"element": _FULL_ONLY}}},
+        {
+            "if": _TETRAHEDRA,
+            "then": {"properties": {"part": {"items": {"properties": {"element": _FULL_ONLY}}}}},
+        },
+    ],
+)
 def _element_fits_the_cells(v, raw, fail):
     """Tetrahedra (mesh.cell) are P1, integrated exactly at one point: "full" only, and no
-    hourglass keys. (For a mesh file the cell type is checked when the body is built.)"""
-    mesh, element = v["mesh"], v["element"]
+    hourglass keys, in [element] and in every part's. (For a mesh file the cell type is
+    checked when the body is built.)"""
+    mesh = v["mesh"]
     if mesh is None or mesh.shape is None or mesh.cell != "tetrahedron":
         return
-    if element.integration == "reduced":
-        fail(
-            "element.integration",
-            "'reduced' is for hexahedra, and mesh.cell is 'tetrahedron' (P1, one exact point): "
-            "use 'full' or leave it out",
-        )
-    for name in ("hourglass", "hourglass_coefficient"):
-        if element.integration is None and name in raw.get("element", {}):
+    tables = [("element", v["element"], raw.get("element", {}))]
+    for i, part in enumerate(v["parts"]):
+        if part.element is not None:
+            tables.append((f"part[{i}].element", part.element, raw["part"][i]["element"]))
+    for where, element, given in tables:
+        if element.integration == "reduced":
             fail(
-                f"element.{name}",
-                "needs integration = 'reduced', and tetrahedra (mesh.cell) are integrated 'full'",
+                f"{where}.integration",
+                "'reduced' is for hexahedra, and mesh.cell is 'tetrahedron' (P1, one exact "
+                "point): use 'full' or leave it out",
             )
+        for name in ("hourglass", "hourglass_coefficient"):
+            if element.integration is None and name in given:
+                fail(
+                    f"{where}.{name}",
+                    "needs integration = 'reduced', and tetrahedra (mesh.cell) are integrated "
+                    "'full'",
+                )
+
+
+@rule(
+    Scene,
+    json=[
+        {"if": {"not": {"required": ["part"]}}, "then": {"required": ["material"]}},
+        {
+            "if": {"not": {"required": ["material"]}},
+            "then": {"properties": {"part": {"items": {"required": ["material"]}}}},
+        },
+    ],
+)
+def _parts_are_whole(v, raw, fail):
+    """Without [[part]], [material] is required; with it, every part has a material (its
+    own or [material]), the parts' names are unique, no region is in two parts, and a
+    wall's secondary.parts names parts."""
+    parts = v["parts"]
+    if not parts and v["material"] is None:
+        fail("material", "missing")
+    names: dict[str, int] = {}
+    regions: dict[str, int] = {}
+    for i, part in enumerate(parts):
+        if part.material is None and v["material"] is None:
+            fail(f"part[{i}].material", "missing: give it, or a [material] for the parts "
+                 "that give none")  # fmt: skip
+        if part.name in names:
+            fail(f"part[{i}].name", f"{part.name!r} is also the name of part[{names[part.name]}]")
+        names[part.name] = i
+        for region in part.volumes:
+            if region in regions:
+                fail(
+                    f"part[{i}].volumes",
+                    f"the region {region!r} is also in part[{regions[region]}]: a cell is in "
+                    "one part only",
+                )
+            regions[region] = i
+    known = list(names) or ["body"]
+    for i, wall in enumerate(v["walls"]):
+        for name in wall.secondary.parts:
+            if name not in known:
+                fail(
+                    f"wall[{i}].secondary.parts",
+                    f"unknown part {name!r}{did_you_mean(name, known)}; the parts: "
+                    + ", ".join(known),
+                )

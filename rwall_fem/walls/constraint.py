@@ -38,12 +38,14 @@ as external work.
 Cost: each step tests only the *near set*, the secondary nodes whose clearance
 (``shape.clearance``, a lower bound on how far a node must travel relative to the
 wall before the wall can treat it) was within a travel budget when the set was
-selected. Every step bounds how far any node and the wall may have travelled
-since (largest velocity and acceleration components of the rank's nodes, the
-wall's exact translation) and selects the set again, from all secondary nodes,
-before that bound passes the budget. No node the wall would treat is ever left
-out, so the results are those of testing every secondary node; each rank
-decides on its own nodes, without communication.
+selected. Every step bounds how far any secondary node and the wall may have
+travelled since (largest velocity and acceleration components of the rank's
+secondary nodes, the wall's exact translation) and selects the set again, from all
+secondary nodes, before that bound passes the budget. No node the wall would treat
+is ever left out, so the results are those of testing every secondary node; each
+rank decides on its own nodes, without communication. The passes over the nodes (the
+test, the impulses, the bound, the selection) are compiled
+(:mod:`rwall_fem.walls.contact`).
 """
 
 from __future__ import annotations
@@ -53,11 +55,11 @@ import math
 import numpy as np
 from mpi4py import MPI
 
+from rwall_fem.walls.contact import SLIDES, ContactPasses
 from rwall_fem.walls.motion import FixedMotion
 
 __all__ = ["RigidWall", "filter_alpha"]
 
-SLIDES = ("free", "tied", "friction")
 # The near set is selected for this many steps of travel at the speed bound of the moment.
 _HORIZON = 16
 # sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
@@ -132,21 +134,17 @@ class RigidWall:
         # the nodes then have (whatever acted on them after the wall).
         self._latest = None
         self._pending_driving = 0.0  # J
+        self._passes: ContactPasses | None = None  # the compiled passes, at the first step
         filtered = slide == "friction" and friction_filter is not None
         self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
         self._filtered_rows = self.nodes[:0]  # rows of it written in the latest step
         # Near set: the secondary nodes (positions in ``nodes``) tested this step; selected
         # at the first step (the budget, m, is -inf until then).
         self._near = self._near_nodes = self.nodes[:0]
-        self._near_X, self._near_mass = np.zeros((0, 3)), np.zeros((0, 1))
         self._budget, self._travel, self._anchor = -np.inf, 0.0, [0.0, 0.0, 0.0]
         self.initially_penetrated = 0
         self.deepest_penetration = 0.0  # m
         self.deepest_position = np.zeros(3)  # m
-
-    def masses_changed(self, state) -> None:
-        """Read again the masses of the nodes it tests (mass scaling added to them)."""
-        self._near_mass = state.mass[self._near_nodes][:, None]
 
     @property
     def work(self) -> float:
@@ -202,8 +200,6 @@ class RigidWall:
             "latest_final": final,  # empty: no latest step
             "filtered_rows": self._filtered_rows,
             "near": self._near,
-            "near_X": self._near_X,
-            "near_mass": self._near_mass,
             "near_budget": np.array([self._budget, self._travel, *self._anchor]),
         }
         if self._previous_tangential is not None:
@@ -227,13 +223,17 @@ class RigidWall:
         self._filtered_rows = arrays["filtered_rows"]
         if self._previous_tangential is not None:
             self._previous_tangential[:] = arrays["previous_tangential"]
-        self._near, self._near_X, self._near_mass = (
-            arrays[k] for k in ("near", "near_X", "near_mass")
-        )
+        self._near = arrays["near"]
         self._near_nodes = self.nodes[self._near]
         self._budget, self._travel, *self._anchor = arrays["near_budget"].tolist()
         motion = {k[7:]: v for k, v in arrays.items() if k.startswith("motion_")}
         self.motion.restore_state(motion)
+
+    def _passes_for(self, state) -> ContactPasses:
+        """The compiled passes on the arrays of ``state`` (made at its first step)."""
+        if self._passes is None or self._passes.state is not state:
+            self._passes = ContactPasses(self.shape, state)
+        return self._passes
 
     def settle(self, state) -> None:
         """Book the v^{n+1/2} halves of the work of the latest step's impulses with the
@@ -241,114 +241,101 @@ class RigidWall:
         masses change, and at the start of every step."""
         if self._latest is not None:
             nodes, normal, tangential, final = self._latest
-            w_new = state.v[nodes] - final
-            self.normal_work += 0.5 * (normal * w_new).sum()
+            passes = self._passes_for(state)
+            self.normal_work += 0.5 * passes.work(normal, final, nodes)
             if tangential is not None:
-                self.friction_work += 0.5 * (tangential * w_new).sum()
+                self.friction_work += 0.5 * passes.work(tangential, final, nodes)
             self._latest = None
         self.driving_work += self._pending_driving
         self._pending_driving = 0.0
 
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
-        dt, dt_v, motion, shape = state.dt, state.dt_velocity, self.motion, self.shape
+        dt, dt_v, motion = state.dt, state.dt_velocity, self.motion
+        passes = self._passes_for(state)
+        # First: the nodes' arrays of the latest step are filled again below.
+        self.settle(state)
         wall_velocity = motion.predict(state.t, dt)
         offset = motion.offset
         wall_next = offset + dt * wall_velocity
         if len(self.nodes):
-            self._follow(state, wall_velocity, wall_next)
+            self._follow(state, passes, wall_velocity, wall_next)
         near = self._near_nodes
-        v_old = state.v[near]
-        v_pred = v_old + dt_v * state.a[near]
-        x_now = self._near_X + state.u[near]
-        x_pred = x_now + dt * v_pred
-        crossing = shape.distance(x_pred, wall_next) < 0.0
-        if self.finite:
-            crossing &= shape.inside_patch(x_pred, wall_next)
-        hits = np.flatnonzero(crossing)  # positions in the near set of the nodes treated
-        target = np.zeros(len(hits))  # normal velocity relative to the wall after the step
-        if self.finite and len(hits):
-            d_now = shape.distance(x_now[hits], offset)
-            normal_speed = np.abs((v_pred[hits] - wall_velocity) @ shape.normal)
-            shallow = d_now >= -2.0 * dt * normal_speed  # deeper nodes pass behind the wall
-            hits, d_now = hits[shallow], d_now[shallow]
-            target = np.maximum(-d_now, 0.0) / dt  # back onto the surface in one step
+        k = passes.find(near, dt_v, dt, offset, wall_next, wall_velocity)
 
-        self.settle(state)
         if self.friction_filter is not None and self.friction_filter[0] == "frequency":
             self.filter_alpha = filter_alpha(self.friction_filter, dt)
-        self.contacts = len(hits)
-        self.touching = near[hits]  # nodes treated in the latest step
+        self.contacts = k
+        self.touching = passes.nodes[:k]  # nodes treated in the latest step
         kept = None
         if self._previous_tangential is not None:
             # Only the rows written in the previous step are non-zero: clear those alone.
-            rows = self._near[hits]
+            rows = self._near[passes.hits[:k]]
             kept = self._previous_tangential[rows]
             self._previous_tangential[self._filtered_rows] = 0.0
             self._filtered_rows = rows
-        if not len(hits) and not motion.dynamic:
+        if not k and not motion.dynamic:
             motion.advance(wall_velocity, dt)
             return
 
-        n = np.broadcast_to(shape.normals(x_now[hits], offset), (len(hits), 3))
-        m = self._near_mass[hits]
-        vs = v_pred[hits]
+        free = self.slide == "free"
         if motion.dynamic:
             predicted = wall_velocity
-            tied = np.full(len(hits), self.slide == "tied")
-            wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, tied)
-        normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
+            tied = np.full(k, self.slide == "tied")
+            wall_velocity = self._coupled_velocity(predicted, passes, k, tied)
+        passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
         if motion.dynamic and self.slide == "friction":
             # Second pass: sticking nodes move with the wall, slipping ones push it.
-            extra = np.where(slip[:, None], tangential, 0.0)
-            wall_velocity = self._coupled_velocity(predicted, m, n, vs, target, ~slip, extra)
-            normal, tangential, slip = self._impulses(m, n, vs - wall_velocity, target, kept)
+            slip = passes.slip[:k]
+            extra = np.where(slip[:, None], passes.tangential[:k], 0.0)
+            wall_velocity = self._coupled_velocity(predicted, passes, k, ~slip, extra)
+            passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
+        normal = passes.normal[:k]
+        tangential = None if free else passes.tangential[:k]
         if self._previous_tangential is not None:
             self._previous_tangential[self._filtered_rows] = tangential
-        impulse = normal if tangential is None else normal + tangential
-        state.a[self.touching] += impulse / (m * dt_v)
+        normal_sum, tangential_sum, impulse_sum = passes.apply(k, not free, dt_v)
 
         final = wall_velocity
         if motion.dynamic:
             # The main node takes exactly what the nodes received (momentum to round-off).
-            final = predicted - self.comm.allreduce(impulse.sum(axis=0)) / motion.mass
+            final = predicted - self.comm.allreduce(impulse_sum) / motion.mass
         before = motion.velocity
         motion.advance(final, dt)
-        w_old = v_old[hits] - before
-        self.normal_work += 0.5 * (normal * w_old).sum()
+        self.normal_work += 0.5 * passes.work(normal, before)
         if tangential is not None:
-            self.friction_work += 0.5 * (tangential * w_old).sum()
-            self.tangential_impulse -= tangential.sum(axis=0)
+            self.friction_work += 0.5 * passes.work(tangential, before)
+            self.tangential_impulse -= tangential_sum
         self._latest = (self.touching, normal, tangential, final)
         if motion.prescribed:
-            self.driving_work += 0.5 * impulse.sum(axis=0) @ before
-            self._pending_driving = 0.5 * impulse.sum(axis=0) @ final
-        self.normal_impulse -= normal.sum(axis=0)
-        if len(hits):
+            self.driving_work += 0.5 * impulse_sum @ before
+            self._pending_driving = 0.5 * impulse_sum @ final
+        self.normal_impulse -= normal_sum
+        if k:
             self.first_contact = min(self.first_contact, state.t)
             self.last_contact = state.t
 
-    def _follow(self, state, wall_velocity, wall_next) -> None:
+    def _follow(self, state, passes, wall_velocity, wall_next) -> None:
         """Keep the near set valid for this step's test; select it again when the nodes
         and the wall may have travelled, relative to each other, more than its budget.
 
         A node outside the set had a clearance above the budget when the set was
         selected, and clearance changes by at most the relative travel, so the test
         ``distance(x*, wall_next) < 0`` cannot be true for it while the travel bound
-        ``reach`` (m) stays within the budget. The bound uses the largest velocity
-        component of all owned nodes (two reductions each for ``v`` and ``a``, no
-        gather) and the wall's exact translation.
+        ``reach`` (m) stays within the budget. The bound uses the largest velocity and
+        acceleration components of the secondary nodes (one compiled pass) and the wall's
+        exact translation.
         """
         dt = state.dt
-        speed = _largest(state.v)  # bounds the components of v^{n-1/2}, m/s
+        speed, acceleration = passes.largest(self.nodes)  # bound |v^{n-1/2}| components, m/s
         self._travel += state.dt_previous * speed  # of x^n from where the set was selected
-        ahead = speed + state.dt_velocity * _largest(state.a)  # bounds those of v*, m/s
+        ahead = speed + state.dt_velocity * acceleration  # bounds those of v*, m/s
         wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster
         reach = _TRAVEL * (self._travel + dt * ahead) + wall_travel
         if not reach <= self._budget:  # also when NaN
-            self._select(state, ahead, wall_velocity)
+            self._select(state, passes, ahead, wall_velocity)
 
-    def _select(self, state, ahead: float, wall_velocity) -> None:
+    def _select(self, state, passes, ahead: float, wall_velocity) -> None:
         """Select the near set: the secondary nodes that can reach the wall within about
         ``_HORIZON`` steps at the current bound ``ahead`` (m/s) of the velocity
         components and the wall's velocity (m/s)."""
@@ -356,22 +343,21 @@ class RigidWall:
         self._budget = _HORIZON * dt * (_TRAVEL * ahead + math.hypot(*wall_velocity))
         self._travel = 0.0
         self._anchor = self.motion.offset.tolist()
-        x = state.X[self.nodes] + state.u[self.nodes]
-        clearance = self.shape.clearance(x, self.motion.offset)
+        clearance, largest = passes.clearance(self.nodes, self.motion.offset)
         # Rounding in positions and distances is far below 1e-12 of their size.
-        size = np.abs(x).max() + np.abs(self.position).max() + self._budget
+        size = largest + np.abs(self.position).max() + self._budget
         slack = self._budget + 1e-12 * size
         if not np.isfinite(slack):
             slack = np.inf  # every node with a finite position
         self._near = np.flatnonzero(clearance <= slack)
         self._near_nodes = self.nodes[self._near]
-        self._near_X = state.X[self._near_nodes]
-        self._near_mass = state.mass[self._near_nodes][:, None]
 
-    def _coupled_velocity(self, predicted, m, n, vs, target, tied, extra=None) -> np.ndarray:
+    def _coupled_velocity(self, predicted, passes, k, tied, extra=None) -> np.ndarray:
         """Velocity (m/s) of a main-node wall over the step when it moves with the mass of
-        the nodes it treats: normal motion shared by all, tangential by the ``tied`` ones;
-        ``extra`` impulses (N s) are given to the nodes on top."""
+        the k nodes in contact (``passes``): normal motion shared by all, tangential by the
+        ``tied`` ones; ``extra`` impulses (N s) are given to the nodes on top."""
+        m, n = passes.mass[:k, None], passes.normals[:k]
+        vs, target = passes.predicted[:k], passes.target[:k]
         P = np.where(tied[:, None, None], np.eye(3), np.einsum("ij,ik->ijk", n, n))
         matrix = np.einsum("i,ijk->jk", m[:, 0], P)
         rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
@@ -382,22 +368,3 @@ class RigidWall:
         return np.linalg.solve(
             mass * np.eye(3) + total[:9].reshape(3, 3), mass * predicted + total[9:]
         )
-
-    def _impulses(self, m, n, w, target, kept):
-        """Normal and tangential impulses (N s) for predicted relative velocities ``w``
-        (n, 3), and which nodes slip; no tangential impulse (None) for free sliding."""
-        wn = np.einsum("ij,ij->i", w, n)
-        normal = m * (target - wn)[:, None] * n
-        slip = np.zeros(len(w), dtype=bool)
-        if self.slide == "free":
-            return normal, None, slip
-        stick = -m * (w - wn[:, None] * n)
-        if self.slide == "tied":
-            return normal, stick, slip
-        if kept is not None:
-            stick = self.filter_alpha * stick + (1.0 - self.filter_alpha) * kept
-        limit = self.friction * np.linalg.norm(normal, axis=1)
-        size = np.linalg.norm(stick, axis=1)
-        slip = size > limit
-        stick[slip] *= (limit[slip] / size[slip])[:, None]
-        return normal, stick, slip

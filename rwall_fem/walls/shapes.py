@@ -90,11 +90,11 @@ class ParallelogramWall(PlaneWall):
         self.point = np.asarray(point, dtype=float)
         self.sides = np.array([corner1, corner2], dtype=float) - self.point  # L1, L2
         self.normal = _unit(np.cross(*self.sides), "(M1 - M) x (M2 - M)")
-        # (a, b) = inverse Gram matrix @ (L1 . r, L2 . r) for r in the plane.
-        self._dual = np.linalg.solve(self.sides @ self.sides.T, self.sides)
+        # (a, b) = dual @ r for r in the plane (the inverse Gram matrix @ (L1 . r, L2 . r)).
+        self.dual = np.linalg.solve(self.sides @ self.sides.T, self.sides)
         # Width (m) of the parallelogram across each pair of sides: a moves by at most
         # |dx| / width_a when x moves by dx.
-        self._widths = 1.0 / np.linalg.norm(self._dual, axis=1)
+        self.widths = 1.0 / np.linalg.norm(self.dual, axis=1)
 
     def parameters(self) -> dict:
         return {
@@ -105,15 +105,15 @@ class ParallelogramWall(PlaneWall):
 
     def inside_patch(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """Whether the projections of ``x`` on the plane fall inside the parallelogram."""
-        ab = (x - (self.point + offset)) @ self._dual.T
+        ab = (x - (self.point + offset)) @ self.dual.T
         return np.all((ab >= 0.0) & (ab <= 1.0), axis=1)
 
     def clearance(self, x: np.ndarray, offset=0.0) -> np.ndarray:
         """The larger of the signed distance to the plane and a lower bound on the distance
         to the prism over the parallelogram (m): a node is treated only inside the prism
         and behind the plane."""
-        ab = (x - (self.point + offset)) @ self._dual.T
-        beside = np.maximum(-ab, ab - 1.0) * self._widths
+        ab = (x - (self.point + offset)) @ self.dual.T
+        beside = np.maximum(-ab, ab - 1.0) * self.widths
         return np.maximum(self.distance(x, offset), beside.max(axis=1))
 
 

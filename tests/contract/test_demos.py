@@ -21,6 +21,7 @@ COARSE = {  # scene -> overrides that keep it to a few seconds
     "taylor_rod": ["mesh.element_size=0.0008", "run.dt_scale=0.1", "run.end_time=1e-5"],
     "taylor_johnson_cook": ["mesh.element_size=0.001", "run.end_time=1e-5"],
     "perforation_weldox": ["run.end_time=2e-5"],  # its mesh file's 2 mm: the first contact
+    "copper_nosed_striker": ["mesh.element_size=0.001", "run.end_time=1e-5"],
 }
 
 

@@ -113,6 +113,19 @@ def test_cell_estimates_hold_to_25_percent(mesh):
     assert estimate(scene).cells == pytest.approx(cells, rel=0.25)
 
 
+def test_parts_estimate_the_step_of_their_fastest_material():
+    """A scene of [[part]] without [material]: the part with the fastest waves sets the
+    estimated step, as one of that material alone would."""
+    mesh = {"shape": "bar", "size": [0.004, 0.004, 0.02], "element_size": 0.002,
+            "front_length": 0.006}  # fmt: skip
+    soft = STEEL | {"young": 21e9}
+    parts = parse_scene({"run": {"end_time": 1e-5}, "mesh": mesh, "part": [
+        {"name": "rod", "volumes": ["body"], "material": soft},
+        {"name": "nose", "volumes": ["front"], "material": STEEL}]})  # fmt: skip
+    alone = parse_scene({"run": {"end_time": 1e-5}, "mesh": mesh, "material": STEEL})
+    assert estimate(parts).steps == estimate(alone).steps
+
+
 def test_times_sample_the_first_step_at_or_after_each_time():
     """Outputs at times: due at the first step at or after each requested time, once per
     step however many times it passes, the rest at the last step; an evenly stepped run

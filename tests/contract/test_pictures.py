@@ -2,6 +2,7 @@
 the renderer's command line (``python -m rwall_fem.output.render``, ``rwall-fem render``)."""
 
 import copy
+import json
 import os
 import subprocess
 import sys
@@ -80,3 +81,31 @@ def test_the_renderer_has_a_help_and_refuses_in_one_line(tmp_path):
     empty = _render(tmp_path)
     assert empty.returncode == 2 and "no frame data" in empty.stderr
     assert len(empty.stderr.splitlines()) == 1
+
+
+def test_a_body_of_parts_is_coloured_by_part(shared_dir):
+    """output.color = "part": each cell of the frames holds its part's index (the 4 mm
+    front of the bar 0, the rest 1), mesh.npz the parts' names, and the renderer paints
+    each part in its own colour (tab10's blue and orange are both in the picture)."""
+    raw = bar_scene(elements=6, h=2e-3, cell="hexahedron", end_time=2e-6)
+    raw["output"].update(frames=2, color="part")
+    raw["mesh"]["front_length"] = 0.004
+    raw["part"] = [{"name": "nose", "volumes": ["front"]}, {"name": "body"}]
+    build_simulation(parse_scene(copy.deepcopy(raw), source="test"), out=shared_dir).run()
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    data = Path(shared_dir) / "frames" / "data"
+    mesh = np.load(data / "mesh.npz")
+    assert json.loads(str(mesh["parts"])) == ["nose", "body"]
+    cells = mesh["topology"].reshape(len(mesh["cell_types"]), -1)[:, 1:]
+    in_front = mesh["points"][cells][:, :, 2].mean(axis=1) < 0.004
+    for frame in sorted(data.glob("frame_*.npz")):
+        assert np.array_equal(np.load(frame)["cell_part"], np.where(in_front, 0.0, 1.0))
+    result = _render(shared_dir, "--color", "part")
+    assert result.returncode == 0, result.stderr
+    import imageio.v2 as imageio
+
+    picture = imageio.imread(Path(shared_dir) / "frames" / "frame_0001.png")[..., :3].reshape(-1, 3)
+    for colour in ("#1f77b4", "#ff7f0e"):
+        rgb = np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)])
+        assert (np.abs(picture.astype(int) - rgb).max(axis=1) <= 60).sum() > 50, colour

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SCENE, bar_scene
+from conftest import SCENE, StopAt, bar_scene
 from mpi4py import MPI
 
 import rwall_fem.checkpoint
@@ -69,22 +69,6 @@ SCENE_WITH_STATE = {
         "checkpoint_steps": 7,
     },
 }
-
-
-class StopAt:
-    """Recorder that, at ``step``, asks the run to stop as SIGTERM does."""
-
-    def __init__(self, step):
-        self.step = step
-
-    def due(self, s):
-        return s.step == self.step
-
-    def record(self, sim, s):
-        sim.stop_requests.add("SIGTERM")
-
-    def close(self, sim):
-        pass
 
 
 class Killed(Exception):

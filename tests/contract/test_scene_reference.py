@@ -112,6 +112,16 @@ BEYOND = {
     "104_wall_points_overflow",
     "207_erode_below_a_dt_min_above_the_step",
     "208_damage_colour_without_failure",  # the cell fields are the body's
+    # The parts: what the mesh's regions tell, and what ties keys of several tables.
+    "84_part_unknown_region",
+    "85_part_region_left_out",
+    "86_part_name_twice",
+    "87_part_region_twice",
+    "88_parts_bonded_at_different_speeds",
+    "90_secondary_parts_unknown",
+    "91_front_length_of_the_whole_bar",
+    "94_part_without_cells",
+    "95_part_density_1e-300",
 }
 
 

@@ -49,6 +49,8 @@ class BarDeck:
     engine: list[str] = field(default_factory=list)
     end_time: float = 2e-5
     extra_nodes: list[tuple[int, tuple[float, float, float]]] = field(default_factory=list)
+    front: int = 0  # layers from z0 whose bricks are the part front_part's (0: none)
+    front_part: int = 2
 
     @property
     def sizes(self):
@@ -56,9 +58,9 @@ class BarDeck:
 
     def q(self, value: float, quantity: str) -> float:
         """An SI value of ``quantity`` in the deck's units."""
-        m, l, t = self.sizes
+        mass, length, time = self.sizes
         a, b, c = DIM[quantity]
-        return value / (m**a * l**b * t**c)
+        return value / (mass**a * length**b * time**c)
 
     def node_id(self, i: int, j: int, k: int) -> int:
         return 1 + i + (self.nx + 1) * (j + (self.ny + 1) * k)
@@ -80,9 +82,10 @@ class BarDeck:
                                  "".join(f20(self.q(c, "length")) for c in x))  # fmt: skip
         for nid, x in self.extra_nodes:
             lines.append(i10(nid) + "".join(f20(self.q(c, "length")) for c in x))
-        lines.append("/BRICK/1")
         e = 0
         for k in range(self.nz):
+            if k in (0, self.front):
+                lines.append(f"/BRICK/{self.front_part if k < self.front else 1}")
             for j in range(self.ny):
                 for i in range(self.nx):
                     e += 1
@@ -107,8 +110,34 @@ class BarDeck:
 
     # --- cards, in SI arguments --------------------------------------------------------
 
-    def part(self, mat: int = 1, prop: int = 1, pid: int = 1) -> None:
-        self.cards += [f"/PART/{pid}", "the bar", "#  prop_ID    mat_ID", i10(prop) + i10(mat)]
+    def part(self, mat: int = 1, prop: int = 1, pid: int = 1, title: str = "the bar") -> None:
+        self.cards += [f"/PART/{pid}", title, "#  prop_ID    mat_ID", i10(prop) + i10(mat)]
+
+    def piece(self, pid: int, x0: float, nz: int, first: int) -> list[int]:
+        """A second bar of nx x ny x nz cells of the part ``pid`` beside this one, from
+        (x0, 0, z0): node and element IDs from ``first``; returns its node IDs."""
+        nodes = {}
+        lines = ["/NODE"]
+        for k in range(nz + 1):
+            for j in range(self.ny + 1):
+                for i in range(self.nx + 1):
+                    nodes[i, j, k] = first + len(nodes)
+                    x = (x0 + i * self.h, j * self.h, self.z0 + k * self.h)
+                    lines.append(i10(nodes[i, j, k]) +
+                                 "".join(f20(self.q(c, "length")) for c in x))  # fmt: skip
+        lines.append(f"/BRICK/{pid}")
+        e = first
+        for k in range(nz):
+            for j in range(self.ny):
+                for i in range(self.nx):
+                    n = lambda a, b, c: nodes[a, b, c]  # noqa: E731
+                    ids = [n(i, j, k), n(i + 1, j, k), n(i + 1, j + 1, k), n(i, j + 1, k),
+                           n(i, j, k + 1), n(i + 1, j, k + 1), n(i + 1, j + 1, k + 1),
+                           n(i, j + 1, k + 1)]  # fmt: skip
+                    lines.append(i10(e) + "".join(i10(q) for q in ids))
+                    e += 1
+        self.cards += lines
+        return list(nodes.values())
 
     def elastic(self, rho: float, E: float, nu: float, mid: int = 1) -> None:
         self.cards += [f"/MAT/LAW1/{mid}", "elastic", f20(self.q(rho, "density")),
@@ -137,8 +166,8 @@ class BarDeck:
                        "".join(f20(self.q(c, "length")) for c in low),
                        "".join(f20(self.q(c, "length")) for c in high)]  # fmt: skip
 
-    def initial_velocity(self, v, group: int) -> None:
-        self.cards += ["/INIVEL/TRA/1", "impact",
+    def initial_velocity(self, v, group: int, iid: int = 1) -> None:
+        self.cards += [f"/INIVEL/TRA/{iid}", "impact",
                        "".join(f20(self.q(c, "velocity")) for c in v) + i10(group) + i10(0),
                        f20(0.0) + i10(0)]  # fmt: skip
 

@@ -79,20 +79,28 @@ def missing_line(lines):
 
 CASES = {
     # name: (edit, the card's header or line text, what the message says)
-    "truncated line": (cut_brick, "/BRICK", r"truncated line: element 1 needs 8 node IDs, got 5"),
-    "field that does not parse": (bad_field, "/MAT/LAW1", r"field E \(columns 1-20\): cannot read '2.1.0e2"),
+    "truncated line": (
+        cut_brick, "/BRICK", r"truncated line: element 1 needs 8 node IDs, got 5"
+    ),
+    "field that does not parse": (
+        bad_field, "/MAT/LAW1", r"field E \(columns 1-20\): cannot read '2.1.0e2"
+    ),
     "ID that refers to nothing": (dangling_mat, "/PART", r"mat_ID 7 refers to no /MAT"),
     "part without a material": (no_material, "/PART", r"part 1 has no material"),
-    "unsupported card": (unsupported, "/INTER/TYPE7/1", r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN"),
+    "unsupported card": (
+        unsupported, "/INTER/TYPE7/1",
+        r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN",
+    ),
     "unsupported Isolid": (isolid, "/PROP", r"Isolid = 16: supported: 24"),
-    "truncated card": (missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"),
+    "truncated card": (
+        missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"
+    ),
 }  # fmt: skip
 
 
-@pytest.mark.parametrize("case", list(CASES))
-def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
-    edit, card, pattern = CASES[case]
-    path = written(good(), shared_dir, edit)
+def refused_in_one_line(path, card: str, pattern: str) -> None:
+    """Loading the deck ``path`` is refused in one line naming the file and a line of the
+    card whose header starts with ``card``, saying ``pattern``."""
     with pytest.raises(DeckError) as info:
         load_deck(path)
     message = str(info.value)
@@ -104,16 +112,69 @@ def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
     assert re.search(pattern, message), message
 
 
-def test_parts_of_two_materials_are_refused_naming_them(shared_dir):
-    d = good()
-    d.nz = 2
-    d.cards += ["/PART/2", "second", f"{1:10d}{2:10d}"]
-    d.elastic(2700.0, 70e9, 0.33, mid=2)
-    d.cards += ["/BRICK/2", f"{99:10d}" + "".join(f"{n:10d}" for n in (1, 2, 5, 4, 10, 11, 14, 13))]
-    path = written(d, shared_dir)
-    with pytest.raises(DeckError, match=r"parts 1 \(mat 1, prop 1\), 2 \(mat 2, prop 1\) differ "
-                       r"in material or property: .*\[\[part\]\], not built yet"):  # fmt: skip
-        load_deck(path)
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_deck_is_one_line_naming_file_and_line(case, shared_dir):
+    edit, card, pattern = CASES[case]
+    refused_in_one_line(written(good(), shared_dir, edit), card, pattern)
+
+
+def two_parts(*velocities) -> BarDeck:
+    """The bar of good() in two bonded parts of one material: 2 (the bottom layer, "front")
+    and 1 (the top one, "the_bar"), with an /INIVEL (velocity, part IDs) each."""
+    d = BarDeck(units="kg-mm-ms", nz=2, front=1)
+    d.part(pid=1)
+    d.part(pid=2, title="front")
+    d.elastic(7850.0, 210e9, 0.3)
+    d.solid(24)
+    for k, (v, parts) in enumerate(velocities, start=1):
+        d.group(k, "PART", parts)
+        d.initial_velocity(v, k, iid=k)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0)
+    return d
+
+
+def split_part() -> BarDeck:
+    d = BarDeck(units="kg-mm-ms", nz=2)
+    d.part()
+    d.elastic(7850.0, 210e9, 0.3)
+    d.solid(24)
+    d.group(2, "NODE", d.face_nodes(0))
+    d.initial_velocity((0, 0, -5.0), 2)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0)
+    return d
+
+
+INITIAL = {
+    # name: (the deck, the card named, what the message says)
+    "/INIVEL on some nodes of a part": (
+        split_part, "/INIVEL/TRA/1",
+        r"/INIVEL/TRA: group 2 holds 9 of the 27 nodes of /PART/1 \(the_bar; node 10 is not "
+        r"in it\): an initial velocity is given to whole parts",
+    ),
+    "bonded parts at different velocities": (
+        lambda: two_parts(((0, 0, -5.0), [1]), ((0, 0, -3.0), [2])), "/INIVEL/TRA/2",
+        r"/PART/1 \(the_bar\) and /PART/2 \(front\) share 9 nodes \(node 10: they are "
+        r"bonded\) but would start at \[0, 0, -5\] and \[0, 0, -3\] m/s: bonded parts start "
+        "together",
+    ),
+    "a bonded part left at rest": (
+        lambda: two_parts(((0, 0, -5.0), [1])), "/INIVEL/TRA/1",
+        r"would start at \[0, 0, -5\] and \[0, 0, 0\] m/s",
+    ),
+    "a second velocity of a part": (
+        lambda: two_parts(((0, 0, -5.0), [1, 2]), ((0, 0, -3.0), [1])), "/INIVEL/TRA/2",
+        r"a second initial velocity of /PART/1 \(the_bar\): \[0, 0, -3\] m/s after "
+        r"\[0, 0, -5\] m/s at .*model_0000.rad:\d+",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(INITIAL))
+def test_initial_velocity_not_of_whole_parts_is_one_line(case, shared_dir):
+    """/INIVEL gives whole parts their velocity, and bonded parts start together: anything
+    else is refused naming the /INIVEL card."""
+    deck, card, pattern = INITIAL[case]
+    refused_in_one_line(written(deck(), shared_dir), card, pattern)
 
 
 class Lines(logging.Handler):
@@ -132,17 +193,18 @@ def test_output_cards_are_skipped_with_one_warning_each(shared_dir):
     path = written(d, shared_dir)
     log, handler = logging.getLogger("rwall_fem"), Lines()
     log.addHandler(handler)  # the command line's tests stop its propagation to pytest
+    level = log.level  # and silence the ranks other than 0: every rank reads the deck here
+    log.setLevel(logging.INFO)
     try:
         load_deck(path)
     finally:
         log.removeHandler(handler)
+        log.setLevel(level)
     skipped = [line for line in handler.lines if "skipped" in line]
     assert [s.split(": ")[1] for s in skipped] == ["/TH/RWALL/1", "/ANIM/VECT/VEL", "/PRINT/-100"]
 
 
 @pytest.mark.serial
-@pytest.mark.skipif(".rad" not in open(sys.modules["rwall_fem.radioss"].__file__.replace(
-    "radioss/__init__.py", "cli.py")).read(), reason="needs the CLI wiring of docs/radioss.md")  # fmt: skip
 def test_command_line_exits_2_with_one_line(tmp_path):
     path = written(good(), tmp_path, no_material)
     done = subprocess.run([sys.executable, "-m", "rwall_fem", "check", str(path)],

@@ -114,51 +114,126 @@ WALLS = {
     # name: (deck cards, the scene's wall tables and other tables)
     "plane fixed, sliding, Dsearch": (
         lambda d: d.wall("PLANE", point=(0, 0, 0), m1=(0.3, 0.0, 1.0), dsearch=1.0),
-        {"wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0.3, 0.0, 1.0],
-                   "secondary": {"search_distance": 1.0}}]},
+        {
+            "wall": [
+                {
+                    "kind": "plane",
+                    "point": [0, 0, 0],
+                    "normal_point": [0.3, 0.0, 1.0],
+                    "secondary": {"search_distance": 1.0},
+                }
+            ]
+        },
     ),
     "plane on a main node, tied, grnd_ID1": (
-        lambda d: (d.extra_nodes.append((900, (0.0, 0.0, -2e-4))), d.group(3, "BOX", [1]),
-                   d.box(1, (-1, -1, -1e-4), (1, 1, 1e-4)),
-                   d.wall("PLANE", node=900, m1=(0, 0, 1), slide=1, add=3, mass=0.02,
-                          velocity=(0, 0, 1.0))),
-        {"wall": [{"kind": "plane", "point": [0, 0, -2e-4], "normal_point": [0, 0, 1],
-                   "slide": "tied", "secondary": {"add": ["bottom"]},
-                   "motion": {"mass": 0.02, "velocity": [0, 0, 1.0]}}]},
+        lambda d: (
+            d.extra_nodes.append((900, (0.0, 0.0, -2e-4))),
+            d.group(3, "BOX", [1]),
+            d.box(1, (-1, -1, -1e-4), (1, 1, 1e-4)),
+            d.wall(
+                "PLANE", node=900, m1=(0, 0, 1), slide=1, add=3, mass=0.02, velocity=(0, 0, 1.0)
+            ),
+        ),
+        {
+            "wall": [
+                {
+                    "kind": "plane",
+                    "point": [0, 0, -2e-4],
+                    "normal_point": [0, 0, 1],
+                    "slide": "tied",
+                    "secondary": {"add": ["bottom"]},
+                    "motion": {"mass": 0.02, "velocity": [0, 0, 1.0]},
+                }
+            ]
+        },
     ),
     "cylinder fixed, friction with a filter, grnd_ID2": (
-        lambda d: (d.group(4, "NODE", d.face_nodes(d.nz)),
-                   d.wall("CYL", point=(0.001, -1, -0.002), m1=(0.001, 1, -0.002), slide=2,
-                          friction=0.3, ffac=0.5, ifq=1, diameter=0.004, dsearch=1.0,
-                          exclude=4)),
-        {"wall": [{"kind": "cylinder", "point": [0.001, -1, -0.002],
-                   "axis_point": [0.001, 1, -0.002], "diameter": 0.004, "slide": "friction",
-                   "friction": 0.3, "friction_filter": {"coefficient": 0.5},
-                   "secondary": {"search_distance": 1.0, "exclude": ["top"]}}]},
+        lambda d: (
+            d.group(4, "NODE", d.face_nodes(d.nz)),
+            d.wall(
+                "CYL",
+                point=(0.001, -1, -0.002),
+                m1=(0.001, 1, -0.002),
+                slide=2,
+                friction=0.3,
+                ffac=0.5,
+                ifq=1,
+                diameter=0.004,
+                dsearch=1.0,
+                exclude=4,
+            ),
+        ),
+        {
+            "wall": [
+                {
+                    "kind": "cylinder",
+                    "point": [0.001, -1, -0.002],
+                    "axis_point": [0.001, 1, -0.002],
+                    "diameter": 0.004,
+                    "slide": "friction",
+                    "friction": 0.3,
+                    "friction_filter": {"coefficient": 0.5},
+                    "secondary": {"search_distance": 1.0, "exclude": ["top"]},
+                }
+            ]
+        },
     ),
     "sphere on a main node, prescribed by /IMPVEL": (
-        lambda d: (d.extra_nodes.append((901, (0.001, 0.001, -0.0031))),
-                   d.group(5, "NODE", [901]), d.function(7, [(0, 0), (1, 1), (3, 1)]),
-                   d.function(8, [(0, 0), (3, 0)]),
-                   d.imposed_velocity(1, 7, "Z", 5, 1e-5, 2.0),
-                   d.imposed_velocity(2, 7, "X", 5, 1e-5, 0.5),
-                   d.imposed_velocity(3, 8, "Y", 5, 1e-5, 1.0),
-                   d.wall("SPHER", node=901, diameter=0.006, dsearch=1.0, mass=1.0)),
-        {"wall": [{"kind": "sphere", "point": [0.001, 0.001, -0.0031], "diameter": 0.006,
-                   "secondary": {"search_distance": 1.0},
-                   "motion": {"velocity": [[0, 0, 0, 0], [1e-5, 0.5, 0, 2.0],
-                                           [3e-5, 0.5, 0, 2.0]]}}]},
+        lambda d: (
+            d.extra_nodes.append((901, (0.001, 0.001, -0.0031))),
+            d.group(5, "NODE", [901]),
+            d.function(7, [(0, 0), (1, 1), (3, 1)]),
+            d.function(8, [(0, 0), (3, 0)]),
+            d.imposed_velocity(1, 7, "Z", 5, 1e-5, 2.0),
+            d.imposed_velocity(2, 7, "X", 5, 1e-5, 0.5),
+            d.imposed_velocity(3, 8, "Y", 5, 1e-5, 1.0),
+            d.wall("SPHER", node=901, diameter=0.006, dsearch=1.0, mass=1.0),
+        ),
+        {
+            "wall": [
+                {
+                    "kind": "sphere",
+                    "point": [0.001, 0.001, -0.0031],
+                    "diameter": 0.006,
+                    "secondary": {"search_distance": 1.0},
+                    "motion": {
+                        "velocity": [[0, 0, 0, 0], [1e-5, 0.5, 0, 2.0], [3e-5, 0.5, 0, 2.0]]
+                    },
+                }
+            ]
+        },
     ),
     "parallelogram fixed, friction in steps, /BCS": (
-        lambda d: (d.group(6, "NODE", d.face_nodes(d.nz)), d.clamp(1, "   110 000", 6),
-                   d.wall("PARAL", point=(-0.001, -0.001, 0), m1=(0.003, -0.001, 0),
-                          m2=(-0.001, 0.0015, 0), slide=2, friction=0.2, ffac=20, ifq=2,
-                          dsearch=1.0)),
-        {"wall": [{"kind": "parallelogram", "point": [-0.001, -0.001, 0],
-                   "corner1": [0.003, -0.001, 0], "corner2": [-0.001, 0.0015, 0],
-                   "slide": "friction", "friction": 0.2, "friction_filter": {"steps": 20.0},
-                   "secondary": {"search_distance": 1.0}}],
-         "boundary": [{"group": "top", "components": "xy"}]},
+        lambda d: (
+            d.group(6, "NODE", d.face_nodes(d.nz)),
+            d.clamp(1, "   110 000", 6),
+            d.wall(
+                "PARAL",
+                point=(-0.001, -0.001, 0),
+                m1=(0.003, -0.001, 0),
+                m2=(-0.001, 0.0015, 0),
+                slide=2,
+                friction=0.2,
+                ffac=20,
+                ifq=2,
+                dsearch=1.0,
+            ),
+        ),
+        {
+            "wall": [
+                {
+                    "kind": "parallelogram",
+                    "point": [-0.001, -0.001, 0],
+                    "corner1": [0.003, -0.001, 0],
+                    "corner2": [-0.001, 0.0015, 0],
+                    "slide": "friction",
+                    "friction": 0.2,
+                    "friction_filter": {"steps": 20.0},
+                    "secondary": {"search_distance": 1.0},
+                }
+            ],
+            "boundary": [{"group": "top", "components": "xy"}],
+        },
     ),
 }
 

@@ -86,7 +86,7 @@ class Failures:
     in. ``events`` (every rank's cells, by step) is complete once the run has closed."""
 
     def __init__(self, sim):
-        self.force, self.comm = sim.internal, sim.comm
+        self.force, self.comm = sim.internal.elements[0], sim.comm  # the body's one part
         self.before = None
         self.events = []
         sim.recorders.append(self)
@@ -166,6 +166,36 @@ def test_eroded_cells_take_their_internal_energy(shared_dir):
     assert energy["max_balance_error"] <= 1e-12
     table = sim.history.energy  # the count column of energy.csv: 0, then all
     assert set(table[:, -1]) == {0.0, sim.info["cells"]}
+
+
+def test_a_part_that_fails_erodes_alone_and_the_books_close(shared_dir):
+    """The pulled bar of fully integrated hexahedra made of two parts of the same steel,
+    only the first cell's ("weak", the bar's front region) with the failure criterion: that
+    cell erodes at eps_f and takes the energy of uniaxial tension with it (as the bar of one
+    part does), the other part none; of the nodes, only the four that no other cell holds
+    are detached (those it shares with the other part stay held). The balance closes to
+    round-off and the parts' internal energies add up to the body's."""
+    raw = pull_scene("full")
+    h = raw["mesh"]["element_size"]
+    raw["mesh"]["front_length"] = h
+    raw["part"] = [
+        {"name": "weak", "volumes": ["front"], "material": raw.pop("material")},
+        {"name": "strong", "volumes": ["body"], "material": STEEL},
+    ]
+    sim, failures = pulled(raw, shared_dir)
+    summary = sim.history.summary
+    assert summary["erosion"]["eroded_cells"] == 1
+    assert summary["erosion"]["detached_nodes"] == 4
+    strain = np.mean([e[3] for e in failures.events])
+    A, H, E = STEEL["yield_stress"], STEEL["hardening_modulus"], STEEL["young"]
+    stress = A + H * strain
+    expected = h**3 * (A * strain + H * strain**2 / 2 + stress**2 / (2 * E))
+    energy = summary["energy"]
+    assert energy["eroded_internal"] == pytest.approx(expected, rel=2e-3)
+    assert energy["max_balance_error"] <= 1e-12
+    parts = {part["name"]: part["energy"] for part in summary["parts"]}
+    total = parts["weak"]["internal"] + parts["strong"]["internal"]
+    assert total == pytest.approx(energy["internal"], rel=1e-12, abs=1e-12 * expected)
 
 
 class Velocities:
@@ -327,7 +357,7 @@ def test_a_run_resumed_after_erosion_equals_the_uninterrupted_one(shared_dir):
     assert resumed.run() == "done"
     assert np.array_equal(resumed.state.u, whole.state.u)
     assert np.array_equal(resumed.internal.erosion.alive, whole.internal.erosion.alive)
-    assert np.array_equal(resumed.internal.history, whole.internal.history)
+    assert np.array_equal(resumed.internal.elements[0].history, whole.internal.elements[0].history)
     MPI.COMM_WORLD.Barrier()
     if MPI.COMM_WORLD.rank == 0:
         for name in ("energy.csv", "walls.csv"):
@@ -362,7 +392,8 @@ class ErodeFrom:
         return s.step == self.step
 
     def record(self, sim, s):
-        sim.internal.params.erode_step = self.floor
+        for force in sim.internal.elements:
+            force.params.erode_step = self.floor
 
     def close(self, sim):
         pass

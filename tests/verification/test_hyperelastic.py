@@ -70,7 +70,8 @@ def test_fixed_step_stops_when_the_limit_falls_below_it(shared_dir):
     raw = bar("neo_hookean")
     raw["run"]["time_step"] = "fixed"
     sim = build_simulation(parse_scene(raw, source="test"), MPI.COMM_WORLD, shared_dir)
-    sim.internal.params.calibration *= 0.5  # as if the deformation had halved the limit
+    for force in sim.internal.elements:  # as if the deformation had halved the limit
+        force.params.calibration *= 0.5
     status = sim.run()
     assert status.startswith("stopped: step 0, t = 0 s: the deformation lowered the stable")
     assert "below the fixed dt = " in status and "run.time_step = 'adaptive'" in status

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import STEEL_NU0, bar_scene, block_scene, run
+from conftest import STEEL_NU0, StopAt, bar_scene, block_scene, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
@@ -121,7 +121,7 @@ def test_the_books_close_to_round_off_whatever_the_steps(name, shared_dir, swing
     update, and the work of the step's changes (on K + U: what the integrator puts in
     when the step varies) is booked; it stays a few % of the energy here."""
     sim = swinging(wall_scenes()[name], shared_dir)
-    assert sim.update.corrects
+    assert sim.internal.corrects
     summary = sim.history.summary
     dt = sim.history.energy[:, -1]
     assert dt.max() > 1.3 * dt.min()
@@ -251,22 +251,6 @@ def test_a_viscous_hourglass_far_above_its_range_stays_stable(shared_dir):
     raw["run"]["time_step"] = "fixed"
     with pytest.raises(SceneError, match="element.hourglass_coefficient: the viscous hourglass"):
         run(raw, shared_dir / "fixed")
-
-
-class StopAt:
-    """Recorder that, at ``step``, asks the run to stop as SIGTERM does."""
-
-    def __init__(self, step):
-        self.step = step
-
-    def due(self, s):
-        return s.step == self.step
-
-    def record(self, sim, s):
-        sim.stop_requests.add("SIGTERM")
-
-    def close(self, sim):
-        pass
 
 
 def test_a_resumed_mass_scaled_run_equals_the_uninterrupted_one(shared_dir):

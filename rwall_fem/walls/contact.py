@@ -1,0 +1,171 @@
+"""The per-node passes of a wall's contact, compiled (``kernels/wall.c``).
+
+:class:`ContactPasses` holds, for one wall, the shape as the C code reads it and the
+arrays the passes fill, sized for the wall's near set: :meth:`~ContactPasses.find` lists
+the nodes in contact at a step, :meth:`~ContactPasses.impulses` gives their impulses for
+a wall velocity, :meth:`~ContactPasses.apply` adds them to the accelerations, and
+:meth:`~ContactPasses.work` sums the work of impulses; :meth:`~ContactPasses.clearance` and
+:meth:`~ContactPasses.largest` select and keep the near set. The arithmetic is NumPy's,
+operation for operation (``kernels/wall.c``), so that the results are those of the NumPy
+code that ``walls/constraint.py`` had before.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rwall_fem.kernels import load
+
+__all__ = ["SLIDES", "ContactPasses"]
+
+KINDS = ("plane", "parallelogram", "cylinder", "sphere")  # the order of kernels/wall.c
+SLIDES = ("free", "tied", "friction")  # likewise
+
+
+def _pointer(ffi, array: np.ndarray, kind: str = "double[]"):
+    if not array.flags.c_contiguous:
+        raise ValueError("the wall's passes need C-contiguous arrays")
+    return ffi.from_buffer(kind, array)
+
+
+def _shape_record(ffi, shape):
+    """The ``wall_shape`` of ``shape`` (a shape of :mod:`rwall_fem.walls.shapes`)."""
+    record = ffi.new("wall_shape *")
+    record.kind = KINDS.index(shape.kind)
+    record.point = shape.point.tolist()
+    if shape.kind in ("plane", "parallelogram"):
+        record.normal = shape.normal.tolist()
+    if shape.kind == "parallelogram":
+        record.dual = shape.dual.ravel().tolist()
+        record.widths = shape.widths.tolist()
+    if shape.kind == "cylinder":
+        record.axis = shape.axis.tolist()
+    if shape.kind in ("cylinder", "sphere"):
+        record.radius = shape.radius
+        record.fallback = np.broadcast_to(shape.fallback, 3).tolist()
+    return record
+
+
+class ContactPasses:
+    """The compiled passes of one wall of ``shape`` over the nodes of its near set, on the
+    arrays of ``state`` (a :class:`~rwall_fem.solver.State`, whose arrays never move).
+
+    After :meth:`find` returned k, the first k rows of :attr:`hits` (positions in the near
+    set), :attr:`nodes`, :attr:`mass` (kg), :attr:`normals`, :attr:`predicted` (v*, m/s),
+    :attr:`previous` (v^{n-1/2}, m/s) and :attr:`target` (m/s) describe the nodes in
+    contact; after :meth:`impulses`, :attr:`normal` and :attr:`tangential` (N s) and
+    :attr:`slip` their impulses. They are views of arrays the next :meth:`find` overwrites.
+    """
+
+    def __init__(self, shape, state):
+        self.ffi, self.lib = load()
+        self.state = state
+        self._shape = _shape_record(self.ffi, shape)
+        self._state = [_pointer(self.ffi, x) for x in (state.X, state.u, state.v, state.a)]
+        self._mass = _pointer(self.ffi, state.mass)
+        self._v, self._a = self._state[2:]
+        # offset, next offset and velocity of the wall (m, m, m/s), then the sums of apply
+        self._vectors = np.zeros(3 * 3 + 9)
+        self._vectors_pointer = _pointer(self.ffi, self._vectors)
+        self._clearance = np.zeros(0)
+        self._reserve(0)
+
+    def _reserve(self, n: int) -> None:
+        """Room for ``n`` nodes in contact (only ever grows: the near set changes often)."""
+        capacity = max(n, 16)
+        if getattr(self, "capacity", -1) >= capacity:
+            return
+        self.capacity = capacity
+        self.hits = np.zeros(capacity, dtype=np.int64)
+        self.nodes = np.zeros(capacity, dtype=np.int64)
+        self.mass = np.zeros(capacity)
+        self.target = np.zeros(capacity)
+        self.slip = np.zeros(capacity, dtype=bool)
+        vectors = ("normals", "predicted", "previous", "normal", "tangential", "_scratch")
+        for name in vectors:
+            setattr(self, name, np.zeros((capacity, 3)))
+        p = self.ffi.from_buffer
+        self._pointers = {
+            name: p("double[]", getattr(self, name)) for name in (*vectors, "mass", "target")
+        }
+        self._pointers |= {
+            "hits": p("int64_t[]", self.hits),
+            "nodes": p("int64_t[]", self.nodes),
+            "slip": p("uint8_t[]", self.slip),
+        }
+
+    def clearance(self, nodes: np.ndarray, offset) -> tuple[np.ndarray, float]:
+        """The clearance (m) of ``nodes`` (node indices, int64) from the wall at ``offset``
+        (m), as the shape's ``clearance``, and the largest absolute coordinate of their
+        positions (m; NaN if one is NaN)."""
+        if len(self._clearance) != len(nodes):
+            self._clearance = np.zeros(len(nodes))
+        self._vectors[0:3] = offset
+        largest = self.lib.wall_clearance(
+            len(nodes), _pointer(self.ffi, nodes, "int64_t[]"), self._state[0], self._state[1],
+            self._shape, self._vectors_pointer, _pointer(self.ffi, self._clearance),
+        )  # fmt: skip
+        return self._clearance, largest
+
+    def largest(self, nodes: np.ndarray) -> tuple[float, float]:
+        """The largest absolute component of the velocities (m/s) and of the accelerations
+        (m/s^2) of ``nodes`` (node indices, int64; NaN if one is NaN), in one pass."""
+        sums = self._vectors_pointer + 9
+        rows = _pointer(self.ffi, nodes, "int64_t[]")
+        self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
+        speed, acceleration = self._vectors[9:11].tolist()
+        return speed, acceleration
+
+    def find(self, near: np.ndarray, dt_v: float, dt: float, offset, wall_next, velocity) -> int:
+        """Test the nodes ``near`` (node indices, int64) against the wall at ``offset`` now
+        and ``wall_next`` after the step (m), moving at ``velocity`` (m/s) over it; returns
+        how many are in contact (listed in the arrays)."""
+        self._reserve(len(near))
+        vectors, q = self._vectors, self._pointers
+        vectors[0:3], vectors[3:6], vectors[6:9] = offset, wall_next, velocity
+        w = self._vectors_pointer
+        X, u, v, a = self._state
+        return self.lib.wall_find(
+            len(near), _pointer(self.ffi, near, "int64_t[]"), X, u, v, a, self._mass, dt_v,
+            dt, self._shape, w, w + 3, w + 6, q["hits"], q["nodes"], q["mass"], q["normals"],
+            q["predicted"], q["previous"], q["target"],
+        )  # fmt: skip
+
+    def impulses(self, k: int, slide: str, friction: float, alpha: float, velocity, kept=None):
+        """The impulses (N s) of the k nodes in contact for a wall moving at ``velocity``
+        (m/s): :attr:`normal`, :attr:`tangential` (not for ``slide`` "free") and
+        :attr:`slip`; ``kept`` (k, 3): the friction filter's previous impulses."""
+        self._vectors[6:9] = velocity
+        q = self._pointers
+        filtered = self.ffi.NULL if kept is None else _pointer(self.ffi, kept)
+        self.lib.wall_impulses(
+            k, SLIDES.index(slide), friction, alpha, q["mass"], q["normals"], q["predicted"],
+            self._vectors_pointer + 6, q["target"], filtered, q["normal"], q["tangential"],
+            q["slip"],
+        )  # fmt: skip
+
+    def apply(self, k: int, tangential: bool, dt_v: float) -> np.ndarray:
+        """Add the impulses of the k nodes in contact (the normal ones, and the tangential
+        if ``tangential``) to their accelerations, impulse / (m dt_v); returns the sums
+        over them of the normal, tangential and whole impulses (N s; rows of a (3, 3)
+        view)."""
+        q = self._pointers
+        t = q["tangential"] if tangential else self.ffi.NULL
+        sums = self._vectors_pointer + 9
+        self.lib.wall_apply(k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, sums)
+        return self._vectors[9:].reshape(3, 3)
+
+    def work(self, impulse: np.ndarray, velocity, nodes: np.ndarray | None = None) -> float:
+        """sum impulse . (v - ``velocity``) (N m/s) over the rows of ``impulse`` (k, 3):
+        with ``nodes``, v is the nodes' current velocity, else :attr:`previous`."""
+        k = len(impulse)
+        self._reserve(k)
+        self._vectors[6:9] = velocity
+        if nodes is None:
+            rows, v = self.ffi.NULL, self._pointers["previous"]
+        else:
+            rows, v = _pointer(self.ffi, nodes, "int64_t[]"), self._v
+        return self.lib.wall_work(
+            k, rows, _pointer(self.ffi, impulse), v, self._vectors_pointer + 6,
+            self._pointers["_scratch"],
+        )  # fmt: skip
