@@ -41,6 +41,7 @@ __all__ = [
     "Interrupted",
     "adopt",
     "at_once",
+    "deferred",
     "handling",
     "leave",
     "on_emergency",
@@ -79,6 +80,7 @@ class _Handling:
         self.received: str | None = None
         self.cleanups: list = []
         self.abrupt = 0  # depth of at_once() regions
+        self.deferring = 0  # depth of deferred() regions
         self.ended = threading.Event()
         self._said = threading.Lock()
         self._read, self._write = os.pipe()
@@ -100,7 +102,8 @@ class _Handling:
             return
         self.received = name
         stop_children()
-        raise Interrupted(name)
+        if not self.deferring:
+            raise Interrupted(name)
 
     def _watch(self) -> None:
         while True:
@@ -178,6 +181,25 @@ def at_once():
         yield
     finally:
         active.abrupt -= 1
+
+
+@contextlib.contextmanager
+def deferred():
+    """A region that a signal does not cut: :class:`Interrupted` is raised when it ends
+    (the watcher still ends the process if it lasts beyond :data:`GRACE_SECONDS`). For
+    objects whose destructor fails when a signal leaves them half made or half closed,
+    e.g. a VTK render window."""
+    if _ACTIVE is None:
+        yield
+        return
+    active, before = _ACTIVE, _ACTIVE.received
+    active.deferring += 1
+    try:
+        yield
+    finally:
+        active.deferring -= 1
+    if before is None and active.received is not None and not active.deferring:
+        raise Interrupted(active.received)
 
 
 @contextlib.contextmanager

@@ -74,43 +74,45 @@ def render_frames(directory: str | Path, color: str = "normal_velocity") -> list
     decimals = _time_decimals(frames, scale)
     files = []
     for path, frame, values, drawn in zip(paths, frames, paint.values, surfaces, strict=True):
-        plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW)
-        # Closed however the frame ends: a plotter that a stop signal leaves open fails in
-        # its destructor at exit, with a traceback.
-        try:
-            grid = body_grid(pyvista, mesh, frame)
-            (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
-            if "cell_eroded" in frame:  # eroded cells are not drawn, detached nodes are points
-                grid = grid.extract_cells(np.flatnonzero(frame["cell_eroded"] < 0.5))
-                loose = (mesh["points"] + frame["u"])[frame["detached"] > 0.5]
-                if len(loose):
-                    plotter.add_points(loose, color="#404040", point_size=3.0)
-            plotter.add_mesh(
-                grid,
-                scalars=paint.title,
-                clim=paint.clim,
-                cmap=paint.cmap,
-                n_colors=len(paint.names) or 256,
-                show_edges=edges,
-                edge_color="#404040",
-                line_width=0.5,
-                ambient=0.3,
-                diffuse=0.7,
-                show_scalar_bar=False,
-            )
-            _colour_bar(plotter, paint)
-            for wall, surface in zip(walls, drawn, strict=True):
-                if view.behind(wall):
-                    plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
-                else:
-                    plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
-            time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
-            plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
-            view.apply(plotter)
-            png = directory / "frames" / path.with_suffix(".png").name
-            plotter.screenshot(str(png))
-        finally:
-            plotter.close()
+        # A frame is not cut by a stop signal (interrupts.deferred: it is raised after the
+        # frame), and its plotter is closed however the frame ends: a VTK window left half
+        # made or half closed fails in its destructor at exit, with a traceback.
+        with interrupts.deferred():
+            plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW)
+            try:
+                grid = body_grid(pyvista, mesh, frame)
+                (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
+                if "cell_eroded" in frame:  # eroded cells are not drawn, detached nodes are points
+                    grid = grid.extract_cells(np.flatnonzero(frame["cell_eroded"] < 0.5))
+                    loose = (mesh["points"] + frame["u"])[frame["detached"] > 0.5]
+                    if len(loose):
+                        plotter.add_points(loose, color="#404040", point_size=3.0)
+                plotter.add_mesh(
+                    grid,
+                    scalars=paint.title,
+                    clim=paint.clim,
+                    cmap=paint.cmap,
+                    n_colors=len(paint.names) or 256,
+                    show_edges=edges,
+                    edge_color="#404040",
+                    line_width=0.5,
+                    ambient=0.3,
+                    diffuse=0.7,
+                    show_scalar_bar=False,
+                )
+                _colour_bar(plotter, paint)
+                for wall, surface in zip(walls, drawn, strict=True):
+                    if view.behind(wall):
+                        plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
+                    else:
+                        plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
+                time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
+                plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
+                view.apply(plotter)
+                png = directory / "frames" / path.with_suffix(".png").name
+                plotter.screenshot(str(png))
+            finally:
+                plotter.close()
         files.append(png)
     images = [imageio.imread(p) for p in files]
     imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)

@@ -68,6 +68,11 @@ FULL = {
 }
 
 # The same with the other mesh shapes and wall kinds, so that every key is somewhere allowed.
+FAILING = {
+    "model": "elastic_plastic", "density": 8930.0, "young": 117e9, "poisson": 0.35,
+    "hardening": "linear", "yield_stress": 400e6, "hardening_modulus": 1e8,
+    "failure": {"criterion": "johnson_cook", "d1": 0.05, "d2": 0.5, "d3": -1.5},
+}  # fmt: skip
 OTHERS = [
     FULL
     | {
@@ -107,6 +112,7 @@ OTHERS = [
             "hardening_curve": [[0.0, 400e6], [1.0, 500e6]],
         },  # fmt: skip
     },
+    FULL | {"material": FAILING, "part": [{"name": "body", "material": FAILING}]},
     FULL
     | {
         "mesh": {"file": "part.msh", "noise": {"amplitude": 1e-7}},
