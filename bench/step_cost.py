@@ -82,11 +82,11 @@ def main():
             params.estimate = estimate
             name = "kernel, estimating" if estimate else "kernel"
             times.setdefault(name, []).append(block(element._kernel, a.repeats))
-        body = sim.internal
+        internal = sim.internal
         plain = CentralDifference(state)
-        body.books_work = True  # as for a varying step: f . v summed, then body.book
-        booking = CentralDifference(state, body)
-        body.books_work = False
+        internal.books_work = True  # as for a varying step: f . v summed, then Body.book
+        booking = CentralDifference(state, internal)
+        internal.books_work = False
         times.setdefault("update", []).append(block(functools.partial(plain, state), a.repeats))
         times.setdefault("update, booking", []).append(
             block(functools.partial(booking, state), a.repeats)
