@@ -167,7 +167,7 @@ class Body:
         self.conservative = all(force.conservative for force in self.elements)
         self.plastic = any(force.plastic for force in self.elements)
         self.nodal_force = self.f.owned  # N, owned nodes
-        self.books_work = not self.conservative
+        self._books_work = not self.conservative
         # One part over all the owned cells: what its kernel notes of the steps is the body's.
         self._alone = len(parts) == 1 and np.array_equal(parts[0].cells, np.arange(owned))
         self.step = self.elements[0].step if self._alone else np.zeros(STEP_SLOTS)
@@ -181,6 +181,7 @@ class Body:
         self._interfaces = []
         if count > 1:
             self.labels = self._interface_cells()
+        self.books_work = self._books_work
         # The books per part (J): the work of its forces (or a stored energy's correction)
         # over the finished halves, its value at the latest step, and what is pending.
         self._done = np.zeros(count)
@@ -191,6 +192,19 @@ class Body:
         owned_nodes = V.dofmap.index_map.size_local
         self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
         self.failure = any(force.failure is not None for force in self.elements)
+
+    @property
+    def books_work(self) -> bool:
+        """Whether the update sums the work of the body's force and hands it to
+        :meth:`book`; only then do the kernels keep the forces of the cells at interfaces
+        of parts (the books of the parts need them)."""
+        return self._books_work
+
+    @books_work.setter
+    def books_work(self, books: bool) -> None:
+        self._books_work = books
+        for force in self.elements:
+            force.keep_interface_forces(books)
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -239,7 +253,7 @@ class Body:
             force.compute(state)
         if self.books_work and self._interfaces:
             self._interface_first = np.array(
-                [self._interface_work(k, self.v.array) for k in range(len(self.elements))]
+                [self._interface_work(k) for k in range(len(self.elements))]
             )
         self.f.scatter_reverse_add()
         if not self._alone:
@@ -287,7 +301,7 @@ class Body:
         dt_v, change = self._pending
         self._pending = None
         for k, force in enumerate(self.elements):
-            second = self._interface_work(k, self.v.array)
+            second = self._interface_work(k)
             if force.conservative:
                 self._done[k] -= change * second
             else:
@@ -323,17 +337,27 @@ class Body:
             slots = np.full(force.num_cells, -1, dtype=np.int32)
             slots[interface] = np.arange(len(interface), dtype=np.int32)
             force.track_interface(slots)
-            self._interfaces.append((force.cells[interface], at[interface]))
+            # Its shared nodes' entries among the kept forces' rows (slot x node), and nodes.
+            entries = np.flatnonzero(at[interface].ravel()).astype(np.int64)
+            nodes = np.ascontiguousarray(force.cells[interface].ravel()[entries], np.int32)
+            ffi = force.ffi
+            work = functools.partial(
+                force.lib.interface_work,
+                len(entries),
+                *(ffi.cast(kind, a.ctypes.data) for kind, a in (
+                    ("int64_t *", entries), ("int32_t *", nodes),
+                    ("double *", force.interface_force), ("double *", self.v.array))),
+            )  # fmt: skip
+            self._interfaces.append((entries, nodes, work))  # the arrays kept alive with it
         owned = self.V.dofmap.index_map.size_local
         labels = np.where(shared, -1, self.held.argmax(axis=1))[:owned]
         return np.ascontiguousarray(labels, dtype=np.int32)
 
-    def _interface_work(self, k: int, v: np.ndarray) -> float:
-        """sum over part k's interface cells of their forces . ``v`` at their shared nodes
-        (N m/s; each cell and node once over the ranks, the cells being owned)."""
-        nodes, at = self._interfaces[k]
-        fe = self.elements[k].interface_force
-        return float(np.einsum("cni,cni,cn->", fe, v[nodes], at))
+    def _interface_work(self, k: int) -> float:
+        """sum over part k's interface cells of their forces . v (the velocity field's
+        current values) at their shared nodes (N m/s; each cell and node once over the
+        ranks, the cells being owned)."""
+        return self._interfaces[k][2]()
 
     # --- energies ----------------------------------------------------------------------
 
