@@ -120,12 +120,8 @@ INLINE void hex8_force(int model, int64_t num_cells, const int32_t *restrict cel
       increments(p, cells, 8, &b, du);
       erode(p, failed, &b, energy_left(w, du, fe, 8), VZERO, VZERO, fe, 8, energy, step);
     }
-    scatter_add(cells, 8, &b, fe, f);
-    note_interface(p, &b, 8, fe);
     total += lane_sum(vselect(failed, VZERO, w), b.nb);
-    note_inverted(inverted & ~failed, &b, x, ue, 8, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 8, step);
+    add_batch(p, cells, 8, &b, inverted, failed, dte, x, ue, fe, f, step);
   }
   energy[0] += total;
 }
@@ -226,12 +222,8 @@ void hex8_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 8), plastic_total,
             VZERO, fe, 8, energy, step);
     }
-    scatter_add(cells, 8, &b, fe, f);
-    note_interface(p, &b, 8, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 8, step);
+    add_batch(p, cells, 8, &b, inverted, failed, dte, x, NULL, fe, f, step);
   }
   energy[0] += stored;
   energy[2] += dissipated;

@@ -314,15 +314,11 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
       erode(p, failed, &b, energy_left(stored + held, du, fe, 8), VZERO, dissipated, fe, 8,
             energy, step);
     }
-    scatter_add(cells, 8, &b, fe, f);
-    note_interface(p, &b, 8, fe);
     total += lane_sum(vselect(failed, VZERO, stored), b.nb);
-    hourglass_total += lane_sum(
-        hourglass == HOURGLASS_VISCOUS ? hourglass_energy : vselect(failed, VZERO, hourglass_energy),
-        b.nb);
-    note_inverted(inverted & ~failed, &b, x, ue, 8, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 8, step);
+    /* the viscous form's work of this step counts (erode took the cell's total back out) */
+    const vec kept = vselect(failed, VZERO, hourglass_energy);
+    hourglass_total += lane_sum(hourglass == HOURGLASS_VISCOUS ? hourglass_energy : kept, b.nb);
+    add_batch(p, cells, 8, &b, inverted, failed, dte, x, ue, fe, f, step);
   }
   energy[0] += total;
   energy[1] += hourglass_total;
@@ -432,12 +428,8 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
       erode(p, failed, &b, energy_left(elastic + plastic_total + hourglass_total, du, fe, 8),
             plastic_total, hourglass_total, fe, 8, energy, step);
     }
-    scatter_add(cells, 8, &b, fe, f);
-    note_interface(p, &b, 8, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    note_inverted(inverted & ~failed, &b, x, NULL, 8, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 8, step);
+    add_batch(p, cells, 8, &b, inverted, failed, dte, x, NULL, fe, f, step);
   }
   energy[0] += stored;
   energy[1] += hourglass_work;

@@ -98,12 +98,8 @@ INLINE void tet4_force(int model, int64_t num_cells, const int32_t *restrict cel
       increments(p, cells, 4, &b, du);
       erode(p, failed, &b, energy_left(w, du, fe, 4), VZERO, VZERO, fe, 4, energy, step);
     }
-    scatter_add(cells, 4, &b, fe, f);
-    note_interface(p, &b, 4, fe);
     total += lane_sum(vselect(failed, VZERO, w), b.nb);
-    note_inverted(inverted & ~failed, &b, x, ue, 4, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, ue, 4, step);
+    add_batch(p, cells, 4, &b, inverted, failed, dte, x, ue, fe, f, step);
   }
   energy[0] += total;
 }
@@ -165,12 +161,8 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 4), plastic_total,
             VZERO, fe, 4, energy, step);
     }
-    scatter_add(cells, 4, &b, fe, f);
-    note_interface(p, &b, 4, fe);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 4, step);
+    add_batch(p, cells, 4, &b, inverted, failed, dte, x, NULL, fe, f, step);
   }
   energy[0] += stored;
   energy[2] += dissipated;

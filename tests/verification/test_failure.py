@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import run
+from conftest import StopAt, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
@@ -323,22 +323,6 @@ def test_the_same_cells_erode_on_any_number_of_ranks(shared_dir, tmp_path):
         assert e.shape == f.shape
         assert np.array_equal(e[:, -1], f[:, -1])  # the eroded cells, sample by sample
         assert np.abs(e[:, 1:-2] - f[:, 1:-2]).max() <= 1e-10 * np.abs(f[:, 1:-2]).max()
-
-
-class StopAt:
-    """Recorder that, at ``step``, asks the run to stop as SIGTERM does."""
-
-    def __init__(self, step):
-        self.step = step
-
-    def due(self, s):
-        return s.step == self.step
-
-    def record(self, sim, s):
-        sim.stop_requests.add("SIGTERM")
-
-    def close(self, sim):
-        pass
 
 
 def test_a_run_resumed_after_erosion_equals_the_uninterrupted_one(shared_dir):
