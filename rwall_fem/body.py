@@ -192,6 +192,7 @@ class Body:
         owned_nodes = V.dofmap.index_map.size_local
         self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
         self.failure = any(force.failure is not None for force in self.elements)
+        self._name_energies()
 
     @property
     def books_work(self) -> bool:
@@ -206,30 +207,27 @@ class Body:
         for force in self.elements:
             force.keep_interface_forces(books)
 
-    @property
-    def energy_names(self) -> tuple[str, ...]:
-        """The energies of the balance: ``"internal"``, ``"hourglass"`` when some part has
-        hourglass control, ``"eroded_internal"`` when some part's cells may erode."""
+    def _name_energies(self) -> None:
+        """:attr:`energy_names`, the energies of the balance: ``"internal"``,
+        ``"hourglass"`` when some part has hourglass control, ``"eroded_internal"`` when
+        some part's cells may erode; :attr:`energy_parts`, those reported beside them:
+        ``"elastic"`` and ``"plastic_work"`` of elasto-plastic parts, ``"eroded_kinetic"``
+        (detached nodes) when cells may erode; :attr:`erosion`, the eroded cells and
+        detached nodes, None when no part's cells may erode."""
         names = {name for force in self.elements for name in force.energy_names}
-        return tuple(n for n in ("internal", "hourglass", "eroded_internal") if n in names)
-
-    @property
-    def energy_parts(self) -> tuple[str, ...]:
-        """Parts of the energies reported beside them: ``"elastic"`` and ``"plastic_work"``
-        of elasto-plastic parts, ``"eroded_kinetic"`` (detached nodes) when cells may erode."""
-        names = {name for force in self.elements for name in force.energy_parts}
-        return tuple(n for n in ("elastic", "plastic_work", "eroded_kinetic") if n in names)
-
-    @property
-    def erosion(self) -> ErodedParts | None:
-        """The eroded cells and detached nodes, None when no part's cells may erode."""
-        return self._eroded if any(f.erosion for f in self.elements) else None
+        parts = {name for force in self.elements for name in force.energy_parts}
+        order = ("internal", "hourglass", "eroded_internal")
+        self.energy_names = tuple(n for n in order if n in names)
+        order = ("elastic", "plastic_work", "eroded_kinetic")
+        self.energy_parts = tuple(n for n in order if n in parts)
+        self.erosion = self._eroded if any(f.erosion for f in self.elements) else None
 
     def erode_below(self, floor: float) -> None:
         """From now on, erode the cells of every part whose step estimate falls below
         ``floor`` (s), and inverted ones (collective)."""
         for force in self.elements:
             force.erode_below(floor)
+        self._name_energies()
 
     def detach_nodes(self) -> None:
         """Count the live cells of the nodes again after a step in which some rank eroded
@@ -367,10 +365,13 @@ class Body:
         ``"hourglass"`` when some part has hourglass control, and for elasto-plastic
         parts ``"elastic"`` and ``"plastic_work"``, their sums over the parts."""
         each = self.part_energies(state, kinetic=False)
-        energies = {name: sum(e.get(name, 0.0) for e in each) for name in self.energy_names}
-        for name in self.energy_parts:
-            energies[name] = sum(e.get(name, 0.0) for e in each)
-        if "eroded_kinetic" in energies:
+        if len(each) == 1:
+            energies = each[0]
+        else:
+            energies = {n: sum(e.get(n, 0.0) for e in each) for n in self.energy_names}
+            for name in self.energy_parts:
+                energies[name] = sum(e.get(name, 0.0) for e in each)
+        if self.erosion is not None:
             energies["eroded_kinetic"] = self._eroded.kinetic_energy(state)
         return energies
 
