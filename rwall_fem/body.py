@@ -191,7 +191,6 @@ class Body:
         self.part_masses = None  # (owned nodes, parts), kg: set by the builder
         owned_nodes = V.dofmap.index_map.size_local
         self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
-        self.failure = any(force.failure is not None for force in self.elements)
         self._name_energies()
 
     @property
