@@ -14,8 +14,8 @@ part, as LS-DYNA's MATSUM does, and add up to the body's to round-off:
 - a part without a stored energy (plasticity, the viscous hourglass form) books the work
   of its own forces at mid-step velocities: on the nodes that only its cells hold they are
   the body's (the update pass sums them part by part, after :attr:`Body.labels`); at the
-  nodes its cells share with another part, its cells' own (their kernels keep the forces
-  of those cells: :meth:`~rwall_fem.elements.ElementForce.track_interface`);
+  nodes its cells share with another part, its cells' own: what its kernel pass added to
+  the body's force there (:meth:`Body.accelerate` takes the difference);
 - a node's kinetic energy and momentum go to the parts by their shares of its mass.
 
 When the step varies, a stored energy misses what the changes of the step take out of
@@ -167,7 +167,7 @@ class Body:
         self.conservative = all(force.conservative for force in self.elements)
         self.plastic = any(force.plastic for force in self.elements)
         self.nodal_force = self.f.owned  # N, owned nodes
-        self._books_work = not self.conservative
+        self.books_work = not self.conservative
         # One part over all the owned cells: what its kernel notes of the steps is the body's.
         self._alone = len(parts) == 1 and np.array_equal(parts[0].cells, np.arange(owned))
         self.step = self.elements[0].step if self._alone else np.zeros(STEP_SLOTS)
@@ -176,12 +176,12 @@ class Body:
         count = len(parts)
         self.held = held_nodes(V, self.elements)  # (owned + ghost nodes, parts): their cells'
         # Each owned node's part when that part's cells alone hold it, else -1 (an
-        # interface: the forces of the cells there are kept by their kernels).
+        # interface); the rows (owned and ghost) of the interface nodes, and per part the
+        # forces its cells put on them at the latest step (N).
         self.labels, self.part_sums = None, np.zeros(2 * count)
-        self._interfaces = []
+        self._shared, self._interface_force, self._interface_works = None, None, []
         if count > 1:
-            self.labels = self._interface_cells()
-        self.books_work = self._books_work
+            self.labels = self._interfaces()
         # The books per part (J): the work of its forces (or a stored energy's correction)
         # over the finished halves, its value at the latest step, and what is pending.
         self._done = np.zeros(count)
@@ -192,19 +192,6 @@ class Body:
         owned_nodes = V.dofmap.index_map.size_local
         self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
         self._name_energies()
-
-    @property
-    def books_work(self) -> bool:
-        """Whether the update sums the work of the body's force and hands it to
-        :meth:`book`; only then do the kernels keep the forces of the cells at interfaces
-        of parts (the books of the parts need them)."""
-        return self._books_work
-
-    @books_work.setter
-    def books_work(self, books: bool) -> None:
-        self._books_work = books
-        for force in self.elements:
-            force.keep_interface_forces(books)
 
     def _name_energies(self) -> None:
         """:attr:`energy_names`, the energies of the balance: ``"internal"``,
@@ -246,12 +233,17 @@ class Body:
         if self.books_work:
             self._second_halves_at_interfaces()
         self.f.array.fill(0.0)
-        for force in self.elements:
+        shared = self._shared if self.books_work else None
+        for k, force in enumerate(self.elements):
+            if shared is not None:  # what this part adds at the interfaces
+                kept = self._interface_force[k]
+                np.take(self.f.array, shared, axis=0, out=self._before, mode="clip")
             force.compute(state)
-        if self.books_work and self._interfaces:
-            self._interface_first = np.array(
-                [self._interface_work(k) for k in range(len(self.elements))]
-            )
+            if shared is not None:
+                np.take(self.f.array, shared, axis=0, out=kept, mode="clip")
+                kept -= self._before
+        if shared is not None:
+            self._interface_first = np.array([work() for work in self._interface_works])
         self.f.scatter_reverse_add()
         if not self._alone:
             self._combine_steps()
@@ -298,7 +290,7 @@ class Body:
         dt_v, change = self._pending
         self._pending = None
         for k, force in enumerate(self.elements):
-            second = self._interface_work(k)
+            second = self._interface_works[k]()
             if force.conservative:
                 self._done[k] -= change * second
             else:
@@ -324,37 +316,29 @@ class Body:
 
     # --- parts that share nodes --------------------------------------------------------
 
-    def _interface_cells(self) -> np.ndarray:
-        """The owned nodes' labels (a part, or -1 at an interface); every part's kernel is
-        told to keep the forces of its cells that touch an interface."""
+    def _interfaces(self) -> np.ndarray:
+        """The owned nodes' labels: a part when that part's cells alone hold the node, -1
+        at an interface of parts; makes room for the parts' forces at the interface nodes
+        (owned and ghost rows) and the compiled sums of their work."""
         shared = (self.held > 0).sum(axis=1) > 1  # owned and ghost nodes
-        for force in self.elements:
-            at = shared[force.cells]  # (cells, nodes): its cells' shared nodes
-            interface = np.flatnonzero(at.any(axis=1))
-            slots = np.full(force.num_cells, -1, dtype=np.int32)
-            slots[interface] = np.arange(len(interface), dtype=np.int32)
-            force.track_interface(slots)
-            # Its shared nodes' entries among the kept forces' rows (slot x node), and nodes.
-            entries = np.flatnonzero(at[interface].ravel()).astype(np.int64)
-            nodes = np.ascontiguousarray(force.cells[interface].ravel()[entries], np.int32)
-            ffi = force.ffi
-            work = functools.partial(
-                force.lib.interface_work,
-                len(entries),
-                *(ffi.cast(kind, a.ctypes.data) for kind, a in (
-                    ("int64_t *", entries), ("int32_t *", nodes),
-                    ("double *", force.interface_force), ("double *", self.v.array))),
-            )  # fmt: skip
-            self._interfaces.append((entries, nodes, work))  # the arrays kept alive with it
+        self._shared = np.flatnonzero(shared).astype(np.int32)
+        count, rows = len(self.elements), len(self._shared)
+        self._before = np.zeros((rows, 3))
+        self._interface_force = np.zeros((count, rows, 3))
+        lib, ffi = self.elements[0].lib, self.elements[0].ffi
+        for k in range(count):  # sum of part k's forces . v at the interface nodes (W)
+            self._interface_works.append(
+                functools.partial(
+                    lib.interface_work,
+                    rows,
+                    ffi.cast("int32_t *", self._shared.ctypes.data),
+                    ffi.cast("double *", self._interface_force[k].ctypes.data),
+                    ffi.cast("double *", self.v.array.ctypes.data),
+                )
+            )
         owned = self.V.dofmap.index_map.size_local
         labels = np.where(shared, -1, self.held.argmax(axis=1))[:owned]
         return np.ascontiguousarray(labels, dtype=np.int32)
-
-    def _interface_work(self, k: int) -> float:
-        """sum over part k's interface cells of their forces . v (the velocity field's
-        current values) at their shared nodes (N m/s; each cell and node once over the
-        ranks, the cells being owned)."""
-        return self._interfaces[k][2]()
 
     # --- energies ----------------------------------------------------------------------
 
@@ -536,10 +520,10 @@ class Body:
         }
         if self.part_masses is not None:
             arrays["part_masses"] = self.part_masses
+        if self._interface_force is not None:
+            arrays["interface_force"] = self._interface_force
         for k, force in enumerate(self.elements):
             arrays |= {f"part{k}_{name}": a for name, a in force.checkpoint_state().items()}
-            if force.interface_force is not None:
-                arrays[f"part{k}_interface_force"] = force.interface_force
         return arrays
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
@@ -551,11 +535,11 @@ class Body:
         self._pending = None if np.isnan(pending[0]) else tuple(pending)
         if "part_masses" in arrays:
             self.part_masses[:] = arrays["part_masses"]
+        if self._interface_force is not None:
+            self._interface_force[...] = arrays["interface_force"]
         for k, force in enumerate(self.elements):
             prefix = f"part{k}_"
             mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
-            if force.interface_force is not None:
-                force.interface_force[...] = mine.pop("interface_force")
             force.restore_state(mine)
 
 

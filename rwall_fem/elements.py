@@ -235,7 +235,6 @@ class ElementForce:
             self._erode()
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
         self._accelerate = None
-        self.interface_force = None  # the nodal forces of its cells at an interface of parts
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -480,23 +479,6 @@ class ElementForce:
     def plastic_strains(self) -> np.ndarray:
         """The equivalent plastic strain of every integration point of the owned cells."""
         return self.history[POINT_SLOTS - 2 : self.points * POINT_SLOTS : POINT_SLOTS]
-
-    def track_interface(self, slots: np.ndarray) -> None:
-        """Room for the nodal forces (N) of the cells with a slot (``slots``: per cell its
-        row of :attr:`interface_force`, or -1): cells at an interface of parts, whose nodes'
-        forces the parts share (:mod:`rwall_fem.body`); :meth:`keep_interface_forces` has
-        :meth:`compute` keep them."""
-        self._slots = np.ascontiguousarray(slots, dtype=np.int32)
-        count = int(self._slots.max(initial=-1)) + 1
-        self.interface_force = np.zeros((count, self.cells.shape[1], 3))
-        self.params.interface_force = self.ffi.cast("double *", self.interface_force.ctypes.data)
-
-    def keep_interface_forces(self, keep: bool) -> None:
-        """Whether :meth:`compute` keeps the forces of the interface cells (after
-        :meth:`track_interface`; a kernel pass that keeps them costs some 10 % more)."""
-        if self.interface_force is not None:
-            slots = self.ffi.cast("int32_t *", self._slots.ctypes.data)
-            self.params.interface = slots if keep else self.ffi.NULL
 
     def compute(self, state) -> None:
         """Add the internal force f_int(u^n) of its cells into :attr:`f` (owned and ghost

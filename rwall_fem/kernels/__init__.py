@@ -97,8 +97,6 @@ typedef struct {
   double *cell_work;
   int64_t cell_stride;
   const double *velocity;
-  const int32_t *interface;
-  double *interface_force;
 } element_params;
 double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);
@@ -125,8 +123,7 @@ void central_difference(int64_t n, double dt_v, double dt, const double *mass, c
                         double *v, double *u, const double *f, double out[9],
                         double integral[3], double momentum[3], const int32_t *labels,
                         double *part_sums);
-double interface_work(int64_t n, const int64_t *entries, const int32_t *nodes, const double *f,
-                      const double *v);
+double interface_work(int64_t n, const int32_t *nodes, const double *f, const double *v);
 typedef struct {
   int kind;
   double point[3], normal[3], dual[6], widths[2], axis[3], radius, fallback[3];

@@ -76,9 +76,6 @@ typedef struct
                                    (row 1) so far, J, rows of cell_stride values */
   int64_t cell_stride;
   const double *velocity;       /* v^{n-1/2} of the nodes, m/s (what an eroded cell did last) */
-  /* a body of parts (rwall_fem/body.py) */
-  const int32_t *interface;     /* NULL, or per cell its slot in interface_force (-1: none) */
-  double *interface_force;      /* the nodal forces (N) of the cells with a slot, 3 npe each */
 } element_params;
 
 /* The cells of a batch: lane k holds cell id[k] (the lanes from nb on repeat the first);
@@ -253,22 +250,6 @@ INLINE void set_cell_values(double *restrict a, const batch_t *b, vec v)
   else
     for (int k = 0; k < b->nb; ++k)
       a[b->id[k]] = v[k];
-}
-
-/* Keep the nodal forces fe[3 I + i] of the cells of the batch that p->interface gives a
- * slot (cells at the interface of two parts, whose nodes' forces the parts share). */
-INLINE void note_interface(const element_params *p, const batch_t *b, int npe,
-                           const vec *restrict fe)
-{
-  if (!p->interface)
-    return;
-  for (int k = 0; k < b->nb; ++k)
-  {
-    const int32_t slot = p->interface[b->id[k]];
-    if (slot >= 0)
-      for (int j = 0; j < 3 * npe; ++j)
-        p->interface_force[3 * npe * (int64_t)slot + j] = fe[j][k];
-  }
 }
 
 /* The sum of the first nb lanes. */

@@ -143,16 +143,15 @@ INLINE void increments(const element_params *p, const int32_t *restrict cells, i
     du[i] *= p->dt;
 }
 
-/* The end of a batch: add its (live) cells' nodal forces fe into f and keep those of the
- * interface cells (batch.h), note the inverted cells that did not erode, and the step
- * estimates dte of the cells that are left (step.h; u: NULL for an updated geometry x). */
+/* The end of a batch: add its (live) cells' nodal forces fe into f, note the inverted
+ * cells that did not erode, and the step estimates dte of the cells that are left
+ * (step.h; u: NULL for an updated geometry x). */
 INLINE void add_batch(const element_params *p, const int32_t *restrict cells, int npe,
                       const batch_t *b, ivec inverted, ivec failed, vec dte,
                       const vec *restrict x, const vec *restrict u, const vec *restrict fe,
                       double *restrict f, double *step)
 {
   scatter_add(cells, npe, b, fe, f);
-  note_interface(p, b, npe, fe);
   note_inverted(inverted & ~failed, b, x, u, npe, step);
   if (p->estimate)
     note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), b, x, u, npe, step);

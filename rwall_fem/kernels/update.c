@@ -17,8 +17,8 @@
  * labels (a part per node, -1 at the interfaces of parts), the same two sums per part
  * over the nodes of that part alone, in part_sums[2 part] and part_sums[2 part + 1].
  *
- * interface_work: sum over k of f[entries[k]] . v[nodes[k]], the work rate (W) of a part's
- * forces at the nodes it shares with other parts (rwall_fem/body.py).
+ * interface_work: sum over k of f[k] . v[nodes[k]], the work rate (W) of a part's forces f
+ * at the nodes it shares with other parts (rwall_fem/body.py).
  */
 #include "batch.h"
 
@@ -105,14 +105,14 @@ void central_difference(int64_t n, double dt_v, double dt, const double *restric
   }
 }
 
-double interface_work(int64_t n, const int64_t *restrict entries, const int32_t *restrict nodes,
-                      const double *restrict f, const double *restrict v)
+double interface_work(int64_t n, const int32_t *restrict nodes, const double *restrict f,
+                      const double *restrict v)
 {
   double sum = 0.0;
   for (int64_t k = 0; k < n; ++k)
   {
-    const double *fk = f + 3 * entries[k], *vk = v + 3 * (int64_t)nodes[k];
-    sum += fk[0] * vk[0] + fk[1] * vk[1] + fk[2] * vk[2];
+    const double *vk = v + 3 * (int64_t)nodes[k];
+    sum += f[3 * k] * vk[0] + f[3 * k + 1] * vk[1] + f[3 * k + 2] * vk[2];
   }
   return sum;
 }
