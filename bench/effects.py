@@ -13,6 +13,7 @@ import os
 import statistics
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from mpi4py import MPI
@@ -77,6 +78,39 @@ def scene(changes):
     return parse_scene(raw, source="bench")
 
 
+# The internal force of one part and of two, in one process on a finer mesh of the bar.
+PART_CELLS = 0.0005  # m: element size, 32,768 hexahedra
+PART_BLOCKS, PART_CALLS = 25, 10
+
+
+def internal_force_of_parts(comm, out: str) -> dict[str, tuple[float, float, int]]:
+    """Per law of :data:`PART_PAIRS`, seconds per internal-force pass (the kernels of the
+    parts, the scatters, -f/m, the parts' books) of the body as one part and as two, on
+    the state after a few steps: medians of alternating blocks of calls in one process
+    (steadier than whole runs, whose spread on a shared machine is of the size sought)."""
+    passes = {}
+    for law, (one, two) in PART_PAIRS.items():
+        sims = []
+        for k, name in enumerate((one, two)):
+            changes = copy.deepcopy(VARIANTS[name])
+            changes["mesh"] = changes.get("mesh", {}) | {"element_size": PART_CELLS}
+            changes["run"] = {"end_time": 2e-3}
+            sim = build_simulation(scene(changes), comm, Path(out) / f"{law} {k}")
+            sim.run()
+            sims.append(sim)
+        times = ([], [])
+        for _ in range(PART_BLOCKS):
+            for sim, seconds in zip(sims, times, strict=True):
+                comm.Barrier()
+                t0 = time.perf_counter()
+                for _ in range(PART_CALLS):
+                    sim.internal.accelerate(sim.state)
+                seconds.append((time.perf_counter() - t0) / PART_CALLS)
+        cells = sims[0].info["cells"]
+        passes[law] = (statistics.median(times[0]), statistics.median(times[1]), cells)
+    return passes
+
+
 def main():
     comm = MPI.COMM_WORLD
     load = [os.getloadavg()[0]]
@@ -90,6 +124,7 @@ def main():
                 sim.run()
                 steps[name] = sim.history.summary["steps"] + 1
                 times[name].append(sim.wall_seconds / steps[name])
+        passes = internal_force_of_parts(comm, out)
     rows = [
         (name, sim.info["cells"], steps[name], statistics.median(t)) for name, t in times.items()
     ]
@@ -115,6 +150,20 @@ def main():
             f"{law} {cost[two] / cost[one]:.3f}x" for law, (one, two) in PART_PAIRS.items()
         )
         lines += ["", f"A body of two parts against the same body as one part, per step: {ratios}."]
+        cells = next(iter(passes.values()))[2]
+        lines += [
+            "",
+            f"The internal force alone (kernels, scatters, -f/m, the parts' books) on {cells:,} "
+            f"hexahedra, medians of {PART_BLOCKS} alternating blocks of {PART_CALLS} passes in "
+            "one process:",
+            "",
+            "| law | one part (ms) | two parts (ms) | x |",
+            "|---|---|---|---|",
+        ]
+        lines += [
+            f"| {law} | {a * 1e3:.3f} | {b * 1e3:.3f} | {b / a:.3f} |"
+            for law, (a, b, _) in passes.items()
+        ]
         Path(__file__).with_name("effects.md").write_text("\n".join(lines) + "\n")
         print("\n".join(lines))
 
