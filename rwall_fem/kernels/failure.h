@@ -143,6 +143,31 @@ INLINE void increments(const element_params *p, const int32_t *restrict cells, i
     du[i] *= p->dt;
 }
 
+/* The failure of a batch of elasto-plastic cells holding the elastic energy `elastic` (J)
+ * after the plastic work `plastic` (and, with `hourglass` not NULL, the hourglass work) of
+ * this step: the works are added to the cells' totals, and the failed lanes are eroded with
+ * what they hold after the increment du (m) and their forces fe; returns those lanes. */
+INLINE ivec erode_plastic(const element_params *p, const batch_t *b, vec damage, ivec inverted,
+                          vec dte, vec elastic, vec plastic, const vec *hourglass,
+                          const vec *restrict du, vec *restrict fe, int npe, double *energy,
+                          double *step)
+{
+  const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
+  track_work(p, b, 0, plastic);
+  if (hourglass)
+    track_work(p, b, 1, *hourglass);
+  if (any_lane(failed))
+  {
+    const vec plastic_total = work_so_far(p, b, 0);
+    const vec hourglass_total = hourglass ? work_so_far(p, b, 1) : VZERO;
+    const vec held =
+        hourglass ? elastic + plastic_total + hourglass_total : elastic + plastic_total;
+    erode(p, failed, b, energy_left(held, du, fe, npe), plastic_total, hourglass_total, fe, npe,
+          energy, step);
+  }
+  return failed;
+}
+
 /* The end of a batch: add its (live) cells' nodal forces fe into f, note the inverted
  * cells that did not erode, and the step estimates dte of the cells that are left
  * (step.h; u: NULL for an updated geometry x). */

@@ -419,15 +419,8 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
       hourglass_nodal_forces(gamma, Q, fe);
       hourglass_work += lane_sum(work, b.nb);
     }
-    const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
-    track_work(p, &b, 0, plastic);
-    track_work(p, &b, 1, work);
-    if (any_lane(failed))
-    {
-      const vec plastic_total = work_so_far(p, &b, 0), hourglass_total = work_so_far(p, &b, 1);
-      erode(p, failed, &b, energy_left(elastic + plastic_total + hourglass_total, du, fe, 8),
-            plastic_total, hourglass_total, fe, 8, energy, step);
-    }
+    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic, &work,
+                                      du, fe, 8, energy, step);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     add_batch(p, cells, 8, &b, inverted, failed, dte, x, NULL, fe, f, step);
   }

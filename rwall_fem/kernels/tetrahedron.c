@@ -153,14 +153,8 @@ void tet4_plastic(int64_t num_cells, const int32_t *restrict cells, const double
       const vec speed = p->wave_speed * vsqrt(volume / cell_values(p->volume0, &b));
       dte = p->calibration * characteristic_length(4, x, volume) / speed;
     }
-    const ivec failed = failed_lanes(p, damage, inverted, dte, elastic);
-    track_work(p, &b, 0, plastic);
-    if (any_lane(failed))
-    {
-      const vec plastic_total = work_so_far(p, &b, 0);
-      erode(p, failed, &b, energy_left(elastic + plastic_total, du, fe, 4), plastic_total,
-            VZERO, fe, 4, energy, step);
-    }
+    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic, NULL,
+                                      du, fe, 4, energy, step);
     stored += lane_sum(vselect(failed, VZERO, elastic), b.nb);
     add_batch(p, cells, 4, &b, inverted, failed, dte, x, NULL, fe, f, step);
   }
