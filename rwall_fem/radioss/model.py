@@ -17,9 +17,10 @@ from rwall_fem.radioss.units import UnitSystem
 
 __all__ = [
     "Body",
+    "Box",
     "Deck",
     "Function",
-    "NodeGroup",
+    "Group",
     "Part",
     "Prescribed",
     "Wall",
@@ -28,25 +29,67 @@ __all__ = [
 
 @dataclass
 class Part:
-    """A /PART: its property and material IDs."""
+    """A /PART: its property and material IDs, and the /SUBSET it belongs to (0: none)."""
 
     id: int
     title: str
     prop: int
     mat: int
     where: str
+    subset: int = 0
 
 
 @dataclass
-class NodeGroup:
-    """A /GRNOD: the node IDs it selects (resolved once every card is read)."""
+class Group:
+    """A group or a surface as its card lists it: a /GRNOD, /GRBRIC, /GRSHEL, /GRSH3N
+    (``family``) or /SURF; :mod:`~rwall_fem.radioss.groups` resolves it.
 
+    ``kind`` names what ``items`` are (the card's second keyword and the ones after it:
+    ``NODE``, ``PART``, ``BOX``, ``GRNOD``, ``PART/EXT``, ...); ``items`` are the listed IDs
+    in order, signed: a negative ID removes that item from a group, and turns the
+    segments of that item over in a surface, as in Radioss. A /SURF/SEG's segments are
+    ``segments``, (k, 4) node IDs (a triangle repeats its third node)."""
+
+    family: str
     id: int
     title: str
-    kind: str  # NODE, PART or BOX
-    items: np.ndarray  # the listed IDs (nodes, parts or boxes); negative ones removed
+    kind: str
+    items: np.ndarray
     where: str
-    nodes: np.ndarray | None = None
+    segments: np.ndarray | None = None
+    nodes: np.ndarray | None = None  # a node group's node IDs, once resolved
+
+    @property
+    def name(self) -> str:
+        return f"/{self.family}/{self.kind}/{self.id}"
+
+
+@dataclass
+class Box:
+    """A /BOX: ``shape`` RECTA (corners ``low``, ``high``), SPHER (``center``, ``radius``) or
+    CYLIN (axis ``center`` to ``end``, ``radius``), in m."""
+
+    id: int
+    shape: str
+    where: str
+    low: np.ndarray | None = None
+    high: np.ndarray | None = None
+    center: np.ndarray | None = None
+    end: np.ndarray | None = None
+    radius: float = 0.0
+    node_refs: dict[str, int] = field(default_factory=dict)  # points given by a node ID
+
+    def inside(self, x: np.ndarray) -> np.ndarray:
+        """Whether each point of ``x`` (n, 3), m, is inside the box or on its surface."""
+        if self.shape == "RECTA":
+            return np.all((x >= self.low) & (x <= self.high), axis=1)
+        if self.shape == "SPHER":
+            return np.linalg.norm(x - self.center, axis=1) <= self.radius
+        axis = self.end - self.center
+        length = np.linalg.norm(axis)
+        s = (x - self.center) @ (axis / length)
+        radial = np.linalg.norm(x - self.center - np.outer(s, axis / length), axis=1)
+        return (s >= 0) & (s <= length) & (radial <= self.radius)
 
 
 @dataclass
@@ -100,14 +143,23 @@ class Wall:
 
 @dataclass
 class Body:
-    """The elements of one part: ``cell`` ("hexahedron" or "tetrahedron"), their IDs and
-    their node IDs (M, 8 or 4), in Radioss's order (which is gmsh's)."""
+    """The elements of one element card (one part): ``cell`` ("hexahedron" or
+    "tetrahedron"; shells will add "quadrilateral" and "triangle"), their IDs and their
+    node IDs (M, 8 or 4), in Radioss's order (which is gmsh's)."""
 
     part: int
     cell: str
     ids: np.ndarray
     nodes: np.ndarray
     card: object  # the reader's Card, to name the line of an element
+
+
+# The element families of Radioss's element groups: the cells each one holds.
+GROUP_CELLS = {
+    "GRBRIC": ("hexahedron", "tetrahedron"),  # /BRICK, /TETRA4: Radioss's solids
+    "GRSHEL": ("quadrilateral",),  # /SHELL
+    "GRSH3N": ("triangle",),  # /SH3N
+}
 
 
 @dataclass
@@ -119,6 +171,7 @@ class Deck:
     engine: Path | None = None
     run_name: str = ""
     version: int = 0
+    begin_where: str = ""  # file:line of /BEGIN
     input_units: UnitSystem = field(default_factory=UnitSystem)
     work_units: UnitSystem = field(default_factory=UnitSystem)
     node_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
@@ -127,8 +180,11 @@ class Deck:
     parts: dict[int, Part] = field(default_factory=dict)
     materials: dict[int, dict] = field(default_factory=dict)  # ID -> material facts
     properties: dict[int, dict] = field(default_factory=dict)  # ID -> property facts
-    groups: dict[int, NodeGroup] = field(default_factory=dict)
-    boxes: dict[int, tuple[np.ndarray, np.ndarray, str]] = field(default_factory=dict)
+    groups: dict[int, Group] = field(default_factory=dict)  # /GRNOD by ID
+    element_groups: dict[tuple[str, int], Group] = field(default_factory=dict)  # (family, ID)
+    surfaces: dict[int, Group] = field(default_factory=dict)  # /SURF by ID
+    subsets: dict[int, tuple[str, np.ndarray, str]] = field(default_factory=dict)  # children
+    boxes: dict[int, Box] = field(default_factory=dict)
     functions: dict[int, Function] = field(default_factory=dict)
     initial: list[tuple[np.ndarray, int, str]] = field(default_factory=list)  # v, group
     clamps: list[tuple[str, int, str]] = field(default_factory=list)  # components, group
@@ -138,9 +194,24 @@ class Deck:
     end_time: float | None = None  # s
     dt_scale: float | None = None
     dt_min: float | None = None  # s
+    dt_min_action: str | None = None  # stop, mass_scaling or erode (/DT/BRICK/..., /DT/NODA/...)
     animation: tuple[float, float] | None = None  # start, interval (s)
     history_interval: float | None = None  # s
-    warnings: list[str] = field(default_factory=list)
+    noise: tuple[float, int] | None = None  # /RANDOM: amplitude (m), seed
+    solid_defaults: dict[str, int] = field(default_factory=dict)  # /DEF_SOLID's fields
+    shell_defaults: dict[str, int] = field(default_factory=dict)  # /DEF_SHELL's fields
+    pending: dict[str, list] = field(default_factory=dict)  # cards a family reads at the end
+    warnings: list[str] = field(default_factory=list)  # where the deck and rwall_fem differ
+    notices: list[str] = field(default_factory=list)  # what was skipped or read so
+    resolved: dict = field(default_factory=dict)  # groups.py's resolved groups, by key
+
+    def notice(self, card, what: str) -> None:
+        """One notice line about ``card``: ``file:line: /CARD: what``."""
+        self.notices.append(f"{card.header.where}: {card.name}: {what}")
+
+    def warn(self, card, what: str, line=None) -> None:
+        """One warning line about ``card`` (at ``line``, else its header)."""
+        self.warnings.append(f"{(line or card.header).where}: {card.name}: {what}")
 
     def node_positions(self, ids: np.ndarray) -> np.ndarray:
         """Rows of :attr:`node_ids` holding ``ids``; -1 where an ID is not a node."""

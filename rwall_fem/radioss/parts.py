@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rwall_fem.radioss.groups import node_ids
 from rwall_fem.radioss.model import Deck, Part
 from rwall_fem.radioss.reader import DeckError
 
@@ -80,13 +81,11 @@ def initial_velocities(deck: Deck, parts: list[DeckPart], mains: set[int]) -> No
     velocity of a part, and bonded parts that would start at different velocities."""
     body = np.unique(np.concatenate([p.nodes for p in parts]))
     for order, (velocity, gid, where) in enumerate(deck.initial):
-        if gid not in deck.groups:
-            raise DeckError(f"{where}: /INIVEL/TRA: Gnod_id {gid} refers to no /GRNOD")
-        g = deck.groups[gid]
-        if set(g.nodes.tolist()) & mains:
+        group_nodes = node_ids(deck, gid, f"{where}: /INIVEL/TRA: Gnod_id")
+        if set(group_nodes.tolist()) & mains:
             raise DeckError(f"{where}: /INIVEL/TRA: group {gid} holds the main node of a "
                             "/RWALL: its velocity is the wall's VX0 VY0 VZ0")  # fmt: skip
-        nodes = np.intersect1d(g.nodes, body)
+        nodes = np.intersect1d(group_nodes, body)
         if not len(nodes):
             raise DeckError(f"{where}: /INIVEL/TRA: group {gid} holds no node of an element")
         whole = [p for p in parts if np.isin(p.nodes, nodes).all()]

@@ -1,26 +1,43 @@
-"""The Radioss block format, read into cards: no meaning yet, only lines and fields.
+"""The Radioss block format's cards and data lines, and the numbers in their fields.
 
-A deck is a starter file (``NAME_0000.rad``) and an engine file (``NAME_0001.rad``). A
-card starts with a line beginning ``/`` (``/RWALL/PLANE/1``) and holds the lines up to
-the next one. Lines starting with ``#`` or ``$`` are comments, but ``#include FILE``,
-which reads FILE (relative to the including file) in place. ``/END`` ends a file.
+A card starts with a line beginning ``/`` (``/RWALL/PLANE/1``) and holds the data lines
+up to the next one (the files of a deck are cut into cards by
+:mod:`~rwall_fem.radioss.deck_files`). A data line is fixed format (fields of 10 or 20
+characters, a blank field meaning the default) unless it holds a comma or a tab: then
+its fields are the words of the line in order (the free format; commas separate, or
+else blanks and tabs). Every line remembers its file and number, so that every refusal
+names them: :class:`DeckError`, one line, ``file:line: /CARD: what; allowed``.
 
-A data line is fixed format (fields of 10 or 20 characters, a blank field meaning the
-default) unless it holds a comma: then its fields are the comma-separated words, in
-order (the free format). Every line remembers its file and number, so that every
-refusal names them: :class:`DeckError`, one line, ``file:line: /CARD: what; allowed``.
+Numbers are read as Radioss reads them: a Fortran ``D`` exponent (``2.1D5``) or none
+(``2.1+5``, ``7.8-9``) is an exponent, an integer field may hold an integral real
+(``1.``, ``1.0D0``). A number that is not finite (``nan``, ``inf``, ``1e999``) or an
+integer of more than 10 digits (Radioss's IDs and flags) is refused naming the field.
 """
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from rwall_fem.scene import SceneError
 
-__all__ = ["Card", "DeckError", "Line", "read_cards"]
+__all__ = [
+    "MAX_DIGITS",
+    "Card",
+    "DeckError",
+    "Line",
+    "fixed_table",
+    "parse_number",
+    "read_fields",
+]
+
+MAX_DIGITS = 10  # Radioss's integers (IDs, flags): "Integer, maximum 10 digits"
+
+# A real whose exponent has no letter, as Fortran writes it in narrow fields: 2.1+5.
+_BARE_EXPONENT = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+))([+-]\d+)")
 
 
 class DeckError(SceneError):
@@ -28,6 +45,10 @@ class DeckError(SceneError):
 
     A :class:`~rwall_fem.scene.SceneError`, so the command line reports it as any bad
     scene: one line on stderr, exit code 2."""
+
+
+class NumberError(ValueError):
+    """A field that is not a number of its kind; the message says why (after the field)."""
 
 
 @dataclass(frozen=True)
@@ -44,12 +65,12 @@ class Line:
 
     @property
     def free(self) -> bool:
-        """Whether the line is in the free format (comma-separated fields)."""
-        return "," in self.text
+        """Whether the line is in the free format (comma- or tab-separated fields)."""
+        return "," in self.text or "\t" in self.text
 
     def words(self) -> list[str]:
-        """The fields of a free-format line, or the blank-separated words of the line."""
-        if self.free:
+        """The fields of a line with commas, or else its words (blanks and tabs)."""
+        if "," in self.text:
             return [w.strip() for w in self.text.split(",")]
         return self.text.split()
 
@@ -92,6 +113,13 @@ class Card:
         """The fields of data line ``index`` by ``layout`` (see :func:`read_fields`)."""
         return read_fields(self, self.line(index, what or layout), layout)
 
+    def read_optional(self, index: int, layout: str) -> list:
+        """The fields of data line ``index``, or the defaults (0, 0.0, '') of the layout if
+        the card has no such line (Radioss's optional lines)."""
+        if index < len(self.lines):
+            return read_fields(self, self.lines[index], layout)
+        return [{"i": 0, "f": 0.0, "s": ""}[k] for k, _, _ in _columns(layout) if k != "-"]
+
 
 def _columns(layout: str) -> list[tuple[str, str, int]]:
     """``"i:node_ID f:Mass 20"``-style layout -> (kind, name, width) per field.
@@ -129,101 +157,97 @@ def read_fields(card: Card, line: Line, layout: str) -> list:
             continue
         try:
             values.append(parse_number(text, integer=kind == "i"))
-        except ValueError:
-            need = "an integer" if kind == "i" else "a number"
-            card.fail(f"field {name} ({at}): cannot read {text!r} as {need}", line)
+        except NumberError as err:
+            card.fail(f"field {name} ({at}): {err}", line)
     return values
 
 
 def parse_number(text: str, integer: bool = False):
-    """A Radioss number: blank is 0; a Fortran ``D`` exponent is read as ``E``."""
+    """A Radioss number: blank is 0; ``D`` or no letter before the exponent; an integral
+    real in an integer field. :class:`NumberError` (a ValueError) says why one is not."""
     text = text.strip()
     if not text:
         return 0 if integer else 0.0
-    if integer:
-        return int(text)
-    return float(text.replace("D", "E").replace("d", "e"))
+    digits = text.lstrip("+-")
+    if integer and digits.isascii() and digits.isdigit() and len(text) - len(digits) <= 1:
+        if len(digits.lstrip("0")) > MAX_DIGITS:
+            raise NumberError(
+                f"{_shown(text)} has {len(digits.lstrip('0'))} digits; Radioss's integers "
+                f"(IDs, flags) have at most {MAX_DIGITS}"
+            )
+        value = int(text)
+    else:
+        value = _real(text, integer)
+        if integer:
+            if not value.is_integer():
+                raise NumberError(f"{text!r} is not an integer")
+            value = int(value)
+    if integer and abs(value) >= 10**MAX_DIGITS:
+        digits = len(str(abs(value)))
+        raise NumberError(
+            f"{_shown(text)} has {digits} digits; Radioss's integers (IDs, flags) have at most "
+            f"{MAX_DIGITS}"
+        )
+    return value
 
 
-def read_cards(path: Path) -> list[Card]:
-    """The cards of the file ``path`` and of the files it includes, in order."""
-    cards: list[Card] = []
-    _read_file(Path(path), cards, [])
-    return cards
-
-
-def _read_file(path: Path, cards: list[Card], stack: list[Path]) -> None:
-    name = str(path)
+def _real(text: str, integer: bool) -> float:
+    spelled = text.replace("D", "E").replace("d", "e")
+    bare = _BARE_EXPONENT.fullmatch(spelled)
+    if bare:
+        spelled = f"{bare[1]}E{bare[2]}"
     try:
-        data = path.read_bytes()
-    except OSError as err:
-        where = f"{stack[-1]}: " if stack else ""
-        raise DeckError(f"{where}{name}: cannot read the deck file: {err.strerror}") from None
-    if b"\0" in data:
-        at = data.index(b"\0")
-        raise DeckError(f"{name}: not a text file (binary data at byte {at})")
-    text = data.decode("utf-8", errors="replace")
-    current: Card | None = None
-    for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.rstrip("\r\n")
-        head = line.lstrip()
-        if head.lower().startswith("#include"):
-            target = head[len("#include") :].strip().strip("'\"")
-            included = (path.parent / target).resolve()
-            if not target:
-                raise DeckError(f"{name}:{number}: #include: no file named")
-            if included in stack or included == path.resolve():
-                raise DeckError(f"{name}:{number}: #include {target}: includes itself")
-            if not included.is_file():
-                raise DeckError(f"{name}:{number}: #include {target}: file not found")
-            _read_file(included, cards, [*stack, path.resolve()])
-            current = cards[-1] if cards else None
-            continue
-        if head.startswith(("#", "$")):
-            continue
-        if line.startswith("/"):
-            parts = [p.strip() for p in line.strip().strip("/").split("/")]
-            if parts == ["END"] or parts == ["end"]:
-                return
-            current = Card(parts, Line(line, name, number))
-            cards.append(current)
-        elif current is None:
-            if line.strip():
-                raise DeckError(f"{name}:{number}: data before the first card: {line.strip()!r}")
-        else:
-            current.lines.append(Line(line, name, number))
+        value = float(spelled)
+    except ValueError:
+        need = "an integer" if integer else "a number"
+        raise NumberError(f"cannot read {_shown(text)} as {need}{_odd_character(text)}") from None
+    if not math.isfinite(value):
+        raise NumberError(f"{_shown(text)} is not a finite number")
+    return value
+
+
+def _shown(text: str) -> str:
+    return repr(text) if len(text) <= 24 else repr(text[:21] + "...")
+
+
+def _odd_character(text: str) -> str:
+    """What is odd in a field that does not read: its first character beyond ASCII."""
+    for k, c in enumerate(text):
+        if not c.isascii():
+            return f" (the character {c!r}, U+{ord(c):04X}, at its character {k + 1})"
+    return ""
 
 
 def fixed_table(card: Card, start: int, layout: str) -> list[np.ndarray]:
     """The fields of the data lines ``start:`` of ``card`` as arrays, one per field of
     ``layout`` (integers as int64, reals as float64): NumPy on the fixed columns, so a
-    million lines read in seconds; free-format lines are read one by one. A field that
-    does not parse is refused naming its line."""
+    million lines read in seconds; free-format lines, and columns NumPy does not read
+    (a bare exponent, a number that is not finite), are read line by line, so that a
+    field that does not parse is refused naming its line."""
     lines = card.lines[start:]
     columns = _columns(layout)
     kinds = [k for k, _, _ in columns if k != "-"]
     types = [np.int64 if k == "i" else float for k in kinds]
     if not lines:
         return [np.zeros(0, dtype=t) for t in types]
-    if any(line.free for line in lines):
-        rows = [read_fields(card, line, layout) for line in lines]
-        return [np.array([r[i] for r in rows], dtype=t) for i, t in enumerate(types)]
-    width = sum(w for _, _, w in columns)
-    text = "".join(line.text[:width].ljust(width) for line in lines)
-    if text.isascii():
-        chars = np.frombuffer(text.encode("ascii"), dtype="S1").reshape(len(lines), width)
-        out, first = [], 0
-        try:
-            for kind, _, w in columns:
-                if kind != "-":
-                    out.append(_column(chars[:, first : first + w], kind))
-                first += w
-            return out
-        except ValueError:
-            pass
-    for line in lines:  # something did not parse: name the first line that does not
-        read_fields(card, line, layout)
-    raise AssertionError("unreachable: every line parsed one by one")  # pragma: no cover
+    if not any(line.free for line in lines):
+        width = sum(w for _, _, w in columns)
+        text = "".join(line.text[:width].ljust(width) for line in lines)
+        if text.isascii():
+            chars = np.frombuffer(text.encode("ascii"), dtype="S1").reshape(len(lines), width)
+            out, first = [], 0
+            try:
+                for kind, _, w in columns:
+                    if kind != "-":
+                        out.append(_column(chars[:, first : first + w], kind))
+                    first += w
+            except (ValueError, OverflowError):
+                pass
+            else:
+                if all(np.isfinite(a).all() for a in out if a.dtype == float):
+                    return out
+    rows = [read_fields(card, line, layout) for line in lines]
+    return [np.array([r[i] for r in rows], dtype=t) for i, t in enumerate(types)]
 
 
 def _column(chars: np.ndarray, kind: str) -> np.ndarray:

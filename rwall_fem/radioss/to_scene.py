@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rwall_fem.radioss.groups import node_ids, part_ids
 from rwall_fem.radioss.materials import element_table, material_table
 from rwall_fem.radioss.mesh import WRITER, FaceGroups, face_groups, write_msh
 from rwall_fem.radioss.model import Deck, Prescribed, Wall
@@ -72,7 +73,6 @@ def scene_of(deck: Deck) -> SceneParts:
             deck.warnings.append(f"{part.where}: /PART/{part.id}: has no elements")
     body_nodes = np.unique(cells)
     mains = {w.main_node for w in deck.walls if w.main_node}
-    _resolve_groups(deck, cells, body_nodes, mains)
     initial_velocities(deck, parts, mains)
     separate = len({(p.part.mat, p.part.prop) for p in parts}) > 1 or not uniform_velocity(parts)
 
@@ -96,6 +96,10 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["run"]["dt_scale"] = deck.dt_scale
     if deck.dt_min is not None:
         raw["run"]["dt_min"] = deck.dt_min
+        if deck.dt_min_action not in (None, "stop"):
+            raw["run"]["dt_min_action"] = deck.dt_min_action
+    if deck.noise is not None:
+        raw["mesh"]["noise"] = {"amplitude": deck.noise[0], "seed": deck.noise[1]}
     if deck.animation is not None:
         start, interval = deck.animation
         raw["output"]["frames"] = int(np.floor((deck.end_time - start) / interval + 1e-9)) + 1
@@ -111,8 +115,7 @@ def scene_of(deck: Deck) -> SceneParts:
         )
 
     by_parts = _groups_as_parts(deck, parts) if separate else {}
-    group_nodes = {gid: g.nodes for gid, g in deck.groups.items()
-                   if _used_group(deck, gid, by_parts)}  # fmt: skip
+    group_nodes = {gid: deck.groups[gid].nodes for gid in _used_groups(deck, by_parts)}
     atoms, unreached = face_groups(cell, cells, {
         gid: np.intersect1d(nodes, body_nodes) for gid, nodes in group_nodes.items()
     })  # fmt: skip
@@ -121,8 +124,8 @@ def scene_of(deck: Deck) -> SceneParts:
             g = deck.groups[gid]
             shown = ", ".join(map(str, missing[:5])) + (", ..." if len(missing) > 5 else "")
             raise DeckError(
-                f"{g.where}: /GRNOD/{g.kind}/{gid}: nodes {shown} lie on no element face whose "
-                "nodes are all in the group: rwall_fem's node sets are unions of element faces"
+                f"{g.where}: {g.name}: nodes {shown} lie on no element face whose nodes are all "
+                "in the group: rwall_fem's node sets are unions of element faces"
             )
     gravity = _gravity(deck, body_nodes)
     if gravity is not None:
@@ -141,6 +144,7 @@ def scene_of(deck: Deck) -> SceneParts:
     facts.append(
         f"run: end time {deck.end_time:g} s"
         + (f", dt scale {deck.dt_scale:g}" if deck.dt_scale is not None else "")
+        + (f", below {deck.dt_min:g} s: {deck.dt_min_action}" if deck.dt_min else "")
         + (f", {raw['output']['frames']} frames" if "frames" in raw["output"] else "")
     )
     return SceneParts(raw, cell, regions, atoms, facts)
@@ -238,14 +242,17 @@ def _names(parts: list[DeckPart]) -> str:
 
 
 def _groups_as_parts(deck: Deck, parts: list[DeckPart]) -> dict[int, list[str]]:
-    """The /GRNOD/PART groups that walls take as their grnd_ID1, as the names of their
-    parts (``secondary.parts``: every node of those parts' elements, as the group's)."""
+    """The /GRNOD/PART (SUBSET, MAT, PROP) groups that walls take as their grnd_ID1, as the
+    names of their parts (``secondary.parts``: every node of those parts' elements, as the
+    group's)."""
     names = {p.part.id: p.name for p in parts}
     out = {}
     for w in deck.walls:
         g = deck.groups.get(w.add_group)
-        if g is not None and g.kind == "PART":
-            out[w.add_group] = [names[pid] for pid in g.items.tolist() if pid in names]
+        if g is not None and g.kind in ("PART", "SUBSET", "MAT", "PROP"):
+            user = f"{g.where}: {g.name}: {g.kind.lower()}"
+            chosen = part_ids(deck, g.kind, g.items, user).tolist()
+            out[w.add_group] = [names[pid] for pid in chosen if pid in names]
     return out
 
 
@@ -269,44 +276,25 @@ def _check_element_nodes(deck: Deck) -> None:
             )
 
 
-def _resolve_groups(deck: Deck, cells, body_nodes, mains) -> None:
-    """The node IDs of every /GRNOD; an ID that refers to nothing is refused."""
-    for g in deck.groups.values():
-        where = f"{g.where}: /GRNOD/{g.kind}/{g.id}"
-        if g.kind == "NODE":
-            missing = g.items[deck.node_positions(g.items) < 0]
-            if len(missing):
-                raise DeckError(f"{where}: node {missing[0]} refers to no /NODE")
-            g.nodes = g.items
-        elif g.kind == "PART":
-            for pid in g.items:
-                if pid not in deck.parts:
-                    raise DeckError(f"{where}: part {pid} refers to no /PART")
-            nodes = [b.nodes.ravel() for b in deck.bodies if b.part in set(g.items.tolist())]
-            g.nodes = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, np.int64)
-        else:
-            inside = np.zeros(len(deck.node_ids), dtype=bool)
-            for bid in g.items:
-                if bid not in deck.boxes:
-                    raise DeckError(f"{where}: box {bid} refers to no /BOX")
-                low, high, _ = deck.boxes[bid]
-                inside |= np.all((deck.coordinates >= low) & (deck.coordinates <= high), axis=1)
-            g.nodes = deck.node_ids[inside]
-
-
 def _group(deck: Deck, gid: int, where: str, what: str):
-    if gid not in deck.groups:
-        raise DeckError(f"{where}: {what} {gid} refers to no /GRNOD")
+    """The /GRNOD ``gid`` that the card at ``where`` names in its field ``what``, its nodes
+    worked out (:mod:`~rwall_fem.radioss.groups`)."""
+    node_ids(deck, gid, f"{where}: {what}")
     return deck.groups[gid]
 
 
-def _used_group(deck: Deck, gid: int, by_parts: dict[int, list[str]]) -> bool:
-    """Whether a group must be written to the mesh (a wall, /BCS or /IMPVEL uses it, other
-    than as the parts ``by_parts``)."""
-    uses = [w.add_group for w in deck.walls if w.add_group not in by_parts]
-    uses += [w.exclude_group for w in deck.walls]
-    uses += [g for _, g, _ in deck.clamps] + [p.group for p in deck.velocities]
-    return gid in uses
+def _used_groups(deck: Deck, by_parts: dict[int, list[str]]) -> list[int]:
+    """The groups that must be written to the mesh (a wall, /BCS or /IMPVEL uses them,
+    other than as the parts ``by_parts``), their nodes worked out."""
+    uses = [(w.add_group, w.where, f"/RWALL/{w.kind}/{w.id}: grnd_ID1") for w in deck.walls
+            if w.add_group and w.add_group not in by_parts]  # fmt: skip
+    uses += [(w.exclude_group, w.where, f"/RWALL/{w.kind}/{w.id}: grnd_ID2")
+             for w in deck.walls if w.exclude_group]  # fmt: skip
+    uses += [(g, where, "/BCS: grnd_ID") for _, g, where in deck.clamps]
+    uses += [(p.group, p.where, f"{p.card}: grnd_ID") for p in deck.velocities]
+    for gid, where, what in uses:
+        _group(deck, gid, where, what)
+    return list(dict.fromkeys(gid for gid, _, _ in uses))
 
 
 def _covers(group_nodes, body_nodes) -> bool:

@@ -1,7 +1,8 @@
 """Unit systems of a deck (``/BEGIN``) and their conversion to SI (kg, m, s).
 
 A unit is a code (``kg``, ``Mg``, ``g``, ``mm``, ``ms``, ``mus``: an SI prefix and the
-base unit g, m or s, or ``lb``, ``in``, ``ft``) or a number, the size of the unit in SI.
+base unit g, m or s, or ``lb``, ``in``, ``ft``, ``t``) or a number, the size of the unit
+in SI (``1000``, ``1.D-3``).
 A quantity's dimension is the exponents of mass, length and time: a stress is
 (1, -1, -2), so in kg-mm-ms its unit is 1 kg / (1e-3 m (1e-3 s)^2) = 1e9 Pa.
 """
@@ -10,7 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["DIMENSIONS", "UnitSystem", "parse_unit"]
+from rwall_fem.radioss.reader import NumberError, parse_number
+
+__all__ = ["DIMENSIONS", "UnitSystem", "parse_unit", "units_text"]
 
 _PREFIXES = {
     "y": 1e-24, "z": 1e-21, "a": 1e-18, "f": 1e-15, "p": 1e-12, "n": 1e-9, "mu": 1e-6,
@@ -35,17 +38,22 @@ DIMENSIONS = {
 
 
 def parse_unit(text: str, quantity: str) -> float | None:
-    """The size in SI of the unit ``text`` of ``quantity`` ("mass", "length", "time");
-    None if it is not a unit; blank gives None too (the caller's default)."""
+    """The size in SI of the unit ``text`` of ``quantity`` ("mass", "length", "time"): a
+    code, or a number (``1000``, ``1.D-3``); None if it is neither, or blank (the
+    caller's default). ValueError (its message says why) for a number that is not a
+    size: not finite, or not above 0."""
     text = text.strip()
     if not text:
         return None
     try:
-        value = float(text)
-    except ValueError:
-        pass
+        value = parse_number(text)
+    except NumberError as err:
+        if "finite" in str(err):
+            raise ValueError(str(err)) from None
     else:
-        return value if value > 0 else None
+        if value <= 0:
+            raise ValueError(f"{value:g} is not a size (a unit's size in SI is above 0)")
+        return value
     base, size = _BASE[quantity]
     if text in _OTHER.get(quantity, {}):
         return _OTHER[quantity][text]
@@ -70,3 +78,13 @@ class UnitSystem:
 
     def describe(self) -> str:
         return "-".join(self.names)
+
+
+def units_text(sizes: tuple[float, float, float], names: tuple[str, str, str]) -> str:
+    """A unit system as ``output.units`` writes it: its codes (``kg-mm-ms``) when each
+    names its size, else the sizes in SI separated by blanks (``1000 0.001 1``)."""
+    coded = all(parse_unit(n, q) == s for n, q, s in zip(names, ("mass", "length", "time"),
+                                                           sizes, strict=True))  # fmt: skip
+    if coded and all(n.isalpha() for n in names):
+        return "-".join(names)
+    return " ".join(f"{s:g}" for s in sizes)

@@ -178,20 +178,20 @@ def test_initial_velocity_not_of_whole_parts_is_one_line(case, shared_dir):
 
 
 class Lines(logging.Handler):
-    def __init__(self):
-        super().__init__(logging.WARNING)
+    def __init__(self, level=logging.WARNING):
+        super().__init__(level)
         self.lines = []
 
     def emit(self, record):
         self.lines.append(record.getMessage())
 
 
-def test_output_cards_are_skipped_with_one_warning_each(shared_dir):
+def test_output_cards_are_skipped_with_one_notice_each(shared_dir):
     d = good()
     d.cards += ["/TH/RWALL/1", "wall", "FNX", "         1"]
     d.engine += ["/ANIM/VECT/VEL", "/PRINT/-100"]
     path = written(d, shared_dir)
-    log, handler = logging.getLogger("rwall_fem"), Lines()
+    log, handler = logging.getLogger("rwall_fem"), Lines(logging.INFO)
     log.addHandler(handler)  # the command line's tests stop its propagation to pytest
     level = log.level  # and silence the ranks other than 0: every rank reads the deck here
     log.setLevel(logging.INFO)
@@ -201,7 +201,8 @@ def test_output_cards_are_skipped_with_one_warning_each(shared_dir):
         log.removeHandler(handler)
         log.setLevel(level)
     skipped = [line for line in handler.lines if "skipped" in line]
-    assert [s.split(": ")[1] for s in skipped] == ["/TH/RWALL/1", "/ANIM/VECT/VEL", "/PRINT/-100"]
+    assert [s.split(": ")[3] for s in skipped] == ["/TH/RWALL/1", "/ANIM/VECT/VEL", "/PRINT/-100"]
+    assert all(line.startswith("deck: notice: ") for line in skipped)
 
 
 @pytest.mark.serial

@@ -5,7 +5,8 @@ import time
 import numpy as np
 import pytest
 
-from rwall_fem.radioss.reader import DeckError, fixed_table, read_cards
+from rwall_fem.radioss.deck_files import read_cards
+from rwall_fem.radioss.reader import DeckError, fixed_table
 from rwall_fem.radioss.units import UnitSystem, parse_unit
 
 

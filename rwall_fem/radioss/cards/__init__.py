@@ -1,0 +1,74 @@
+"""The cards of a deck, one module per family of cards.
+
+Each module declares the cards it reads: ``STARTER`` and ``ENGINE``, dicts from a
+keyword path (``"NODE"``, ``"MAT/LAW2"``, ``"RWALL/PLANE"``) to a function
+``read(deck, card)`` that reads such a :class:`~rwall_fem.radioss.reader.Card` into the
+:class:`~rwall_fem.radioss.model.Deck` (in SI) or refuses it in one line. A card is read
+by the function of the longest path that its first keywords match (``/MAT/LAW2/7``:
+``MAT/LAW2``); a path of one keyword catches the card's other variants, to refuse them
+naming what is read. A module may also define ``finish(deck)``, called once every
+starter card is read, in the order of :data:`STARTER_FAMILIES` (nodes are read before the
+groups that refer to them are resolved, /DEF_SOLID's defaults apply to every /PROP).
+
+A new family of cards (shells, interfaces, loads, rigid bodies) is a module here and one
+entry in the tuple of its file; the reader and its refusals of unknown cards need
+nothing else.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from rwall_fem.radioss.cards import (
+    begin,
+    conditions,
+    control,
+    functions,
+    groups,
+    materials,
+    nodes,
+    parts,
+    run,
+    solids,
+    walls,
+)
+
+__all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "lookup", "supported", "table"]
+
+STARTER_FAMILIES = (
+    begin, nodes, solids, parts, materials, groups, functions, conditions, walls, control,
+)  # fmt: skip
+ENGINE_FAMILIES = (run, control)
+
+Reader = Callable[..., None]
+
+
+def table(families, which: str) -> dict[tuple[str, ...], Reader]:
+    """The readers of ``which`` ("STARTER" or "ENGINE") cards of ``families``, by path."""
+    out: dict[tuple[str, ...], Reader] = {}
+    for module in families:
+        for path, read in getattr(module, which, {}).items():
+            key = tuple(path.upper().split("/"))
+            if key in out:
+                raise RuntimeError(f"the card {path} is read by two families")  # a coding error
+            out[key] = read
+    return out
+
+
+def lookup(readers: dict[tuple[str, ...], Reader], card) -> Reader | None:
+    """The reader of the longest path that the card's first keywords match, or None."""
+    keys = tuple(p.upper() for p in card.parts)
+    for length in range(min(len(keys), 4), 0, -1):
+        read = readers.get(keys[:length])
+        if read is not None:
+            return read
+    return None
+
+
+def supported(readers: dict[tuple[str, ...], Reader]) -> str:
+    """The cards of the model that ``readers`` read, in the order of their families (not
+    those only noticed, nor the catch-alls that refuse), as a list for messages."""
+    paths = ["/" + "/".join(k) for k, read in readers.items()
+             if not getattr(read, "notice_only", False)
+             and not getattr(read, "catch_all", False)]  # fmt: skip
+    return ", ".join(paths)

@@ -1,0 +1,53 @@
+"""/BEGIN: the run name, the input version and the unit systems (input units for the
+starter's values, work units for the engine's)."""
+
+from __future__ import annotations
+
+from rwall_fem.radioss.model import Deck
+from rwall_fem.radioss.reader import Card, read_fields
+from rwall_fem.radioss.units import UnitSystem, parse_unit
+
+__all__ = ["STARTER"]
+
+
+def _begin(deck: Deck, card: Card) -> None:
+    if deck.version:
+        card.fail("a second /BEGIN")
+    deck.run_name = card.line(0, "Runname").text.strip()
+    version, _ = card.read(1, "i:Invers i:Irun", "Invers Irun")
+    if version < 100:
+        card.fail(
+            f"input version {version}: only the block format of version 10 and later "
+            "(Invers >= 100) is read",
+            card.lines[1],
+        )
+    deck.version = version
+    systems = []
+    for index, what in ((3, "Work_mass_unit Work_length_unit Work_time_unit"),
+                        (2, "Input_mass_unit Input_length_unit Input_time_unit")):  # fmt: skip
+        line = card.line(index, what)
+        texts = read_fields(card, line, "s:mass:20 s:length:20 s:time:20")
+        default = systems[0] if systems else UnitSystem()
+        sizes, names = [], []
+        for text, quantity, fallback, name in zip(
+            texts, ("mass", "length", "time"),
+            (default.mass, default.length, default.time), default.names, strict=True,
+        ):  # fmt: skip
+            try:
+                size = parse_unit(text, quantity)
+            except ValueError as err:
+                card.fail(f"{quantity} unit {text!r}: {err}", line)
+            if size is None and text:
+                card.fail(
+                    f"{quantity} unit {text!r}: give a code (an SI prefix and g, m or s, such "
+                    "as kg, Mg, mm, ms, mus; or lb, in, ft, t) or the unit's size in SI",
+                    line,
+                )
+            sizes.append(fallback if size is None else size)
+            names.append(text or name)
+        systems.append(UnitSystem(*sizes, names=tuple(names)))
+    deck.work_units, deck.input_units = systems
+    deck.begin_where = card.header.where
+
+
+STARTER = {"BEGIN": _begin}

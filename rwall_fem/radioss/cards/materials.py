@@ -1,0 +1,139 @@
+"""/MAT: LAW1 (ELAST), LAW2 (PLAS_JOHNS: Johnson-Cook, with its failure plastic strain)
+and LAW36 (PLAS_TAB: one tabulated hardening curve), read into material facts in SI
+(:mod:`rwall_fem.radioss.materials` makes them [material] tables). A field of a law that
+has no counterpart is refused unless it is left at its default."""
+
+from __future__ import annotations
+
+from rwall_fem.radioss.cards.base import catch_all, ident, inactive
+from rwall_fem.radioss.model import Deck
+from rwall_fem.radioss.reader import Card
+from rwall_fem.radioss.units import UnitSystem
+
+__all__ = ["LAWS", "STARTER"]
+
+# Keyword -> law, for the laws read.
+LAWS = {"LAW1": "LAW1", "ELAST": "LAW1", "LAW2": "LAW2", "PLAS_JOHNS": "LAW2",
+        "LAW36": "LAW36", "PLAS_TAB": "LAW36"}  # fmt: skip
+_SUPPORTED = "/MAT/LAW1 (ELAST), /MAT/LAW2 (PLAS_JOHNS), /MAT/LAW36 (PLAS_TAB)"
+
+
+def _material(deck: Deck, card: Card) -> None:
+    law = LAWS[card.key(1)]
+    units = deck.input_units
+    mid = ident(card, 2, "mat_ID")
+    if mid in deck.materials:
+        card.fail(f"material {mid} is defined twice")
+    rho, rho0 = card.read(1, "f:RHO_I f:RHO_0", "RHO_I")
+    facts: dict = {"law": law, "title": card.title(), "where": card.header.where,
+                   "density": rho * units.factor("density"), "raw_density": rho}  # fmt: skip
+    if rho0 and rho0 != rho:
+        deck.warn(card, "RHO_0 (reference density of an equation of state) is not used: these "
+                  "laws have none", card.lines[1])  # fmt: skip
+    stress = units.factor("stress")
+    if law == "LAW1":
+        E, nu = card.read(2, "f:E f:nu", "E nu")
+        facts |= {"young": E * stress, "poisson": nu, "raw_young": E}
+    elif law == "LAW2":
+        facts |= _johnson_cook(deck, card, units)
+    else:
+        facts |= _tabulated(card, units)
+    deck.materials[mid] = facts
+
+
+@catch_all
+def _other_material(deck: Deck, card: Card) -> None:
+    card.fail(f"unsupported material law; supported: {_SUPPORTED}")
+
+
+def _failure_strain(card: Card, name: str, value: float, line) -> dict:
+    """The [material.failure] facts of a failure plastic strain field (none if inactive)."""
+    if inactive(value):
+        return {}
+    if value < 0:
+        card.fail(f"{name} = {value:g}: a failure plastic strain is > 0 (blank: none)", line)
+    return {"failure": {"criterion": "plastic_strain", "plastic_strain": value}}
+
+
+def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
+    """/MAT/LAW2: (a + b eps_p^n)(1 + c ln(rate/rate_0))(1 - T*^m), the element deleted
+    when eps_p reaches EPS_p_max; what has no counterpart is refused unless inactive."""
+    stress = units.factor("stress")
+    E, nu, iflag, vp, pmin = card.read(2, "f:E f:nu i:Iflag i:VP f:Pmin", "E nu Iflag VP Pmin")
+    if iflag != 0:
+        card.fail("Iflag 1 (yield stress, UTS and strain at UTS): give a, b and n (Iflag 0)",
+                  card.lines[2])  # fmt: skip
+    if not inactive(pmin):
+        card.fail(f"Pmin = {pmin:g}: rwall_fem has no pressure cut-off; leave Pmin blank",
+                  card.lines[2])  # fmt: skip
+    a, b, n, eps_max, sig_max = card.read(3, "f:a f:b f:n f:EPS_p_max f:SIG_max0",
+                                          "a b n EPS_p_max SIG_max0")  # fmt: skip
+    if not inactive(sig_max):
+        card.fail(f"SIG_max0 = {sig_max:g}: rwall_fem has no cap on the flow stress; leave "
+                  "SIG_max0 blank", card.lines[3])  # fmt: skip
+    c, rate0, _, smooth, _, chard = card.read(
+        4, "f:c f:EPS_DOT_0 i:ICC i:Fsmooth f:F_cut f:Chard", "c EPS_DOT_0 ICC Fsmooth F_cut Chard"
+    )
+    if chard != 0.0:
+        card.fail(f"Chard = {chard:g}: rwall_fem's hardening is isotropic (Chard 0)",
+                  card.lines[4])  # fmt: skip
+    m, t_melt, rho_cp, t_room, t_max = card.read(5, "f:m f:T_melt f:rhoC_p f:T_r f:T_max",
+                                                 "m T_melt rhoC_p T_r T_max")  # fmt: skip
+    if n == 0.0 and b != 0.0:
+        n = 1.0  # Radioss's default exponent
+    facts = {"young": E * stress, "poisson": nu, "a": a * stress, "b": b * stress,
+             "n": n if n else 1.0, "raw_young": E}  # fmt: skip
+    facts |= _failure_strain(card, "EPS_p_max", eps_max, card.lines[3])
+    if c != 0.0:
+        if rate0 <= 0.0:
+            card.fail("c > 0 needs EPS_DOT_0 > 0 (the reference strain rate)", card.lines[4])
+        facts |= {"c": c, "rate0": rate0 * units.factor("rate")}
+        deck.warn(card, "the rate term uses rwall_fem's strain rate, the equivalent deviatoric "
+                  f"rate of each step, unfiltered (flagVP {vp}, Fsmooth {smooth} of the deck "
+                  "choose Radioss's)", card.lines[4])  # fmt: skip
+    if not inactive(t_melt):
+        if rho_cp <= 0.0:
+            card.fail("T_melt is given: the thermal term needs rhoC_p > 0", card.lines[5])
+        if not inactive(t_max):
+            card.fail(f"T_max = {t_max:g}: rwall_fem has no temperature cap; leave it blank",
+                      card.lines[5])  # fmt: skip
+        facts |= {"m": m if m else 1.0, "t_melt": t_melt,
+                  "heat": rho_cp * units.factor("heat_capacity_per_volume"),
+                  "t_room": t_room if t_room else 298.0}  # fmt: skip
+        deck.warn(card, "the thermal term heats by the plastic work (taylor_quinney = 1), where "
+                  "Radioss heats by the internal energy", card.lines[5])  # fmt: skip
+    return facts
+
+
+def _tabulated(card: Card, units: UnitSystem) -> dict:
+    """/MAT/LAW36 with one function and no rate, pressure or modulus dependence: a
+    tabulated hardening curve, the element deleted at EPS_p_max."""
+    stress = units.factor("stress")
+    E, nu, eps_max, eps_t, eps_m = card.read(2, "f:E f:nu f:EPS_p_max f:EPS_t f:EPS_m",
+                                             "E nu EPS_p_max EPS_t EPS_m")  # fmt: skip
+    for name, value in (("EPS_t", eps_t), ("EPS_m", eps_m)):
+        if not inactive(value):
+            card.fail(f"{name} = {value:g}: rwall_fem has no failure by tensile strain (with "
+                      "damage); leave it blank (EPS_p_max, the failure plastic strain, is "
+                      "read)", card.lines[2])  # fmt: skip
+    nfunct, _, chard = card.read(3, "i:N_funct i:Fsmooth f:Chard", "N_funct Fsmooth Chard")
+    if nfunct != 1:
+        card.fail(f"N_funct = {nfunct}: one hardening function (no strain-rate dependence) is "
+                  "read", card.lines[3])  # fmt: skip
+    if chard != 0.0:
+        card.fail(f"Chard = {chard:g}: rwall_fem's hardening is isotropic (Chard 0)",
+                  card.lines[3])  # fmt: skip
+    fct_p, _, fct_e = card.read(4, "i:fct_IDp f:Fscale i:fct_IDE", "fct_IDp Fscale fct_IDE")
+    if fct_p or fct_e:
+        card.fail("fct_IDp and fct_IDE (pressure and Young's modulus functions) are not read; "
+                  "leave them blank", card.lines[4])  # fmt: skip
+    (fct,) = card.read(5, "i:fct_ID1", "fct_ID1")
+    (scale,) = card.read(6, "f:Fscale1", "Fscale1")
+    if fct <= 0:
+        card.fail("fct_ID1 (the hardening function) is missing", card.lines[5])
+    return {"young": E * stress, "poisson": nu, "curve": fct, "raw_young": E,
+            "curve_scale": (scale or 1.0) * stress, "curve_where": card.lines[5].where,
+            **_failure_strain(card, "EPS_p_max", eps_max, card.lines[2])}  # fmt: skip
+
+
+STARTER = {f"MAT/{keyword}": _material for keyword in LAWS} | {"MAT": _other_material}

@@ -1,0 +1,263 @@
+"""The files of a deck cut into cards, as Radioss reads them.
+
+A deck is a starter file ``NAME_0000.rad`` (``/BEGIN`` ... ``/END``) and an engine file
+``NAME_0001.rad``, or one file holding both (Radioss's single-file input: the engine's
+cards, ``/END/ENGINE``, then the starter's; the engine's cards may also follow the
+starter's ``/END``, up to ``/END/ENGINE``). :func:`read_deck_text` returns the starter's
+cards and the engine's, and notices: one line for each thing read in a way the user
+may want to know about.
+
+- Lines starting with ``#`` or ``$`` are comments, but ``#include FILE``, which reads
+  FILE (relative to the including file) in place, and ``#enddata``, after which the
+  rest of its file is not read.
+- ``/END`` ends the starter (what follows is not read, but a one-file deck's engine);
+  in an included file it ends that file.
+- The lines of an included file before its first card continue the card that includes
+  it, as if pasted in place; a block of them that starts with text rather than numbers
+  is a free-text header (a copyright notice), skipped with a notice, as are the text
+  lines before the first card of the deck.
+- A file is UTF-8 (a byte-order mark is dropped), else Latin-1, whose columns are
+  Radioss's byte columns; UTF-16 with its byte-order mark is read too. CRLF and CR line
+  ends are line ends; blank lines at the end of a card are dropped. A space that is not
+  ASCII (a no-break space) is read as a space, with one notice naming where.
+"""
+
+from __future__ import annotations
+
+import codecs
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rwall_fem.radioss.reader import Card, DeckError, Line, NumberError, parse_number
+
+__all__ = ["DeckText", "read_cards", "read_deck_text"]
+
+# Unicode spaces that editors and word processors put where a space was meant.
+_ODD_SPACES = re.compile("[\u00a0\u1680\u2000-\u200a\u202f\u205f\u3000]")
+_NAMES = {"\u00a0": "a no-break space", "\u202f": "a narrow no-break space",
+          "\u3000": "an ideographic space"}  # fmt: skip
+
+
+@dataclass
+class DeckText:
+    """The cards of a deck file: ``starter`` (``/BEGIN`` to ``/END``; empty in an engine
+    file), ``engine`` (the others, up to ``/END`` or ``/END/ENGINE``), whether the file
+    holds an engine block ``/END/ENGINE`` closes, and ``notices``."""
+
+    starter: list[Card] = field(default_factory=list)
+    engine: list[Card] = field(default_factory=list)
+    engine_block: bool = False
+    notices: list[str] = field(default_factory=list)
+
+
+@dataclass
+class _End:
+    """``/END`` (``engine``: ``/END/ENGINE``) where it is."""
+
+    engine: bool
+    where: str
+
+
+def read_cards(path: str | Path) -> list[Card]:
+    """Every card of the file ``path`` and of the files it includes, in order."""
+    items, _ = _read(Path(path))
+    return [item for item in items if isinstance(item, Card)]
+
+
+def read_deck_text(path: str | Path) -> DeckText:
+    """The starter's and the engine's cards of the deck file ``path`` (see the module)."""
+    items, notices = _read(Path(path))
+    text = DeckText(notices=notices)
+    begin = next((k for k, item in enumerate(items)
+                  if isinstance(item, Card) and item.key(0) == "BEGIN"), None)  # fmt: skip
+    ends_engine = [k for k, item in enumerate(items) if isinstance(item, _End) and item.engine]
+    if begin is None:
+        for item in items:
+            if isinstance(item, _End):
+                break
+            text.engine.append(item)
+        text.engine_block = bool(ends_engine)
+        return text
+    end = next((k for k in range(begin, len(items))
+                if isinstance(items[k], _End) and not items[k].engine), len(items))  # fmt: skip
+    text.starter = [item for item in items[begin:end] if isinstance(item, Card)]
+    if any(isinstance(item, _End) for item in items[begin:end]):
+        where = next(item.where for item in items[begin:end] if isinstance(item, _End))
+        raise DeckError(f"{where}: /END/ENGINE inside the starter (after /BEGIN, before its "
+                        "/END): a one-file deck holds the engine's cards, /END/ENGINE, then "
+                        "/BEGIN and the starter's")  # fmt: skip
+    before = [item for item in items[:begin] if isinstance(item, Card)]
+    if before and not any(k < begin for k in ends_engine):
+        first = before[0]
+        raise DeckError(
+            f"{first.header.where}: {first.name}: a card before /BEGIN: the starter file must "
+            "begin with /BEGIN (a one-file deck: the engine's cards, then /END/ENGINE)"
+        )
+    after = [k for k in ends_engine if k > end]
+    if before:
+        text.engine, text.engine_block = before, True
+        if after:
+            raise DeckError(f"{items[after[0]].where}: a second /END/ENGINE: a one-file deck "
+                            "holds one engine block")  # fmt: skip
+    elif after:
+        text.engine = [item for item in items[end + 1 : after[0]] if isinstance(item, Card)]
+        text.engine_block = True
+    else:
+        ignored = [item for item in items[end + 1 :] if isinstance(item, Card)]
+        if ignored:
+            text.notices.append(
+                f"{ignored[0].header.where}: {len(ignored)} cards after /END not read (Radioss "
+                "reads nothing after /END)"
+            )
+    return text
+
+
+def _read(path: Path) -> tuple[list, list[str]]:
+    """The cards and /END markers of the file ``path`` and its includes, and notices."""
+    reading = _Reading()
+    reading.file(path, [])
+    for item in reading.items:
+        if isinstance(item, Card):
+            while item.lines and not item.lines[-1].text.strip():
+                item.lines.pop()
+    return reading.items, reading.notices
+
+
+class _Reading:
+    """The state of reading a deck file and the files it includes."""
+
+    def __init__(self):
+        self.items: list = []
+        self.notices: list[str] = []
+        self.current: Card | None = None
+        self.ended = False  # after the main file's /END: its text lines are not read
+
+    def file(self, path: Path, stack: list[Path]) -> None:
+        name = str(path)
+        lines = self._text(path, stack)
+        included = bool(stack)
+        head: list[Line] = []  # an included file's lines before its first card
+        at_head = True
+        for number, raw in enumerate(lines, start=1):
+            line = raw.rstrip()
+            head_text = line.lstrip()
+            lower = head_text.lower()
+            if lower.startswith("#include"):
+                self._flush_head(head, included)
+                at_head = False
+                self._include(path, number, head_text[len("#include") :].strip(), stack)
+                continue
+            if lower.startswith("#enddata"):
+                break
+            if head_text.startswith(("#", "$")):
+                continue
+            if line.startswith("/"):
+                self._flush_head(head, included)
+                at_head = False
+                parts = [p.strip() for p in line.strip().strip("/").split("/")]
+                upper = [p.upper() for p in parts]
+                where = f"{name}:{number}"
+                if upper == ["END"]:
+                    if included:
+                        self.notices.append(f"{where}: /END in an included file ends that "
+                                            "file (as Radioss reads it)")  # fmt: skip
+                        return
+                    self.items.append(_End(False, where))
+                    self.current, self.ended = None, True
+                    continue
+                if upper == ["END", "ENGINE"]:
+                    self.items.append(_End(True, where))
+                    self.current = None
+                    continue
+                if line.startswith("//"):
+                    raise DeckError(f"{where}: {line.strip()}: submodels (//SUBMODEL: ID offsets "
+                                    "and units of their own) are not read; write the "
+                                    "submodel's cards in the deck")  # fmt: skip
+                self.current = Card(parts, Line(line, name, number))
+                self.items.append(self.current)
+                continue
+            entry = Line(line, name, number)
+            if at_head:
+                head.append(entry)
+            elif self.current is not None:
+                self.current.lines.append(entry)
+            elif line.strip() and not self.ended:
+                self._header([entry])
+        self._flush_head(head, included)
+
+    def _flush_head(self, head: list[Line], included: bool) -> None:
+        """An included file's lines before its first card continue the including card, or
+        are a free-text header (skipped); the main file's are a header."""
+        if not head:
+            return
+        lines = list(head)
+        head.clear()
+        filled = [line for line in lines if line.text.strip()]
+        if not filled:
+            return
+        if included and self.current is not None and _numbers(filled[0]):
+            self.current.lines.extend(lines)
+            return
+        self._header(filled)
+
+    def _header(self, lines: list[Line]) -> None:
+        first, last = lines[0], lines[-1]
+        span = f"{first.where}" if first is last else f"{first.where}-{last.number}"
+        self.notices.append(
+            f"{span}: {len(lines)} line{'s' if len(lines) > 1 else ''} of text outside any card "
+            f"(a header: {first.text.strip()[:40]!r}) skipped"
+        )
+
+    def _include(self, path: Path, number: int, target: str, stack: list[Path]) -> None:
+        target = target.strip().strip("'\"")
+        where = f"{path}:{number}"
+        if not target:
+            raise DeckError(f"{where}: #include: no file named")
+        included = (path.parent / target).resolve()
+        if included in stack or included == path.resolve():
+            raise DeckError(f"{where}: #include {target}: includes itself")
+        if not included.is_file():
+            raise DeckError(f"{where}: #include {target}: file not found")
+        self.file(included, [*stack, path.resolve()])
+
+    def _text(self, path: Path, stack: list[Path]) -> list[str]:
+        """The lines of the file ``path`` (see the module for encodings and line ends)."""
+        name = str(path)
+        try:
+            data = path.read_bytes()
+        except OSError as err:
+            where = f"{stack[-1]}: " if stack else ""
+            raise DeckError(f"{where}{name}: cannot read the deck file: {err.strerror}") from None
+        if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+            text = data.decode("utf-16", errors="replace")
+        else:
+            if b"\0" in data:
+                at = data.index(b"\0")
+                raise DeckError(f"{name}: not a text file (binary data at byte {at})")
+            try:
+                text = data.decode("utf-8-sig")
+            except UnicodeDecodeError:
+                text = data.decode("latin-1")
+        lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        odd = [(k, m) for k, line in enumerate(lines, start=1)
+               for m in [_ODD_SPACES.search(line)] if m]  # fmt: skip
+        if odd:
+            k, m = odd[0]
+            what = _NAMES.get(m[0], "a Unicode space")
+            more = f" ({len(odd)} lines hold such spaces)" if len(odd) > 1 else ""
+            self.notices.append(f"{name}:{k}: {what} (U+{ord(m[0]):04X}) at column "
+                                f"{m.start() + 1} read as a space{more}")  # fmt: skip
+            lines = [_ODD_SPACES.sub(" ", line) for line in lines]
+        return lines
+
+
+def _numbers(line: Line) -> bool:
+    """Whether every word of ``line`` reads as a number (data, rather than a header)."""
+    try:
+        for word in line.words():
+            if word:
+                parse_number(word)
+    except NumberError:
+        return False
+    return True
