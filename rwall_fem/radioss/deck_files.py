@@ -121,7 +121,32 @@ def _read(path: Path) -> tuple[list, list[str]]:
         if isinstance(item, Card):
             while item.lines and not item.lines[-1].text.strip():
                 item.lines.pop()
-    return reading.items, reading.notices
+    items = [item for item in reading.items if not _submodel(item, reading.notices)]
+    return items, reading.notices
+
+
+def _submodel(item, notices: list[str]) -> bool:
+    """Whether ``item`` is a //SUBMODEL card, read in place when it offsets no ID and has
+    no units of its own (its cards are then the deck's), refused otherwise."""
+    if not isinstance(item, Card) or item.parts[:2] != ["", "SUBMODEL"]:
+        return False
+    where = item.header.where
+    if len(item.parts) > 3 and item.parts[3] not in ("", "0"):
+        raise DeckError(f"{where}: {item.name}: unit_ID {item.parts[3]}: a submodel's own units "
+                        "are not read; give its values in the units of /BEGIN")  # fmt: skip
+    offsets = [w for line in item.lines[1:2] for w in line.words()]
+    if any(_offset(w) for w in offsets):
+        raise DeckError(f"{item.lines[1].where}: {item.name}: ID offsets ({' '.join(offsets)}) "
+                        "are not read: write the submodel's cards with the deck's IDs")  # fmt: skip
+    notices.append(f"{where}: {item.name}: read in place (no ID offsets, no units of its own)")
+    return True
+
+
+def _offset(word: str) -> bool:
+    try:
+        return parse_number(word, integer=True) != 0
+    except NumberError:
+        return True
 
 
 class _Reading:
@@ -155,7 +180,10 @@ class _Reading:
             if line.startswith("/"):
                 self._flush_head(head, included)
                 at_head = False
-                parts = [p.strip() for p in line.strip().strip("/").split("/")]
+                body = line.strip()[2:] if line.startswith("//") else line.strip()[1:]
+                parts = [p.strip() for p in body.rstrip("/").split("/")]
+                if line.startswith("//"):  # //SUBMODEL, //ENDSUB
+                    parts.insert(0, "")
                 upper = [p.upper() for p in parts]
                 where = f"{name}:{number}"
                 if upper == ["END"]:
@@ -170,10 +198,9 @@ class _Reading:
                     self.items.append(_End(True, where))
                     self.current = None
                     continue
-                if line.startswith("//"):
-                    raise DeckError(f"{where}: {line.strip()}: submodels (//SUBMODEL: ID offsets "
-                                    "and units of their own) are not read; write the "
-                                    "submodel's cards in the deck")  # fmt: skip
+                if upper[:2] == ["", "ENDSUB"]:
+                    self.current = None
+                    continue
                 self.current = Card(parts, Line(line, name, number))
                 self.items.append(self.current)
                 continue

@@ -13,7 +13,32 @@ __all__ = ["element_table", "material_table"]
 
 
 def material_table(deck: Deck, mid: int) -> tuple[dict, str]:
-    """The [material] table of /MAT ``mid`` and the line saying what it became."""
+    """The [material] table of /MAT ``mid`` and the line saying what it became, with its
+    [material.failure]: the law's failure plastic strain (EPS_p_max), or /FAIL/JOHNSON."""
+    material, fact = _law_table(deck, mid)
+    m, fail = deck.materials[mid], deck.failures.get(mid)
+    own = m.get("failure")
+    if own and fail:
+        raise DeckError(f"{fail['where']}: {fail['card']}: material {mid} has a failure plastic "
+                        f"strain already (EPS_p_max of {m['where']}): one failure criterion per "
+                        "material here")  # fmt: skip
+    failure = own or fail
+    if failure is None:
+        return material, fact
+    if material["model"] == "linear_elastic":
+        deck.warnings.append(f"{fail['where']}: {fail['card']}: material {mid} is elastic (no "
+                             "plastic strain): it never fails; not used")  # fmt: skip
+        return material, fact
+    table = {k: v for k, v in failure.items() if k not in ("where", "card") and v is not None}
+    if own:
+        how = f"eroded at plastic strain {own['plastic_strain']:g} (EPS_p_max)"
+    else:
+        how = f"Johnson-Cook failure D1-D5 ({fail['card']}, {fail['where']})"
+    return material | {"failure": table}, f"{fact}, {how}"
+
+
+def _law_table(deck: Deck, mid: int) -> tuple[dict, str]:
+    """The [material] table of /MAT ``mid`` without failure, and its line."""
     m = deck.materials[mid]
     table = {"density": m["density"], "young": m["young"], "poisson": m["poisson"]}
     head = f"material: /MAT/{m['law']}/{mid} ({m['where']})"

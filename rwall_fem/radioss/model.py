@@ -179,6 +179,7 @@ class Deck:
     bodies: list[Body] = field(default_factory=list)
     parts: dict[int, Part] = field(default_factory=dict)
     materials: dict[int, dict] = field(default_factory=dict)  # ID -> material facts
+    failures: dict[int, dict] = field(default_factory=dict)  # mat_ID -> /FAIL facts
     properties: dict[int, dict] = field(default_factory=dict)  # ID -> property facts
     groups: dict[int, Group] = field(default_factory=dict)  # /GRNOD by ID
     element_groups: dict[tuple[str, int], Group] = field(default_factory=dict)  # (family, ID)

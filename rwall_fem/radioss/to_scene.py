@@ -151,9 +151,18 @@ def scene_of(deck: Deck) -> SceneParts:
 
 
 def _check_references(deck: Deck) -> None:
-    """Every part's /MAT and /PROP, every element's /PART and nodes exist; there are
-    elements."""
+    """Every element's /PART, and that part's /MAT and /PROP, and its nodes exist; there
+    are elements."""
+    used = {b.part for b in deck.bodies}
     for part in deck.parts.values():
+        if part.id not in used:  # a part of elements that are not read (springs) may have none
+            continue
+        if part.mat == 0:
+            raise DeckError(f"{part.where}: /PART/{part.id}: part {part.id} has no material "
+                            "(mat_ID is 0 or blank)")  # fmt: skip
+        if part.prop == 0:
+            raise DeckError(f"{part.where}: /PART/{part.id}: part {part.id} has no property "
+                            "(prop_ID is 0 or blank)")  # fmt: skip
         if part.mat not in deck.materials:
             raise DeckError(f"{part.where}: /PART/{part.id}: mat_ID {part.mat} refers to no /MAT")
         if part.prop not in deck.properties:

@@ -23,6 +23,7 @@ from rwall_fem.radioss.cards import (
     begin,
     conditions,
     control,
+    failures,
     functions,
     groups,
     materials,
@@ -32,11 +33,13 @@ from rwall_fem.radioss.cards import (
     solids,
     walls,
 )
+from rwall_fem.radioss.cards.base import keyword
 
-__all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "lookup", "supported", "table"]
+__all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supported", "table"]
 
 STARTER_FAMILIES = (
-    begin, nodes, solids, parts, materials, groups, functions, conditions, walls, control,
+    begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
+    control,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 
@@ -56,8 +59,9 @@ def table(families, which: str) -> dict[tuple[str, ...], Reader]:
 
 
 def lookup(readers: dict[tuple[str, ...], Reader], card) -> Reader | None:
-    """The reader of the longest path that the card's first keywords match, or None."""
-    keys = tuple(p.upper() for p in card.parts)
+    """The reader of the longest path that the card's first keywords match, or None
+    (``LAW01`` is ``LAW1``, as Radioss reads it)."""
+    keys = tuple(keyword(p) for p in card.parts)
     for length in range(min(len(keys), 4), 0, -1):
         read = readers.get(keys[:length])
         if read is not None:

@@ -3,9 +3,11 @@ Radioss's "no limit" values."""
 
 from __future__ import annotations
 
+import re
+
 from rwall_fem.radioss.reader import Card
 
-__all__ = ["BIG", "catch_all", "ident", "inactive", "notice_only"]
+__all__ = ["BIG", "catch_all", "ident", "inactive", "keyword", "notice_only"]
 
 BIG = 1e19  # Radioss writes "no limit" as 1e20 or 1e30; a blank or 0 field means it too
 
@@ -24,6 +26,12 @@ def ident(card: Card, index: int, what: str = "ID") -> int:
             "give the values in the input units of /BEGIN"
         )
     return value
+
+
+def keyword(part: str) -> str:
+    """A keyword of a card's name as the tables hold it: capitals, a law's number without
+    leading zeros (``/MAT/LAW02`` is ``/MAT/LAW2``)."""
+    return re.sub(r"^LAW0+(?=\d)", "LAW", part.upper())
 
 
 def inactive(value: float) -> bool:

@@ -12,7 +12,8 @@ __all__ = ["STARTER"]
 
 def _begin(deck: Deck, card: Card) -> None:
     if deck.version:
-        card.fail("a second /BEGIN")
+        _again(deck, card)
+        return
     deck.run_name = card.line(0, "Runname").text.strip()
     version, _ = card.read(1, "i:Invers i:Irun", "Invers Irun")
     if version < 100:
@@ -25,8 +26,13 @@ def _begin(deck: Deck, card: Card) -> None:
     systems = []
     for index, what in ((3, "Work_mass_unit Work_length_unit Work_time_unit"),
                         (2, "Input_mass_unit Input_length_unit Input_time_unit")):  # fmt: skip
-        line = card.line(index, what)
-        texts = read_fields(card, line, "s:mass:20 s:length:20 s:time:20")
+        # A blank line of work units is a blank card's end, which the reader drops.
+        line = card.lines[index] if index < len(card.lines) or index == 2 else None
+        if line is None:
+            texts = ["", "", ""]
+        else:
+            line = card.line(index, what)
+            texts = read_fields(card, line, "s:mass:20 s:length:20 s:time:20")
         default = systems[0] if systems else UnitSystem()
         sizes, names = [], []
         for text, quantity, fallback, name in zip(
@@ -48,6 +54,26 @@ def _begin(deck: Deck, card: Card) -> None:
         systems.append(UnitSystem(*sizes, names=tuple(names)))
     deck.work_units, deck.input_units = systems
     deck.begin_where = card.header.where
+
+
+def _again(deck: Deck, card: Card) -> None:
+    """A second /BEGIN (an included file written as a deck of its own): skipped if its
+    units are the deck's, refused otherwise (its values would be in other units)."""
+    first = (deck.input_units, deck.work_units, deck.begin_where, deck.version, deck.run_name)
+    deck.version = 0
+    try:
+        _begin(deck, card)
+        units = [_sizes(deck.input_units), _sizes(deck.work_units)]
+    finally:
+        deck.input_units, deck.work_units, deck.begin_where, deck.version, deck.run_name = first
+    if units != [_sizes(deck.input_units), _sizes(deck.work_units)]:
+        card.fail(f"a second /BEGIN, in other units than the first ({deck.begin_where}): a deck "
+                  "has one input and one work unit system")  # fmt: skip
+    deck.notice(card, f"a second /BEGIN, in the units of the first ({deck.begin_where}): skipped")
+
+
+def _sizes(units: UnitSystem) -> tuple[float, float, float]:
+    return (units.mass, units.length, units.time)
 
 
 STARTER = {"BEGIN": _begin}

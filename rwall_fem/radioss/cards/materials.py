@@ -5,7 +5,9 @@ has no counterpart is refused unless it is left at its default."""
 
 from __future__ import annotations
 
-from rwall_fem.radioss.cards.base import catch_all, ident, inactive
+import math
+
+from rwall_fem.radioss.cards.base import catch_all, ident, inactive, keyword
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card
 from rwall_fem.radioss.units import UnitSystem
@@ -19,7 +21,7 @@ _SUPPORTED = "/MAT/LAW1 (ELAST), /MAT/LAW2 (PLAS_JOHNS), /MAT/LAW36 (PLAS_TAB)"
 
 
 def _material(deck: Deck, card: Card) -> None:
-    law = LAWS[card.key(1)]
+    law = LAWS[keyword(card.parts[1])]
     units = deck.input_units
     mid = ident(card, 2, "mat_ID")
     if mid in deck.materials:
@@ -56,12 +58,13 @@ def _failure_strain(card: Card, name: str, value: float, line) -> dict:
 
 
 def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
-    """/MAT/LAW2: (a + b eps_p^n)(1 + c ln(rate/rate_0))(1 - T*^m), the element deleted
-    when eps_p reaches EPS_p_max; what has no counterpart is refused unless inactive."""
+    """/MAT/LAW2: (a + b eps_p^n)(1 + c ln(rate/rate_0))(1 - T*^m) (Iflag 1: b and n from
+    a tensile test), the element deleted when eps_p reaches EPS_p_max; what has no
+    counterpart is refused unless inactive."""
     stress = units.factor("stress")
     E, nu, iflag, vp, pmin = card.read(2, "f:E f:nu i:Iflag i:VP f:Pmin", "E nu Iflag VP Pmin")
-    if iflag != 0:
-        card.fail("Iflag 1 (yield stress, UTS and strain at UTS): give a, b and n (Iflag 0)",
+    if iflag not in (0, 1):
+        card.fail(f"Iflag = {iflag}: 0 (a, b, n) or 1 (yield stress, UTS, strain at UTS)",
                   card.lines[2])  # fmt: skip
     if not inactive(pmin):
         card.fail(f"Pmin = {pmin:g}: rwall_fem has no pressure cut-off; leave Pmin blank",
@@ -71,15 +74,16 @@ def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
     if not inactive(sig_max):
         card.fail(f"SIG_max0 = {sig_max:g}: rwall_fem has no cap on the flow stress; leave "
                   "SIG_max0 blank", card.lines[3])  # fmt: skip
-    c, rate0, _, smooth, _, chard = card.read(
-        4, "f:c f:EPS_DOT_0 i:ICC i:Fsmooth f:F_cut f:Chard", "c EPS_DOT_0 ICC Fsmooth F_cut Chard"
+    c, rate0, _, smooth, _, chard = card.read_optional(
+        4, "f:c f:EPS_DOT_0 i:ICC i:Fsmooth f:F_cut f:Chard"
     )
     if chard != 0.0:
         card.fail(f"Chard = {chard:g}: rwall_fem's hardening is isotropic (Chard 0)",
                   card.lines[4])  # fmt: skip
-    m, t_melt, rho_cp, t_room, t_max = card.read(5, "f:m f:T_melt f:rhoC_p f:T_r f:T_max",
-                                                 "m T_melt rhoC_p T_r T_max")  # fmt: skip
-    if n == 0.0 and b != 0.0:
+    m, t_melt, rho_cp, t_room, t_max = card.read_optional(5, "f:m f:T_melt f:rhoC_p f:T_r f:T_max")
+    if iflag == 1:
+        b, n = _from_tensile_test(deck, card, E, a, b, n)
+    elif n == 0.0 and b != 0.0:
         n = 1.0  # Radioss's default exponent
     facts = {"young": E * stress, "poisson": nu, "a": a * stress, "b": b * stress,
              "n": n if n else 1.0, "raw_young": E}  # fmt: skip
@@ -103,6 +107,27 @@ def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
         deck.warn(card, "the thermal term heats by the plastic work (taylor_quinney = 1), where "
                   "Radioss heats by the internal energy", card.lines[5])  # fmt: skip
     return facts
+
+
+def _from_tensile_test(deck: Deck, card: Card, E: float, a: float, uts: float,
+                       strain: float) -> tuple[float, float]:  # fmt: skip
+    """b and n of Iflag 1, from the yield stress a, the engineering stress UTS and strain
+    at UTS, as Radioss works them out: the true stress and strain at UTS lie on the curve
+    where it starts necking (Considere: d sigma / d eps = sigma), n = sigma ln(1 + e) /
+    (sigma - a); above n = 1, the line through the yield point and UTS (Radioss's)."""
+    line = card.lines[3]
+    if uts <= a or strain <= 0:
+        card.fail(f"Iflag 1: UTS = {uts:g} must be above the yield stress {a:g} and the strain "
+                  f"at UTS ({strain:g}) above 0", line)  # fmt: skip
+    true_stress, true_strain = uts * (1 + strain), math.log(1 + strain)
+    n = true_stress * true_strain / (true_stress - a)
+    b = true_stress / (n * true_strain ** (n - 1))
+    if n > 1:
+        n = 1.0
+        b = (true_stress - a) / (true_strain - true_stress / E - a / E)
+        deck.warn(card, "Iflag 1: the exponent from UTS is above 1: linear hardening through the "
+                  "yield point and UTS, as Radioss", line)  # fmt: skip
+    return b, n
 
 
 def _tabulated(card: Card, units: UnitSystem) -> dict:

@@ -1,5 +1,6 @@
 """/PART (a property and a material for elements) and /SUBSET (parts and subsets
-gathered: a part names its subset, a subset its child subsets)."""
+gathered: a part names its subset, a subset its child subsets). A part without a
+material or property is refused once it has elements (a spring's part has none)."""
 
 from __future__ import annotations
 
@@ -17,10 +18,6 @@ def _part(deck: Deck, card: Card) -> None:
     prop, mat, subset = card.read(1, "i:prop_ID i:mat_ID i:subset_ID", "prop_ID mat_ID subset_ID")
     if pid in deck.parts:
         card.fail(f"part {pid} is defined twice")
-    if mat == 0:
-        card.fail(f"part {pid} has no material (mat_ID is 0 or blank)", card.lines[1])
-    if prop == 0:
-        card.fail(f"part {pid} has no property (prop_ID is 0 or blank)", card.lines[1])
     deck.parts[pid] = Part(pid, card.title(), prop, mat, card.lines[1].where, subset)
 
 

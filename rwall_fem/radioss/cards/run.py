@@ -6,7 +6,7 @@ does not have are noticed and skipped."""
 from __future__ import annotations
 
 from rwall_fem.radioss.model import GROUP_CELLS, Deck
-from rwall_fem.radioss.reader import Card, read_fields
+from rwall_fem.radioss.reader import Card, Line, read_fields
 
 __all__ = ["ENGINE", "finish"]
 
@@ -21,9 +21,12 @@ _OTHER_TYPES = ("INTER", "BEAM", "TRUSS", "SPRING", "QUAD", "AIRBAG", "SPH", "SM
 
 
 def _free(card: Card, layout: str, what: str) -> list:
-    """The fields of the card's first line by ``layout``, its words in order (the engine's
-    free format) or its columns."""
-    return read_fields(card, card.line(0, what), layout)
+    """The numbers of the card's first line by ``layout``: its words in order (the
+    engine's lines are read in the free format, blanks separating the fields)."""
+    line = card.line(0, what)
+    words = line.words()
+    free = Line(", ".join(words), line.file, line.number)
+    return read_fields(card, free, layout)
 
 
 def _run(deck: Deck, card: Card) -> None:
