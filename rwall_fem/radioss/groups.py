@@ -15,17 +15,20 @@ Each takes ``user``, the text that names the card using the group (``"file:line:
 /GRNOD``. A group holding a group holding itself is refused naming the cycle. Results
 are kept on the deck (``deck.resolved``): a group is worked out once.
 
-In groups, a negative ID removes what that item holds (from what the positive items
-gather, whatever the order); in surfaces, it turns that item's segments over, as in
-Radioss. Kinds (the card's second keyword): a /GRNOD lists NODE (NODENS), GRNOD, PART,
-SUBSET, MAT, PROP, BOX (nodes inside or on the box), SURF (nodes of the segments),
-GRBRIC, GRSHEL, GRSH3N (nodes of the elements); an element group lists its own
-elements (BRIC, SHEL, SH3N), groups of its family, PART, SUBSET, MAT, PROP, BOX (the
-elements whose nodes are all in the box) or BOX2 (at least one); a /SURF lists SEG
-(its segments), SURF, GRSHEL, GRSH3N (the shells), PART, SUBSET, MAT, PROP (their
-shells; with /EXT also the outer faces of their solids, the faces no other solid of
-the selection shares; with /ALL every face of their solids), BOX and BOX2 (a box's
-segments, likewise).
+In groups, a negative ID removes what that item holds from what the items before it
+gathered (items are taken in order, as Radioss tags them: an item listed after its
+removal is in again); parts, subsets, materials and properties are gathered and removed
+as parts, before their nodes or elements are taken. In surfaces, a negative ID turns
+that item's segments over, as in Radioss.
+
+Kinds (the card's second keyword): a /GRNOD lists NODE (NODENS), GRNOD, PART, SUBSET,
+MAT, PROP, BOX (nodes inside or on the box), SURF (nodes of the segments), GRBRIC,
+GRSHEL, GRSH3N (nodes of the elements); an element group lists its own elements (BRIC,
+SHEL, SH3N), groups of its family, PART, SUBSET, MAT, PROP, BOX (the elements whose nodes
+are all in the box) or BOX2 (at least one); a /SURF lists SEG (its segments), SURF,
+GRSHEL, GRSH3N (the shells), PART, SUBSET, MAT, PROP (their shells; with /EXT also the
+outer faces of their solids, the faces no other solid of the selection shares; with
+/ALL every face of their solids), BOX and BOX2 (a box's segments, likewise).
 """
 
 from __future__ import annotations
@@ -76,10 +79,19 @@ def surface(deck: Deck, sid: int, user: str) -> np.ndarray:
 
 
 def part_ids(deck: Deck, kind: str, items: np.ndarray, user: str) -> np.ndarray:
-    """The sorted IDs of the parts that ``items`` (signed IDs: a negative one removes)
-    of ``kind`` PART, SUBSET, MAT or PROP gather."""
-    keep, drop = _split(items)
-    return np.setdiff1d(_parts(deck, kind, keep, user), _parts(deck, kind, drop, user))
+    """The sorted IDs of the parts that ``items`` (signed IDs, in order: a negative one
+    removes) of ``kind`` PART, SUBSET, MAT or PROP gather."""
+    return _in_order(items, lambda item: _parts(deck, kind, np.array([item]), user))
+
+
+def _in_order(items: np.ndarray, members) -> np.ndarray:
+    """What the signed ``items`` gather in order: ``members(item)`` (sorted IDs) added for
+    a positive item, taken away for a negative one."""
+    out = np.zeros(0, np.int64)
+    for item in np.asarray(items, dtype=np.int64).tolist():
+        held = np.asarray(members(abs(item)), dtype=np.int64)
+        out = np.union1d(out, held) if item > 0 else np.setdiff1d(out, held)
+    return out
 
 
 def _resolved(deck: Deck, group: Group, how) -> np.ndarray:
@@ -174,36 +186,29 @@ def _subset_parts(deck: Deck, sid: int, user: str, stack: list[int]) -> set[int]
 
 
 def _node_group(deck: Deck, group: Group) -> np.ndarray:
-    keep, drop = _split(group.items)
-    return np.setdiff1d(_node_items(deck, group, keep), _node_items(deck, group, drop))
-
-
-def _node_items(deck: Deck, group: Group, items: np.ndarray) -> np.ndarray:
-    """The node IDs the items (positive IDs) of the node group ``group`` hold."""
     kind, user = group.kind, _user(group)
-    if not len(items):
-        return np.zeros(0, np.int64)
+    if kind in ("PART", "SUBSET", "MAT", "PROP"):
+        parts = set(part_ids(deck, kind, group.items, user).tolist())
+        return _union(b.nodes.ravel() for b in deck.bodies if b.part in parts)
     if kind == "NODE":
-        missing = items[deck.node_positions(items) < 0]
+        missing = np.abs(group.items)[deck.node_positions(np.abs(group.items)) < 0]
         if len(missing):
             raise DeckError(f"{group.where}: {group.name}: node {missing[0]} refers to no /NODE")
-        return np.unique(items)
+    return _in_order(group.items, lambda item: _node_item(deck, group, item, user))
+
+
+def _node_item(deck: Deck, group: Group, item: int, user: str) -> np.ndarray:
+    """The node IDs that the item ``item`` (an ID > 0) of the node group holds."""
+    kind = group.kind
+    if kind == "NODE":
+        return np.array([item])
     if kind == "GRNOD":
-        return _union(node_ids(deck, g, user) for g in items.tolist())
-    if kind in ("PART", "SUBSET", "MAT", "PROP"):
-        parts = _parts(deck, kind, items, user)
-        nodes = [b.nodes.ravel() for b in deck.bodies if b.part in set(parts.tolist())]
-        return _union(nodes)
+        return node_ids(deck, item, user)
     if kind == "BOX":
-        inside = np.zeros(len(deck.node_ids), dtype=bool)
-        for bid in items.tolist():
-            inside |= _box(deck, bid, user).inside(deck.coordinates)
-        return np.unique(deck.node_ids[inside])
+        return np.unique(deck.node_ids[_box(deck, item, user).inside(deck.coordinates)])
     if kind == "SURF":
-        return _union(surface(deck, s, user).ravel() for s in items.tolist())
-    family = kind  # GRBRIC, GRSHEL, GRSH3N
-    return _union(_element_nodes(deck, family, element_ids(deck, family, g, user))
-                  for g in items.tolist())  # fmt: skip
+        return np.unique(surface(deck, item, user))
+    return _element_nodes(deck, kind, element_ids(deck, kind, item, user))  # GRBRIC, GRSHEL...
 
 
 def _union(arrays) -> np.ndarray:
@@ -222,34 +227,28 @@ def _box(deck: Deck, bid: int, user: str):
 
 
 def _element_group(deck: Deck, group: Group) -> np.ndarray:
-    keep, drop = _split(group.items)
-    return np.setdiff1d(_element_items(deck, group, keep), _element_items(deck, group, drop))
-
-
-def _element_items(deck: Deck, group: Group, items: np.ndarray) -> np.ndarray:
     family, kind, user = group.family, group.kind, _user(group)
-    if not len(items):
-        return np.zeros(0, np.int64)
     ids, parts, cards = _elements(deck, family)
+    if kind in ("PART", "SUBSET", "MAT", "PROP"):
+        return np.unique(ids[np.isin(parts, part_ids(deck, kind, group.items, user))])
     if kind in _FAMILY:  # the element IDs themselves
-        missing = np.setdiff1d(items, ids)
+        missing = np.setdiff1d(np.abs(group.items), ids)
         if len(missing):
             raise DeckError(f"{group.where}: {group.name}: element {missing[0]} refers to no "
                             f"element of {family}'s kind")  # fmt: skip
-        return np.unique(items)
+        return _in_order(group.items, lambda item: np.array([item]))
     if kind == family:
-        return _union(element_ids(deck, family, g, user) for g in items.tolist())
-    if kind in ("PART", "SUBSET", "MAT", "PROP"):
-        return np.unique(ids[np.isin(parts, _parts(deck, kind, items, user))])
-    inside = np.zeros(0, dtype=bool)  # BOX: every node inside; BOX2: one at least
-    for nodes in cards:
-        x = deck.coordinates[deck.node_positions(nodes.ravel())]
-        hit = np.zeros(len(x), dtype=bool)
-        for bid in items.tolist():
-            hit |= _box(deck, bid, user).inside(x)
-        hit = hit.reshape(nodes.shape)
-        inside = np.concatenate([inside, hit.all(axis=1) if kind == "BOX" else hit.any(axis=1)])
-    return np.unique(ids[inside])
+        return _in_order(group.items, lambda item: element_ids(deck, family, item, user))
+
+    def in_box(item: int) -> np.ndarray:  # BOX: every node inside; BOX2: one at least
+        box, inside = _box(deck, item, user), []
+        for nodes in cards:
+            hit = box.inside(deck.coordinates[deck.node_positions(nodes.ravel())])
+            hit = hit.reshape(nodes.shape)
+            inside.append(hit.all(axis=1) if kind == "BOX" else hit.any(axis=1))
+        return np.unique(ids[np.concatenate(inside)]) if inside else ids
+
+    return _in_order(group.items, in_box)
 
 
 # --- surfaces ---------------------------------------------------------------------------
