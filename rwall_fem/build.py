@@ -65,6 +65,7 @@ from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
 from rwall_fem.time_step import step_size
+from rwall_fem.units import parse_system
 from rwall_fem.walls import RigidWall
 from rwall_fem.walls.motion import MainNodeMotion, PrescribedMotion
 from rwall_fem.walls.shapes import SHAPES
@@ -398,6 +399,7 @@ def _add_recorders(
         every=scene.output.history_interval,
         guards=guards,
         plot=scene.output.plot,
+        units=parse_system(scene.output.units),
     )
     run_log = RunLog(
         directory, scene, facts, comm=sim.comm, frames=scene.output.frames,

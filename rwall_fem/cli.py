@@ -5,8 +5,9 @@
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
 - ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`);
-- ``rwall-fem convert NAME_0000.rad DIR``: a Radioss deck as a scene and its mesh
-  (:mod:`rwall_fem.radioss`); ``run`` and ``check`` also take a deck as they take a scene.
+- ``rwall-fem convert NAME_0000.rad DIR [--force]``: a Radioss deck as a scene and its
+  mesh (:mod:`rwall_fem.radioss`; a scene of that name in DIR is replaced only with
+  ``--force``); ``run`` and ``check`` also take a deck as they take a scene.
 
 Exit codes: 0 done, 2 bad input (one line on stderr, no traceback, on every rank; also a
 mistake on the command line, a checkpoint that does not fit the scene, code the C
@@ -90,6 +91,9 @@ def _command(argv: list[str] | None) -> int:
     )
     convert.add_argument("deck", help="the starter file NAME_0000.rad (NAME_0001.rad beside it)")
     convert.add_argument("directory", help="where NAME.toml and NAME.msh go")
+    convert.add_argument(
+        "--force", action="store_true", help="replace a NAME.toml and NAME.msh in DIRECTORY"
+    )
     study = commands.add_parser("study", help="accuracy against wall time, on exact references")
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
@@ -115,7 +119,7 @@ def _command(argv: list[str] | None) -> int:
             if args.command == "study":
                 code = _study(args.out, args.quick, comm)
             elif args.command == "convert":
-                code = _convert(args.deck, args.directory, comm)
+                code = _convert(args.deck, args.directory, comm, args.force)
             elif args.command == "check":
                 code = _check(args.scene, args.overrides, comm, args.lift_limits)
             else:
@@ -230,10 +234,12 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
     from rwall_fem.checkpoint import latest_checkpoint
     from rwall_fem.output.run_log import CycleLines, cycle_schedule
 
-    scene = _load(scene_file, overrides, comm)
+    scene, deck_report = _load(scene_file, overrides, comm)
     if resume:  # before meshing, and before the folder is made
         latest_checkpoint(Path(out) if out is not None else scene.output.directory, comm)
     sim = build_simulation(scene, comm, out, limits=not lift_limits)
+    if deck_report is not None:
+        deck_report.say()
     if comm.rank == 0 and not quiet:
         if sys.stderr.isatty():
             from rwall_fem.output.progress import Progress
@@ -247,24 +253,28 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
 
 
 def _load(scene_file, overrides, comm):
-    """The scene of a TOML file, or of a Radioss deck (:mod:`rwall_fem.radioss`)."""
+    """The scene of a TOML file, or of a Radioss deck (:mod:`rwall_fem.radioss`), and
+    for a deck its :class:`~rwall_fem.radioss.DeckReport` (None for a TOML file), to say
+    once the run is built: a deck whose run cannot be built gets one line, the error."""
     from rwall_fem.radioss import is_deck, load_deck
     from rwall_fem.scene import load_scene
 
     if is_deck(scene_file):
-        return load_deck(scene_file, overrides, comm)
-    return load_scene(scene_file, overrides)
+        report: list = []
+        scene = load_deck(scene_file, overrides, comm, report=report)
+        return scene, report[0]
+    return load_scene(scene_file, overrides), None
 
 
-def _convert(deck: str, directory: str, comm) -> int:
-    """``rwall-fem convert``: rank 0 writes the scene and its mesh; a refusal reaches every
-    rank."""
+def _convert(deck: str, directory: str, comm, force: bool) -> int:
+    """``rwall-fem convert``: rank 0 writes the scene and its mesh (not over a scene of
+    the same name, unless ``force``); a refusal reaches every rank."""
     from rwall_fem.radioss import DeckError, convert
 
     outcome = None
     if comm.rank == 0:
         try:
-            outcome = str(convert(deck, directory))
+            outcome = str(convert(deck, directory, force=force))
         except DeckError as err:
             outcome = err
     outcome = comm.bcast(outcome, root=0)
@@ -319,11 +329,13 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
     from rwall_fem.build import build_simulation
     from rwall_fem.estimate import estimate
 
-    scene = _load(scene_file, overrides, comm)
+    scene, deck_report = _load(scene_file, overrides, comm)
     guess = estimate(scene, comm.size)  # on every rank: it may refuse the scene
     if comm.rank == 0:
         print(f"rwall-fem: estimate before meshing: {guess.describe()}")
     sim = build_simulation(scene, comm, out=None, limits=not lift_limits)
+    if deck_report is not None:
+        deck_report.say()
     started = time.perf_counter()
     for _ in range(5):
         sim.internal.accelerate(sim.state)
@@ -350,14 +362,18 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
             f"s from the smallest cell L/c); {steps}"
         )
         print(f"  effects: {', '.join(sim.effects)}")
-        for w, count in zip(sim.walls, walls, strict=True):
-            print(f"  {w.name}: {w.shape.kind}, slide {w.slide}, {count} secondary nodes")
+        cards = deck_report.walls if deck_report is not None else [""] * len(walls)
+        for w, count, card in zip(sim.walls, walls, cards, strict=True):
+            print(f"  {w.name}{f' {card}' if card else ''}: {w.shape.kind}, slide {w.slide}, "
+                  f"{count} secondary nodes")  # fmt: skip
         for b, count in zip(sim.boundaries, boundaries, strict=True):
             print(f"  {b.name}: {count} nodes, components {''.join('xyz'[i] for i in b.axes)}")
         print(
             f"  estimated wall time: {1.2 * per_step * (sim.planned_steps + 1):.3g} s "
             f"(internal force {per_step * 1e3:.3g} ms per step, + 20 % for the rest)"
         )
+        for line in deck_report.listing if deck_report is not None else ():
+            print(f"  {line}")
     return 0
 
 

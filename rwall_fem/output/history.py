@@ -36,7 +36,9 @@ from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every
 from rwall_fem.output.summary import momentum, run_summary, write_summary
 from rwall_fem.output.tables import CsvTable
+from rwall_fem.output.units import column_scales, summary_in
 from rwall_fem.output.wall_table import WALL_COLUMNS, WallTable
+from rwall_fem.units import SI, UnitSystem
 
 __all__ = ["FLUSH_SECONDS", "POLL_SECONDS", "History"]
 
@@ -50,12 +52,15 @@ class History:
     step) of ``sim``, into ``directory``; it writes the run summary when closed.
 
     :attr:`energy` and :meth:`wall` read the samples back from the files as arrays
-    (collective calls), :attr:`summary` is the summary once the run has ended;
+    (collective calls; in the files' ``units``), :attr:`summary` is the summary once the
+    run has ended (SI);
     :attr:`balance` is the energy balance.
     """
 
-    def __init__(self, sim, directory: Path, *, every: int, guards: Guards, plot: bool = False):
+    def __init__(self, sim, directory: Path, *, every: int, guards: Guards, plot: bool = False,
+                 units: UnitSystem = SI):  # fmt: skip
         self.directory = Path(directory)
+        self.units = units  # of the files (:mod:`~rwall_fem.output.units`); SI in memory
         self.steps = Every(every)
         self.guards = guards
         self.plot = plot  # draw histories.png at the end
@@ -82,8 +87,10 @@ class History:
         )
         self.wall_table = WallTable(walls)
         self.summary: dict | None = None
-        self._energy_csv = CsvTable(self.directory / "energy.csv", self.balance.columns, comm)
-        self._walls_csv = CsvTable(self.directory / "walls.csv", WALL_COLUMNS, comm)
+        self._energy_csv = CsvTable(self.directory / "energy.csv", self.balance.columns, comm,
+                                    column_scales(self.balance.columns, "energy", units))
+        self._walls_csv = CsvTable(self.directory / "walls.csv", WALL_COLUMNS, comm,
+                                   column_scales(WALL_COLUMNS, "walls", units))  # fmt: skip
         self._tables = [self._energy_csv] + ([self._walls_csv] if walls else [])
         self._written_at = time.monotonic()
         self._sums = _Sums(
@@ -237,7 +244,7 @@ class History:
         energy_rows, wall_rows = arrays["rows"].tolist()
         latest = self._energy_csv.resume(energy_rows) or ()
         self._walls_csv.resume(wall_rows)
-        if list(latest) != arrays["balance_latest"].tolist():
+        if list(latest) != list(self._energy_csv.in_units(arrays["balance_latest"].tolist())):
             raise ValueError(
                 f"{self._energy_csv.path}: row {energy_rows} is not the checkpoint's (the file "
                 "was changed, or is another run's)"
@@ -283,7 +290,7 @@ class History:
                 failures.append(err)
         if sim.comm.rank == 0:
             try:
-                write_summary(self.directory, self.summary)
+                write_summary(self.directory, summary_in(self.summary, self.units))
             except OutputError as err:
                 failures.append(err)
             if failures:

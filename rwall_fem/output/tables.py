@@ -26,10 +26,12 @@ PENDING_LINES = 1000  # rows kept before they are written, whatever the time sin
 
 
 class CsvTable:
-    """Rows with the columns ``columns``, written to ``path`` by rank 0 of ``comm``."""
+    """Rows with the columns ``columns``, written to ``path`` by rank 0 of ``comm``, each
+    value times its column's ``scales`` if given (another unit system than SI's)."""
 
-    def __init__(self, path: Path, columns: Sequence[str], comm):
+    def __init__(self, path: Path, columns: Sequence[str], comm, scales=None):
         self.path, self.columns, self.comm = Path(path), list(columns), comm
+        self.scales = scales
         self.count = 0  # rows so far
         self.error: OutputError | None = None  # why the file could not be written (rank 0)
         self._pending: list[str] = []
@@ -42,10 +44,16 @@ class CsvTable:
         self.count += 1
         if self.comm.rank != 0:
             return
-        self._pending.append(row)
+        self._pending.append(self.in_units(row))
         if len(self._pending) >= PENDING_LINES:
             with contextlib.suppress(OutputError):  # kept in :attr:`error`
                 self.flush()
+
+    def in_units(self, row: Sequence) -> Sequence:
+        """``row`` as the file holds it: each float times its column's scale."""
+        if self.scales is None:
+            return row
+        return [x * k if isinstance(x, float) else x for x, k in zip(row, self.scales, strict=True)]
 
     def flush(self, create: bool = False) -> None:
         """Write the pending lines and flush the file (rank 0); the first flush with lines

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from rwall_fem.radioss.deck_files import read_deck_text
 from rwall_fem.radioss.engine import read_engine
+from rwall_fem.radioss.listing import starter_listing
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import DeckError
 from rwall_fem.radioss.starter import read_starter
@@ -130,6 +131,8 @@ class DeckReport:
     notices: list[str]
     warnings: list[str]
     work_units: tuple[tuple[float, float, float], tuple[str, str, str]]
+    listing: list[str]  # a starter listing (:mod:`~rwall_fem.radioss.listing`)
+    walls: list[str]  # each wall's card, in the order of the scene's walls
 
     def say(self) -> None:
         """Log the lines: facts and notices as information, warnings as warnings."""
@@ -155,8 +158,10 @@ def _prepare(path: Path, mesh_dir: Path | None) -> DeckReport:
             raise DeckError(f"{path}: cannot write the mesh file {mesh}: {err.strerror}") from None
     parts.raw["mesh"]["file"] = str(mesh.resolve())
     units = deck.work_units
-    return DeckReport(parts.raw, parts.facts, deck.notices, deck.warnings,
-                      ((units.mass, units.length, units.time), units.names))  # fmt: skip
+    listing = starter_listing(deck, deck.dt_scale or 0.9)
+    walls = [f"/RWALL/{w.kind}/{w.id} ({w.where})" for w in deck.walls]
+    sizes = ((units.mass, units.length, units.time), units.names)
+    return DeckReport(parts.raw, parts.facts, deck.notices, deck.warnings, sizes, listing, walls)
 
 
 def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None = None):

@@ -21,6 +21,7 @@ from rwall_fem.radioss.materials import element_table, material_table
 from rwall_fem.radioss.mesh import WRITER, FaceGroups, face_groups, write_msh
 from rwall_fem.radioss.model import Deck, Prescribed, Wall
 from rwall_fem.radioss.parts import DeckPart, deck_parts, initial_velocities, uniform_velocity
+from rwall_fem.radioss.plausible import unit_warning
 from rwall_fem.radioss.reader import DeckError
 
 __all__ = ["SceneParts", "scene_of"]
@@ -58,6 +59,9 @@ class SceneParts:
 def scene_of(deck: Deck) -> SceneParts:
     """The scene the deck describes (mesh file key left for the caller to fill)."""
     _check_references(deck)
+    slip = unit_warning(deck)
+    if slip is not None:
+        deck.warnings.append(slip)
     cells_by_kind = {b.cell for b in deck.bodies}
     if len(cells_by_kind) > 1:
         raise DeckError(

@@ -34,6 +34,7 @@ from rwall_fem.scene.keys import (
     rule,
     table,
 )
+from rwall_fem.units import parse_system
 
 __all__ = [
     "MATERIAL_MODELS",
@@ -998,6 +999,26 @@ class Output:
         doc="wall time between checkpoints, at least 1 s; 0: none (a stop by SIGTERM or a "
         "guard writes one)",
     )
+    units: str = key(
+        Text("a unit system"),
+        "SI",
+        doc="the units of energy.csv, walls.csv and summary.json: SI, or a system of mass, "
+        "length and time as codes ('kg-mm-ms', 'Mg-mm-s') or sizes in SI ('1000 0.001 1'); "
+        "'deck': the work units of a Radioss deck's /BEGIN",
+    )
+
+
+@rule(Output)
+def _output_units(v, raw, fail):
+    """units is SI, or a unit system of three codes or sizes ('deck' is resolved when a
+    Radioss deck is read)."""
+    if v["units"] == "deck":
+        fail("units", "'deck' is for a scene read from a Radioss deck (the work units of its "
+             "/BEGIN); give the units, e.g. 'kg-mm-ms'")  # fmt: skip
+    try:
+        parse_system(v["units"])
+    except ValueError as err:
+        fail("units", f"{v['units']!r}: {err}")
 
 
 # Checkpoints are large files written and synced by every rank: a wall-time interval

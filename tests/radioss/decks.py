@@ -69,7 +69,10 @@ class BarDeck:
         """The node IDs of the layer k (k = 0: the bottom face)."""
         return [self.node_id(i, j, k) for j in range(self.ny + 1) for i in range(self.nx + 1)]
 
-    def write(self, directory: Path, name: str = "model") -> Path:
+    def write(self, directory: Path, name: str = "model", one_file: str = "") -> Path:
+        """Write the starter NAME_0000.rad and the engine NAME_0001.rad; ``one_file``
+        "engine first" (Radioss's single-file input) or "starter first" writes both in
+        NAME_0000.rad with /END/ENGINE after the engine's cards."""
         masses, names = UNITS[self.units]
         lines = ["#RADIOSS STARTER", "/BEGIN", name, "      2026"]
         lines += ["".join(n.rjust(20) for n in names)] * 2
@@ -96,10 +99,15 @@ class BarDeck:
                     lines.append(i10(e) + "".join(i10(q) for q in ids))
         lines += self.cards + ["/END"]
         starter = Path(directory) / f"{name}_0000.rad"
-        starter.write_text("\n".join(lines) + "\n")
         engine = ["#RADIOSS ENGINE", f"/RUN/{name}/1", f"{self.q(self.end_time, 'time'):.14g}"]
-        engine += self.engine + ["/END"]
-        (Path(directory) / f"{name}_0001.rad").write_text("\n".join(engine) + "\n")
+        engine += self.engine
+        if one_file == "engine first":
+            lines = engine + ["/END/ENGINE"] + lines
+        elif one_file == "starter first":
+            lines = lines + engine + ["/END/ENGINE"]
+        else:
+            (Path(directory) / f"{name}_0001.rad").write_text("\n".join(engine + ["/END"]) + "\n")
+        starter.write_text("\n".join(lines) + "\n")
         return starter
 
     def scene_mesh(self) -> dict:
@@ -143,11 +151,12 @@ class BarDeck:
         self.cards += [f"/MAT/LAW1/{mid}", "elastic", f20(self.q(rho, "density")),
                        f20(self.q(E, "stress")) + f20(nu)]  # fmt: skip
 
-    def johnson_cook(self, rho, E, nu, a, b, n, c=0.0, rate0=0.0, mid=1, keyword="LAW2"):
+    def johnson_cook(self, rho, E, nu, a, b, n, c=0.0, rate0=0.0, mid=1, keyword="LAW2",
+                     eps_max=0.0):  # fmt: skip
         s = lambda v: f20(self.q(v, "stress"))  # noqa: E731
         self.cards += [f"/MAT/{keyword}/{mid}", "Johnson-Cook", f20(self.q(rho, "density")),
                        f20(self.q(E, "stress")) + f20(nu) + i10(0) + i10(0) + f20(0.0),
-                       s(a) + s(b) + f20(n) + f20(0.0) + f20(0.0),
+                       s(a) + s(b) + f20(n) + f20(eps_max) + f20(0.0),
                        f20(c) + f20(self.q(rate0, "rate")) + i10(0) + i10(0) + f20(0) + f20(0),
                        f20(0.0) * 5]  # fmt: skip
 

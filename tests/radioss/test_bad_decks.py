@@ -3,15 +3,17 @@ allowed, on every rank and with no traceback (a DeckError, which the command lin
 into exit code 2 as any bad scene); cards that only ask for Radioss's outputs are skipped
 with one warning line each."""
 
+import codecs
 import logging
 import re
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rwall_fem.radioss import DeckError, load_deck
+from rwall_fem.radioss import DeckError, load_deck, read_deck
 
 from .decks import BarDeck
 
@@ -77,6 +79,27 @@ def missing_line(lines):
     del lines[k + 5 :]
 
 
+def long_node_id(lines):
+    k = line_of(lines, "/NODE") + 1
+    lines[k] = "12345678901234567890, 0.0, 0.0, 0.0"
+
+
+def brick_id_twice(lines):
+    k = line_of(lines, "/BRICK") + 2
+    lines[k] = f"{1:10d}" + lines[k][10:]
+
+
+def length_unit_inf(lines):
+    k = line_of(lines, "/BEGIN") + 3
+    lines[k] = f"{'kg':>20}{'inf':>20}{'ms':>20}"
+
+
+def failure_strain_negative(lines):
+    k = line_of(lines, "/MAT/LAW1")
+    lines[k:k + 4] = ["/MAT/LAW2/1", "jc", f"{7.85e-6:20g}", f"{210:20g}{0.3:20g}",
+                      f"{0.4:20g}{0.1:20g}{0.5:20g}{-0.2:20g}"]  # fmt: skip
+
+
 CASES = {
     # name: (edit, the card's header or line text, what the message says)
     "truncated line": (
@@ -94,6 +117,23 @@ CASES = {
     "unsupported Isolid": (isolid, "/PROP", r"Isolid = 16: supported: 24"),
     "truncated card": (
         missing_line, "/RWALL", r"truncated card: the line 'XM1 YM1 ZM1' is missing"
+    ),
+    # issue 28, class 1: numbers Python cannot hold or that are not finite
+    "20-digit node ID": (
+        long_node_id, "/NODE", r"/NODE: field node_ID \(field 1\): '12345678901234567890' has "
+        r"20 digits; Radioss's integers \(IDs, flags\) have at most 10",
+    ),
+    "length unit inf": (
+        length_unit_inf, "/BEGIN", r"/BEGIN: length unit 'inf': 'inf' is not a finite number",
+    ),
+    # class 3: one element ID used twice (Radioss refuses it)
+    "element ID twice": (
+        brick_id_twice, "/BRICK",
+        r"/BRICK/1: element ID 1 is used twice \(again at .*model_0000.rad:\d+, /BRICK/1\): "
+        "an element ID names one element",
+    ),
+    "failure strain below 0": (
+        failure_strain_negative, "/MAT/LAW2", r"EPS_p_max = -0.2: a failure plastic strain is > 0",
     ),
 }  # fmt: skip
 
@@ -213,3 +253,86 @@ def test_command_line_exits_2_with_one_line(tmp_path):
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "has no material" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def engine_edit(value: str, card: str = "/RUN"):
+    def edit(lines):
+        lines[line_of(lines, card) + 1] = value
+
+    return edit
+
+
+ENGINE = {
+    # issue 28, class 1: /RUN's Tstop not finite, with /ANIM/DT (frames over the run)
+    "Tstop nan": (engine_edit("nan"), r"/RUN/model/1: field Tstop \(field 1\): 'nan' is not a "
+                  "finite number"),
+    "Tstop 1e999": (engine_edit("1e999"), r"field Tstop \(field 1\): '1e999' is not a finite"),
+    "Tfreq inf": (engine_edit("0.0 inf", "/ANIM/DT"), r"/ANIM/DT: field Tfreq \(field 2\): "
+                  "'inf' is not a finite number"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(ENGINE))
+def test_bad_engine_number_is_one_line_naming_the_engine_file(case, shared_dir):
+    edit, pattern = ENGINE[case]
+    d = good()
+    d.engine += ["/ANIM/DT", "0.0 0.001"]
+    path = written(d, shared_dir)
+    engine = path.with_name("model_0001.rad")
+    if MPI.COMM_WORLD.rank == 0:
+        lines = engine.read_text().splitlines()
+        edit(lines)
+        engine.write_text("\n".join(lines) + "\n")
+    MPI.COMM_WORLD.barrier()
+    with pytest.raises(DeckError) as info:
+        load_deck(path)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(f"{engine}:")
+    assert re.search(pattern, message), message
+
+
+def test_odd_characters_are_read_as_radioss_reads_them(shared_dir):
+    """Issue 28, class 2: no-break spaces in a /NODE line and a UTF-8 byte-order mark give
+    the deck of plain spaces (one notice names the first no-break space)."""
+    plain = written(good(), shared_dir)
+    coordinates = read_deck(plain).coordinates
+    odd = None
+    if MPI.COMM_WORLD.rank == 0:
+        lines = plain.read_text().splitlines()
+        k = line_of(lines, "/NODE") + 2
+        lines[k] = lines[k].replace("  ", "\u00a0\u00a0")
+        odd = plain.with_name("odd_0000.rad")
+        odd.write_bytes(codecs.BOM_UTF8 + "\n".join(lines).encode() + b"\n")
+        plain.with_name("odd_0001.rad").write_text(plain.with_name("model_0001.rad").read_text())
+    odd = MPI.COMM_WORLD.bcast(odd, root=0)
+    deck = read_deck(odd)
+    assert np.array_equal(deck.coordinates, coordinates)
+    (notice,) = [n for n in deck.notices if "no-break" in n]
+    assert re.match(rf"{re.escape(str(odd))}:\d+: a no-break space \(U\+00A0\) at column \d+ "
+                    r"read as a space", notice)  # fmt: skip
+
+
+@pytest.mark.serial
+def test_a_warning_is_not_printed_before_the_error(tmp_path):
+    """Issue 28, class 9: a deck whose property draws a warning and whose run cannot be
+    built prints one line, the error; convert does not overwrite a scene without --force."""
+    d = good()
+    d.cards = [c.replace(f"{0.0:20g}" * 2 + f"{0.0:20g}", f"{0.1:20g}" * 2 + f"{0.0:20g}")
+               for c in d.cards]  # qa, qb: a warning  # fmt: skip
+    path = written(d, tmp_path)
+    command = [sys.executable, "-m", "rwall_fem", "check", str(path), "--set", "run.max_steps=10"]
+    done = subprocess.run(command, capture_output=True, text=True)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.count("\n") == 1 and "run.max_steps" in done.stderr, done.stderr
+    done = subprocess.run(command[:-2], capture_output=True, text=True)
+    assert done.returncode == 0 and "qa, qb (bulk viscosity) are not used" in done.stderr
+    convert = [sys.executable, "-m", "rwall_fem", "convert", str(path), str(tmp_path / "scene")]
+    assert subprocess.run(convert, capture_output=True).returncode == 0
+    toml = tmp_path / "scene" / "model.toml"
+    toml.write_text("# mine\n" + toml.read_text())
+    again = subprocess.run(convert, capture_output=True, text=True)
+    assert again.returncode == 2 and again.stderr.count("\n") == 1
+    assert f"{toml}: exists; convert does not overwrite a scene" in again.stderr
+    assert toml.read_text().startswith("# mine")
+    forced = subprocess.run([*convert, "--force"], capture_output=True, text=True)
+    assert forced.returncode == 0 and not toml.read_text().startswith("# mine")

@@ -25,7 +25,7 @@ def _free(card: Card, layout: str, what: str) -> list:
     engine's lines are read in the free format, blanks separating the fields)."""
     line = card.line(0, what)
     words = line.words()
-    free = Line(", ".join(words), line.file, line.number)
+    free = Line(", ".join(words) + ",", line.file, line.number)  # a comma: the free format
     return read_fields(card, free, layout)
 
 

@@ -127,13 +127,12 @@ def _element_ids_once(deck: Deck) -> None:
     if not np.any(counts > 1):
         return
     twice = unique[counts > 1]
-    where = []
-    for body in solids:
-        for k in np.flatnonzero(body.ids == twice[0]):
-            where.append(f"{body.card.lines[k].where} ({body.card.name})")
-    more = f" ({len(twice)} IDs are used more than once)" if len(twice) > 1 else ""
-    raise DeckError(f"{where[0]}: element ID {twice[0]} is used twice (again at {where[1]}){more}:"
-                    " an element ID names one element")  # fmt: skip
+    where = [(body.card.lines[k].where, body.card.name) for body in solids
+             for k in np.flatnonzero(body.ids == twice[0])]  # fmt: skip
+    more = f"; {len(twice)} IDs are used more than once" if len(twice) > 1 else ""
+    (first, card), (again, other) = where[:2]
+    raise DeckError(f"{first}: {card}: element ID {twice[0]} is used twice (again at {again}, "
+                    f"{other}){more}: an element ID names one element")  # fmt: skip
 
 
 STARTER = {
