@@ -173,6 +173,7 @@ class Deck:
     version: int = 0
     begin_where: str = ""  # file:line of /BEGIN
     input_units: UnitSystem = field(default_factory=UnitSystem)
+    unit_systems: dict[int, UnitSystem] = field(default_factory=dict)  # /UNIT by ID
     work_units: UnitSystem = field(default_factory=UnitSystem)
     node_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     coordinates: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # m

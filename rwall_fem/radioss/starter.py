@@ -10,12 +10,22 @@ control and output cards with no counterpart here are skipped with one notice ea
 from __future__ import annotations
 
 from rwall_fem.radioss.cards import STARTER_FAMILIES, lookup, supported, table
+from rwall_fem.radioss.cards.base import keyword
+from rwall_fem.radioss.cards.unknown import refusal
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card, DeckError
 
 __all__ = ["read_starter"]
 
 READERS = table(STARTER_FAMILIES, "STARTER")
+# The cards read before the others (a /UNIT may come after the cards that name it).
+FIRST = [tuple(path.split("/")) for family in STARTER_FAMILIES
+         for path in getattr(family, "FIRST", ())]  # fmt: skip
+
+
+def _first(card: Card) -> bool:
+    keys = tuple(keyword(p) for p in card.parts)
+    return any(keys[: len(path)] == path for path in FIRST)
 
 
 def read_starter(deck: Deck, cards: list[Card]) -> None:
@@ -26,9 +36,14 @@ def read_starter(deck: Deck, cards: list[Card]) -> None:
             f"{where}: the starter file must begin with /BEGIN (run name, input version, "
             "input and work units)"
         )
-    for card in cards:
+    first = [c for c in cards[1:] if _first(c)]
+    chosen = {id(c) for c in first}
+    for card in [cards[0], *first, *(c for c in cards[1:] if id(c) not in chosen)]:
         read = lookup(READERS, card)
         if read is None:
+            why = refusal(card)
+            if why:
+                card.fail(f"{why}; the cards read: docs/radioss.md")
             card.fail(f"unsupported card; the starter cards read are {supported(READERS)}")
         read(deck, card)
     for family in STARTER_FAMILIES:

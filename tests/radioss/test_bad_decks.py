@@ -69,6 +69,11 @@ def unsupported(lines):
     lines[k:k] = ["/INTER/TYPE7/1", "contact", "         1         2"]
 
 
+def unknown(lines):
+    k = line_of(lines, "/PROP")
+    lines[k:k] = ["/XYZ/1", "what", "         1         2"]
+
+
 def isolid(lines):
     k = line_of(lines, "/PROP") + 2
     lines[k] = f"{16:10d}" + lines[k][10:]
@@ -110,9 +115,13 @@ CASES = {
     ),
     "ID that refers to nothing": (dangling_mat, "/PART", r"mat_ID 7 refers to no /MAT"),
     "part without a material": (no_material, "/PART", r"part 1 has no material"),
-    "unsupported card": (
+    "a card of physics not read": (
         unsupported, "/INTER/TYPE7/1",
-        r"/INTER/TYPE7/1: unsupported card; the starter cards read are /BEGIN",
+        r"/INTER/TYPE7/1: contact interfaces are not read: bodies meet rigid walls \(/RWALL\) "
+        r"only; the cards read: docs/radioss.md",
+    ),
+    "an unknown card": (
+        unknown, "/XYZ/1", r"/XYZ/1: unsupported card; the starter cards read are /BEGIN, /UNIT",
     ),
     "unsupported Isolid": (isolid, "/PROP", r"Isolid = 16: supported: 24"),
     "truncated card": (
@@ -336,3 +345,12 @@ def test_a_warning_is_not_printed_before_the_error(tmp_path):
     assert toml.read_text().startswith("# mine")
     forced = subprocess.run([*convert, "--force"], capture_output=True, text=True)
     assert forced.returncode == 0 and not toml.read_text().startswith("# mine")
+
+
+def test_a_unit_id_of_no_unit_card_is_one_line(shared_dir):
+    def edit(lines):
+        k = line_of(lines, "/MAT/LAW1/1")
+        lines[k] = "/MAT/LAW1/1/4"
+
+    refused_in_one_line(written(good(), shared_dir, edit), "/MAT/LAW1/1/4",
+                        r"/MAT/LAW1/1/4: unit_ID 4 refers to no /UNIT")  # fmt: skip

@@ -179,3 +179,31 @@ def test_a_one_file_deck_runs_as_its_two_file_form(shared_dir):
         assert same_but_names(scene) == same_but_names(two_files)
     sim = run(replace(scenes[0], output=replace(scenes[0].output, plot=False)), shared_dir / "one")
     assert sim.history.summary["status"] == "done" and sim.step_size.mode == "adaptive"
+
+
+def test_cards_in_local_units_of_a_unit_card(shared_dir):
+    """A /MAT in the /UNIT it names (Mg, mm, s) and a wall in another (kg, m, s), in a deck
+    of kg, mm, ms: the scene of the deck written in its input units alone."""
+    d = plain()
+    local = plain()
+    k = local.cards.index("/MAT/LAW1/1")
+    local.cards[k : k + 4] = ["/MAT/LAW1/1/7", "elastic", f20(7.85e-9), f20(2.1e5) + f20(0.3)]
+    k = local.cards.index("/RWALL/PLANE/1")
+    wall = local.cards[k : k + 6]
+    local.cards[k : k + 6] = [
+        "/RWALL/PLANE/1/8",
+        wall[1],
+        wall[2],
+        f20(1.0) + wall[3][20:],
+        f20(0.0) * 3,
+        f20(0.0) * 2 + f20(1.0),
+    ]
+    local.cards += ["/UNIT/7", "Mg mm s", f"{'Mg':>20}{'mm':>20}{'s':>20}",
+                    "/UNIT/8", "SI", f"{'1':>20}{'1.D0':>20}{'s':>20}"]  # fmt: skip
+    a, _ = loaded(local, shared_dir)
+    b, _ = loaded(d, shared_dir)
+    assert a.material.density == pytest.approx(b.material.density, rel=1e-14)
+    assert a.material.young == pytest.approx(b.material.young, rel=1e-14)
+    assert a.walls[0].secondary.search_distance == pytest.approx(1.0, rel=1e-14)
+    assert a.walls[0] == replace(b.walls[0], normal_point=a.walls[0].normal_point)
+    assert a.walls[0].normal_point == pytest.approx(b.walls[0].normal_point, rel=1e-14)

@@ -6,9 +6,14 @@ keyword path (``"NODE"``, ``"MAT/LAW2"``, ``"RWALL/PLANE"``) to a function
 :class:`~rwall_fem.radioss.model.Deck` (in SI) or refuses it in one line. A card is read
 by the function of the longest path that its first keywords match (``/MAT/LAW2/7``:
 ``MAT/LAW2``); a path of one keyword catches the card's other variants, to refuse them
-naming what is read. A module may also define ``finish(deck)``, called once every
-starter card is read, in the order of :data:`STARTER_FAMILIES` (nodes are read before the
-groups that refer to them are resolved, /DEF_SOLID's defaults apply to every /PROP).
+naming what is read. A module may also define ``FIRST``, the paths of its cards read
+before all others (/UNIT, which the cards before it may name), and ``finish(deck)``,
+called once every card of its file (starter or engine) is read, in the order of
+:data:`STARTER_FAMILIES` (nodes are read before the groups that refer to them are
+resolved, /DEF_SOLID's defaults apply to every /PROP).
+
+A card's values are in the input units of /BEGIN, or in those of the /UNIT it names
+after its ID (:func:`~rwall_fem.radioss.cards.base.card_units`).
 
 A new family of cards (shells, interfaces, loads, rigid bodies) is a module here and one
 entry in the tuple of its file; the reader and its refusals of unknown cards need

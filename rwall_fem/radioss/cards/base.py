@@ -6,26 +6,36 @@ from __future__ import annotations
 import re
 
 from rwall_fem.radioss.reader import Card
+from rwall_fem.radioss.units import UnitSystem
 
-__all__ = ["BIG", "catch_all", "ident", "inactive", "keyword", "notice_only"]
+__all__ = ["BIG", "card_units", "catch_all", "ident", "inactive", "keyword", "notice_only"]
 
 BIG = 1e19  # Radioss writes "no limit" as 1e20 or 1e30; a blank or 0 field means it too
 
 
 def ident(card: Card, index: int, what: str = "ID") -> int:
-    """The integer keyword part ``index`` (an ID); a unit_ID after it must be absent."""
+    """The integer keyword part ``index`` (an ID); the part after it, if any, is the
+    card's unit_ID (see :func:`card_units`)."""
     if index >= len(card.parts) or not card.parts[index]:
         card.fail(f"missing {what} in the card's name")
     try:
-        value = int(card.parts[index])
+        return int(card.parts[index])
     except ValueError:
         card.fail(f"{what} {card.parts[index]!r} is not an integer")
-    if index + 1 < len(card.parts) and card.parts[index + 1] not in ("", "0"):
-        card.fail(
-            f"unit_ID {card.parts[index + 1]}: local unit systems (/UNIT) are not supported; "
-            "give the values in the input units of /BEGIN"
-        )
-    return value
+
+
+def card_units(deck, card: Card, index: int) -> UnitSystem:
+    """The units of the card's values: those of the /UNIT whose ID is the keyword part
+    ``index`` (after the card's ID), else the input units of /BEGIN."""
+    if index >= len(card.parts) or card.parts[index] in ("", "0"):
+        return deck.input_units
+    try:
+        uid = int(card.parts[index])
+    except ValueError:
+        card.fail(f"unit_ID {card.parts[index]!r} is not an integer")
+    if uid not in deck.unit_systems:
+        card.fail(f"unit_ID {uid} refers to no /UNIT")
+    return deck.unit_systems[uid]
 
 
 def keyword(part: str) -> str:

@@ -3,6 +3,7 @@ starter's values, work units for the engine's)."""
 
 from __future__ import annotations
 
+from rwall_fem.radioss.cards.base import ident
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card, read_fields
 from rwall_fem.radioss.units import UnitSystem, parse_unit
@@ -76,4 +77,26 @@ def _sizes(units: UnitSystem) -> tuple[float, float, float]:
     return (units.mass, units.length, units.time)
 
 
-STARTER = {"BEGIN": _begin}
+def _unit(deck: Deck, card: Card) -> None:
+    """/UNIT: a local unit system, in which a card that names its ID gives its values."""
+    uid = ident(card, 1, "unit_ID")
+    if uid in deck.unit_systems:
+        card.fail(f"unit system {uid} is defined twice")
+    line = card.line(1, "mass_unit length_unit time_unit")
+    texts = read_fields(card, line, "s:mass:20 s:length:20 s:time:20")
+    sizes = []
+    for text, quantity in zip(texts, ("mass", "length", "time"), strict=True):
+        try:
+            size = parse_unit(text, quantity)
+        except ValueError as err:
+            card.fail(f"{quantity} unit {text!r}: {err}", line)
+        if size is None:
+            card.fail(f"{quantity} unit {text!r}: a /UNIT gives its three units, codes (kg, "
+                      "mm, ms, ...) or sizes in SI", line)  # fmt: skip
+        sizes.append(size)
+    deck.unit_systems[uid] = UnitSystem(*sizes, names=tuple(texts))
+
+
+STARTER = {"BEGIN": _begin, "UNIT": _unit}
+# Read before the other cards: the /UNIT of a card may come after it.
+FIRST = ("UNIT",)

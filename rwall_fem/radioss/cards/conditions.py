@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rwall_fem.radioss.cards.base import BIG, catch_all, ident
+from rwall_fem.radioss.cards.base import BIG, card_units, catch_all, ident
 from rwall_fem.radioss.model import Deck, Prescribed
 from rwall_fem.radioss.reader import Card, read_fields
 
@@ -14,6 +14,7 @@ __all__ = ["STARTER"]
 
 def _initial_velocity(deck: Deck, card: Card) -> None:
     ident(card, 2, "inivel_ID")
+    units = card_units(deck, card, 3)
     vx, vy, vz, group, skew = card.read(1, "f:Vx f:Vy f:Vz i:grnd_ID i:skew_ID",
                                         "Vx Vy Vz Gnod_id Skew_id")  # fmt: skip
     if skew:
@@ -21,7 +22,7 @@ def _initial_velocity(deck: Deck, card: Card) -> None:
     tstart, sensor = card.read_optional(2, "f:Tstart i:sens_ID")
     if tstart or sensor:
         card.fail("Tstart and sens_ID are not supported: the velocity is initial", card.lines[2])
-    velocity = np.array([vx, vy, vz]) * deck.input_units.factor("velocity")
+    velocity = np.array([vx, vy, vz]) * units.factor("velocity")
     deck.initial.append((velocity, group, card.lines[1].where))
 
 
@@ -58,8 +59,8 @@ def _clamp(deck: Deck, card: Card) -> None:
 
 def _prescribed(deck: Deck, card: Card, quantity: str, grav: bool = False) -> Prescribed:
     """/IMPVEL or /GRAV: fct_IDT Dir skew sens grnd (frame icoor), Ascale_x Fscale_y."""
-    units = deck.input_units
     ident(card, 1, "ID")
+    units = card_units(deck, card, 2)
     line = card.line(1, "fct_IDT Dir skew_ID sens_ID grnd_ID frame_ID icoor")
     fct, direction, skew, sensor, group, frame, icoor = read_fields(
         card, line, "i:fct_IDT s:Dir i:skew_ID i:sens_ID i:grnd_ID i:frame_ID i:icoor"

@@ -4,7 +4,7 @@ of it by :mod:`rwall_fem.radioss.materials`."""
 
 from __future__ import annotations
 
-from rwall_fem.radioss.cards.base import catch_all, ident
+from rwall_fem.radioss.cards.base import card_units, catch_all, ident
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card
 
@@ -13,6 +13,7 @@ __all__ = ["STARTER"]
 
 def _johnson_cook(deck: Deck, card: Card) -> None:
     mid = ident(card, 2, "mat_ID")
+    rate = card_units(deck, card, 3).factor("rate")
     if mid in deck.failures:
         card.fail(f"a second failure model of material {mid} (the first at "
                   f"{deck.failures[mid]['where']}): a material has one here")  # fmt: skip
@@ -33,7 +34,7 @@ def _johnson_cook(deck: Deck, card: Card) -> None:
                   card.lines[2])  # fmt: skip
     deck.failures[mid] = {
         "criterion": "johnson_cook", "d1": d1, "d2": d2, "d3": d3, "d4": d4, "d5": d5,
-        "reference_strain_rate": rate0 * deck.input_units.factor("rate") if rate0 else None,
+        "reference_strain_rate": rate0 * rate if rate0 else None,
         "where": card.header.where, "card": card.name,
     }  # fmt: skip
 

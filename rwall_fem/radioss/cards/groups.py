@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rwall_fem.radioss.cards.base import catch_all, ident
+from rwall_fem.radioss.cards.base import card_units, catch_all, ident
 from rwall_fem.radioss.model import Box, Deck, Group
 from rwall_fem.radioss.reader import Card, DeckError, fixed_table, read_fields
 
@@ -87,7 +87,7 @@ def _box(deck: Deck, card: Card) -> None:
     bid = ident(card, 2, "box_ID")
     if bid in deck.boxes:
         card.fail(f"box {bid} is defined twice")
-    length = deck.input_units.length
+    length = card_units(deck, card, 3).length
     box = Box(bid, shape, card.header.where)
     if shape == "RECTA":
         n1, n2, skew = card.read(1, "i:N1 i:N2 i:skew_ID", "N1 N2 skew_ID")

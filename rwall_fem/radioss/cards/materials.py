@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from rwall_fem.radioss.cards.base import catch_all, ident, inactive, keyword
+from rwall_fem.radioss.cards.base import card_units, catch_all, ident, inactive, keyword
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card
 from rwall_fem.radioss.units import UnitSystem
@@ -22,8 +22,8 @@ _SUPPORTED = "/MAT/LAW1 (ELAST), /MAT/LAW2 (PLAS_JOHNS), /MAT/LAW36 (PLAS_TAB)"
 
 def _material(deck: Deck, card: Card) -> None:
     law = LAWS[keyword(card.parts[1])]
-    units = deck.input_units
     mid = ident(card, 2, "mat_ID")
+    units = card_units(deck, card, 3)
     if mid in deck.materials:
         card.fail(f"material {mid} is defined twice")
     rho, rho0 = card.read(1, "f:RHO_I f:RHO_0", "RHO_I")

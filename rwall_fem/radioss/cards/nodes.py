@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rwall_fem.radioss.cards.base import card_units
 from rwall_fem.radioss.model import Deck
 from rwall_fem.radioss.reader import Card, DeckError, fixed_table
 
@@ -12,9 +13,7 @@ __all__ = ["STARTER", "finish"]
 
 
 def _node(deck: Deck, card: Card) -> None:
-    if len(card.parts) > 1 and card.parts[1] not in ("", "0"):
-        card.fail(f"unit_ID {card.parts[1]}: local unit systems (/UNIT) are not supported; "
-                  "give the coordinates in the input units of /BEGIN")  # fmt: skip
+    card_units(deck, card, 1)  # checked here: the card that names it
     deck.pending.setdefault("NODE", []).append(card)
 
 
@@ -29,9 +28,9 @@ def finish(deck: Deck) -> None:
         if len(bad):
             card.fail(f"node ID {i[bad[0]]}: node IDs are positive", card.lines[bad[0]])
         ids.append(i)
-        xyz.append(np.column_stack([x, y, z]))
+        xyz.append(np.column_stack([x, y, z]) * card_units(deck, card, 1).length)
     deck.node_ids = np.concatenate(ids) if ids else np.zeros(0, dtype=np.int64)
-    deck.coordinates = (np.concatenate(xyz) if xyz else np.zeros((0, 3))) * deck.input_units.length
+    deck.coordinates = np.concatenate(xyz) if xyz else np.zeros((0, 3))
     unique, counts = np.unique(deck.node_ids, return_counts=True)
     if np.any(counts > 1):
         node = unique[counts > 1][0]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rwall_fem.radioss.cards.base import catch_all, ident
+from rwall_fem.radioss.cards.base import card_units, catch_all, ident
 from rwall_fem.radioss.model import Deck, Wall
 from rwall_fem.radioss.reader import Card
 
@@ -13,9 +13,9 @@ __all__ = ["STARTER"]
 
 
 def _wall(deck: Deck, card: Card) -> None:
-    units = deck.input_units
     kind = card.key(1)
     wid = ident(card, 2, "rwall_ID")
+    units = card_units(deck, card, 3)
     node, slide, add, exclude, iform = card.read(
         1, "i:node_ID i:Slide i:grnd_ID1 i:grnd_ID2 i:Iform", "node_ID Slide grnd_ID1 grnd_ID2"
     )
