@@ -252,7 +252,7 @@ def _run(scene_file, out, overrides, comm, quiet: bool, lift_limits: bool, resum
     return sim.history.summary
 
 
-def _load(scene_file, overrides, comm):
+def _load(scene_file, overrides, comm, listing: bool = False):
     """The scene of a TOML file, or of a Radioss deck (:mod:`rwall_fem.radioss`), and
     for a deck its :class:`~rwall_fem.radioss.DeckReport` (None for a TOML file), to say
     once the run is built: a deck whose run cannot be built gets one line, the error."""
@@ -261,7 +261,7 @@ def _load(scene_file, overrides, comm):
 
     if is_deck(scene_file):
         report: list = []
-        scene = load_deck(scene_file, overrides, comm, report=report)
+        scene = load_deck(scene_file, overrides, comm, report=report, listing=listing)
         return scene, report[0]
     return load_scene(scene_file, overrides), None
 
@@ -329,7 +329,7 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
     from rwall_fem.build import build_simulation
     from rwall_fem.estimate import estimate
 
-    scene, deck_report = _load(scene_file, overrides, comm)
+    scene, deck_report = _load(scene_file, overrides, comm, listing=True)
     guess = estimate(scene, comm.size)  # on every rank: it may refuse the scene
     if comm.rank == 0:
         print(f"rwall-fem: estimate before meshing: {guess.describe()}")

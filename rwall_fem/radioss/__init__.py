@@ -144,8 +144,9 @@ class DeckReport:
             log.warning("%s", line)
 
 
-def _prepare(path: Path, mesh_dir: Path | None) -> DeckReport:
-    """Read the deck and write its mesh (once: the cache is keyed by the mesh's content)."""
+def _prepare(path: Path, mesh_dir: Path | None, listing: bool = False) -> DeckReport:
+    """Read the deck and write its mesh (once: the cache is keyed by the mesh's content);
+    with ``listing``, work out its starter listing too."""
     deck = read_deck(path)
     parts: SceneParts = scene_of(deck)
     directory = Path(mesh_dir) if mesh_dir is not None else _cache_dir() / parts.mesh_key(deck)
@@ -158,13 +159,14 @@ def _prepare(path: Path, mesh_dir: Path | None) -> DeckReport:
             raise DeckError(f"{path}: cannot write the mesh file {mesh}: {err.strerror}") from None
     parts.raw["mesh"]["file"] = str(mesh.resolve())
     units = deck.work_units
-    listing = starter_listing(deck, deck.dt_scale or 0.9)
+    listing = starter_listing(deck, deck.dt_scale or 0.9) if listing else []
     walls = [f"/RWALL/{w.kind}/{w.id} ({w.where})" for w in deck.walls]
     sizes = ((units.mass, units.length, units.time), units.names)
     return DeckReport(parts.raw, parts.facts, deck.notices, deck.warnings, sizes, listing, walls)
 
 
-def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None = None):
+def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None = None,
+              listing: bool = False):  # fmt: skip
     """The :class:`~rwall_fem.scene.Scene` of the deck whose starter file is ``path``
     (``--set`` ``overrides`` applied as to a TOML scene), its mesh written to the cache.
 
@@ -172,7 +174,8 @@ def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None 
     ``MPI.COMM_WORLD``) as the same :class:`DeckError`. What the deck became, its notices
     and its warnings go to the ``rwall_fem`` logger, one line each, once the scene is
     valid; or, if ``report`` is a list, its :class:`DeckReport` is appended to it, for
-    the caller to say when the run is built (so that an error is the only line)."""
+    the caller to say when the run is built (so that an error is the only line), with
+    a starter listing if ``listing`` (``rwall-fem check``)."""
     from mpi4py import MPI
 
     from rwall_fem.scene import apply_override, parse_scene
@@ -182,7 +185,7 @@ def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None 
     outcome = None
     if comm.rank == 0:
         try:
-            outcome = _prepare(path, None)
+            outcome = _prepare(path, None, listing)
         except DeckError as err:
             outcome = str(err)
     outcome = comm.bcast(outcome, root=0)

@@ -164,45 +164,24 @@ class _Reading:
         included = bool(stack)
         head: list[Line] = []  # an included file's lines before its first card
         at_head = True
-        for number, raw in enumerate(lines, start=1):
-            line = raw.rstrip()
-            head_text = line.lstrip()
-            lower = head_text.lower()
-            if lower.startswith("#include"):
+        for number, line in enumerate(lines, start=1):
+            first = line[:1]
+            if first == " " or first == "\t":  # most data lines: look past the indent
+                first = line.lstrip()[:1]
+            if first == "#" or first == "$":  # a comment, #include or #enddata
+                word = line.lstrip()[:8].lower()
+                if word == "#include":
+                    self._flush_head(head, included)
+                    at_head = False
+                    self._include(path, number, line.lstrip()[8:].strip(), stack)
+                elif word == "#enddata":
+                    break
+                continue
+            if line[:1] == "/":
                 self._flush_head(head, included)
                 at_head = False
-                self._include(path, number, head_text[len("#include") :].strip(), stack)
-                continue
-            if lower.startswith("#enddata"):
-                break
-            if head_text.startswith(("#", "$")):
-                continue
-            if line.startswith("/"):
-                self._flush_head(head, included)
-                at_head = False
-                body = line.strip()[2:] if line.startswith("//") else line.strip()[1:]
-                parts = [p.strip() for p in body.rstrip("/").split("/")]
-                if line.startswith("//"):  # //SUBMODEL, //ENDSUB
-                    parts.insert(0, "")
-                upper = [p.upper() for p in parts]
-                where = f"{name}:{number}"
-                if upper == ["END"]:
-                    if included:
-                        self.notices.append(f"{where}: /END in an included file ends that "
-                                            "file (as Radioss reads it)")  # fmt: skip
-                        return
-                    self.items.append(_End(False, where))
-                    self.current, self.ended = None, True
-                    continue
-                if upper == ["END", "ENGINE"]:
-                    self.items.append(_End(True, where))
-                    self.current = None
-                    continue
-                if upper[:2] == ["", "ENDSUB"]:
-                    self.current = None
-                    continue
-                self.current = Card(parts, Line(line, name, number))
-                self.items.append(self.current)
+                if not self._card(line.rstrip(), name, number, included):
+                    return
                 continue
             entry = Line(line, name, number)
             if at_head:
@@ -212,6 +191,32 @@ class _Reading:
             elif line.strip() and not self.ended:
                 self._header([entry])
         self._flush_head(head, included)
+
+    def _card(self, line: str, name: str, number: int, included: bool) -> bool:
+        """Start the card whose header is ``line``, or mark /END and /END/ENGINE; False
+        when the file ends here (/END in an included file)."""
+        body = line.strip()[2:] if line.startswith("//") else line.strip()[1:]
+        parts = [p.strip() for p in body.rstrip("/").split("/")]
+        if line.startswith("//"):  # //SUBMODEL, //ENDSUB
+            parts.insert(0, "")
+        upper = [p.upper() for p in parts]
+        where = f"{name}:{number}"
+        if upper == ["END"]:
+            if included:
+                self.notices.append(f"{where}: /END in an included file ends that file (as "
+                                    "Radioss reads it)")  # fmt: skip
+                return False
+            self.items.append(_End(False, where))
+            self.current, self.ended = None, True
+        elif upper == ["END", "ENGINE"]:
+            self.items.append(_End(True, where))
+            self.current = None
+        elif upper[:2] == ["", "ENDSUB"]:
+            self.current = None
+        else:
+            self.current = Card(parts, Line(line, name, number))
+            self.items.append(self.current)
+        return True
 
     def _flush_head(self, head: list[Line], included: bool) -> None:
         """An included file's lines before its first card continue the including card, or
@@ -267,8 +272,10 @@ class _Reading:
             except UnicodeDecodeError:
                 text = data.decode("latin-1")
         lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-        odd = [(k, m) for k, line in enumerate(lines, start=1)
-               for m in [_ODD_SPACES.search(line)] if m]  # fmt: skip
+        odd = []
+        if not text.isascii() and _ODD_SPACES.search(text):
+            odd = [(k, m) for k, line in enumerate(lines, start=1)
+                   for m in [_ODD_SPACES.search(line)] if m]  # fmt: skip
         if odd:
             k, m = odd[0]
             what = _NAMES.get(m[0], "a Unicode space")

@@ -40,8 +40,8 @@ def cell_geometry(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         # d N_I / d xi of the trilinear shape functions at the Gauss point.
         grad = _CORNERS * np.prod(1 + _CORNERS * point, axis=1)[:, None] / 8
         grad = grad / (1 + _CORNERS * point)
-        jacobian = np.einsum("nia,ib->nab", x, grad)
-        volume += np.linalg.det(jacobian)
+        j = np.einsum("nia,ib->bna", x, grad)  # the Jacobian's columns d x / d xi_b
+        volume += np.einsum("na,na->n", j[0], np.cross(j[1], j[2]))
     f = x[:, _HEX_FACES]
     area = np.linalg.norm(np.cross(f[:, :, 2] - f[:, :, 0], f[:, :, 3] - f[:, :, 1]), axis=2) / 2
     return volume, volume / area.max(axis=1)
@@ -59,7 +59,7 @@ def starter_listing(deck: Deck, dt_scale: float) -> list[str]:
     lines = ["parts (as Radioss's starter lists them):",
              f"  {'part':>10}  {'elements':>18}  {'mass (kg)':>12}  {'material':<34}  "
              f"{'smallest L/c (s)':>16}  at element"]  # fmt: skip
-    steps, where = [], []
+    steps, elements_of = [], []  # per element card: steps, and (card, part, IDs, centres)
     for pid in sorted({b.part for b in deck.bodies}):
         bodies = [b for b in deck.bodies if b.part == pid]
         part = deck.parts[pid]
@@ -77,19 +77,20 @@ def starter_listing(deck: Deck, dt_scale: float) -> list[str]:
             k = int(np.argmin(dt))
             smallest = min(smallest, (float(dt[k]), int(body.ids[k])))
             steps.append(dt)
-            centres = x.mean(axis=1)
-            where += [(f"/{name} {i}", pid, c) for i, c in zip(body.ids, centres, strict=True)]
+            elements_of.append((name, pid, body.ids, x))
         elements = ", ".join(f"{n} /{k}" for k, n in counts.items())
         law = f"/MAT/{material['law']}/{part.mat} {material['title'][:18]}".strip()
         lines.append(f"  {pid:>10}  {elements:>18}  {mass:>12.6g}  {law:<34}  "
                      f"{smallest[0]:>16.4g}  {smallest[1]}")  # fmt: skip
     dt = np.concatenate(steps)
     order = np.argsort(dt, kind="stable")[:SMALLEST]
-    lines.append(f"the {len(order)} smallest element steps L/c (the run starts at "
+    lines.append(f"the {len(order)} smallest element steps L/c (the run starts at about "
                  f"{dt_scale:g} x the smallest, {dt_scale * dt[order[0]]:.4g} s):")  # fmt: skip
+    starts = np.cumsum([0] + [len(ids) for _, _, ids, _ in elements_of])
     for k in order:
-        element, pid, centre = where[k]
-        at = ", ".join(f"{c:.4g}" for c in centre)
-        lines.append(f"  {dt[k]:.4g} s: element {element.split()[1]} ({element.split()[0]}, "
-                     f"part {pid}) at ({at}) m")  # fmt: skip
+        j = int(np.searchsorted(starts, k, side="right")) - 1
+        name, pid, ids, x = elements_of[j]
+        at = ", ".join(f"{c:.4g}" for c in x[k - starts[j]].mean(axis=0))
+        lines.append(f"  {dt[k]:.4g} s: element {ids[k - starts[j]]} (/{name}, part {pid}) "
+                     f"at ({at}) m")  # fmt: skip
     return lines
