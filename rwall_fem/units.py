@@ -96,9 +96,9 @@ def parse_system(text: str) -> UnitSystem:
             try:
                 size = float(word)
             except ValueError:
-                raise ValueError(f"{word!r} is no {quantity} unit; {_ALLOWED}") from None
+                raise ValueError(f"{word[:20]!r} is no {quantity} unit; {_ALLOWED}") from None
             if not (math.isfinite(size) and size > 0):
-                raise ValueError(f"{word!r} is no {quantity} unit's size; {_ALLOWED}")
+                raise ValueError(f"{word[:20]!r} is no {quantity} unit's size; {_ALLOWED}")
         sizes.append(size)
     return UnitSystem(*sizes, names=tuple(words))
 

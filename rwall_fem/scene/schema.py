@@ -32,6 +32,7 @@ from rwall_fem.scene.keys import (
     did_you_mean,
     key,
     rule,
+    show,
     table,
 )
 from rwall_fem.units import parse_system
@@ -1018,7 +1019,7 @@ def _output_units(v, raw, fail):
     try:
         parse_system(v["units"])
     except ValueError as err:
-        fail("units", f"{v['units']!r}: {err}")
+        fail("units", f"{show(v['units'])}: {err}")
 
 
 # Checkpoints are large files written and synced by every rank: a wall-time interval
