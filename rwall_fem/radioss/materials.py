@@ -89,6 +89,9 @@ def element_table(deck: Deck, pid: int, cell: str, material: dict, cells) -> tup
     p = deck.properties[pid]
     head = f"property: /PROP/SOLID/{pid} Isolid {p['isolid']} ({p['where']})"
     if cell == "tetrahedron":
+        if p["itetra4"]:  # the column is Irot of bricks before version 12
+            raise DeckError(f"{p['line']}: /PROP/SOLID/{pid}: Itetra4 = {p['itetra4']}: "
+                            "tetrahedra are one-point P1 elements (Itetra4 0)")  # fmt: skip
         return {}, f"{head} -> P1 tetrahedra (Itetra4 0)"
     element = dict(p["element"])
     plastic = material["model"] in ("elastic_plastic", "johnson_cook")

@@ -99,6 +99,15 @@ def length_unit_inf(lines):
     lines[k] = f"{'kg':>20}{'inf':>20}{'ms':>20}"
 
 
+def version_44(lines):
+    lines[line_of(lines, "/BEGIN") + 2] = f"{44:10d}{0:10d}"
+
+
+def version_90_units_by_cards(lines):
+    k = line_of(lines, "/BEGIN")
+    lines[k + 2 : k + 5] = [f"{90:10d}{0:10d}", "/UNIT/LENGTH/1", "/UNIT/MASS/1"]
+
+
 def failure_strain_negative(lines):
     k = line_of(lines, "/MAT/LAW1")
     lines[k:k + 4] = ["/MAT/LAW2/1", "jc", f"{7.85e-6:20g}", f"{210:20g}{0.3:20g}",
@@ -140,6 +149,14 @@ CASES = {
         brick_id_twice, "/BRICK",
         r"/BRICK/1: element ID 1 is used twice \(again at .*model_0000.rad:\d+, /BRICK/1\): "
         "an element ID names one element",
+    ),
+    "version 44": (
+        version_44, "/BEGIN", r"input version 44: the block format of version 5.1 and later "
+        r"\(Invers >= 51: fields of 10 and 20 characters\) is read",
+    ),
+    "version 90 without units lines": (
+        version_90_units_by_cards, "/BEGIN", r"input version 90: no line of input units: the "
+        r"units of decks before version 10 \(/UNIT/MASS, LENGTH, TIME\) are not read",
     ),
     "failure strain below 0": (
         failure_strain_negative, "/MAT/LAW2", r"EPS_p_max = -0.2: a failure plastic strain is > 0",
@@ -354,3 +371,10 @@ def test_a_unit_id_of_no_unit_card_is_one_line(shared_dir):
 
     refused_in_one_line(written(good(), shared_dir, edit), "/MAT/LAW1/1/4",
                         r"/MAT/LAW1/1/4: unit_ID 4 refers to no /UNIT")  # fmt: skip
+
+
+def test_a_deck_of_version_9_with_units_lines_reads(shared_dir):
+    def edit(lines):
+        lines[line_of(lines, "/BEGIN") + 2] = f"{90:10d}{0:10d}"
+
+    assert read_deck(written(good(), shared_dir, edit)).version == 90

@@ -17,20 +17,24 @@ def _begin(deck: Deck, card: Card) -> None:
         return
     deck.run_name = card.line(0, "Runname").text.strip()
     version, _ = card.read(1, "i:Invers i:Irun", "Invers Irun")
-    if version < 100:
+    if version < 51:
         card.fail(
-            f"input version {version}: only the block format of version 10 and later "
-            "(Invers >= 100) is read",
+            f"input version {version}: the block format of version 5.1 and later (Invers >= "
+            "51: fields of 10 and 20 characters) is read; older ones have fields of 8 and 16",
             card.lines[1],
         )
     deck.version = version
+    if len(card.lines) < 3 and version < 100:
+        card.fail(
+            f"input version {version}: no line of input units: the units of decks "
+            f"before version 10 (/UNIT/MASS, LENGTH, TIME) are not read; {_GIVE}"
+        )
     systems = []
     for index, what in ((3, "Work_mass_unit Work_length_unit Work_time_unit"),
                         (2, "Input_mass_unit Input_length_unit Input_time_unit")):  # fmt: skip
         # A blank line of work units is a blank card's end, which the reader drops.
-        line = card.lines[index] if index < len(card.lines) or index == 2 else None
-        if line is None:
-            texts = ["", "", ""]
+        if index == 3 and index >= len(card.lines):
+            line, texts = card.header, ["", "", ""]
         else:
             line = card.line(index, what)
             texts = read_fields(card, line, "s:mass:20 s:length:20 s:time:20")
@@ -57,6 +61,9 @@ def _begin(deck: Deck, card: Card) -> None:
     deck.begin_where = card.header.where
 
 
+_GIVE = "give /BEGIN's lines of input and work units (kg mm ms, ...), as version 10 and later"
+
+
 def _again(deck: Deck, card: Card) -> None:
     """A second /BEGIN (an included file written as a deck of its own): skipped if its
     units are the deck's, refused otherwise (its values would be in other units)."""
@@ -79,6 +86,8 @@ def _sizes(units: UnitSystem) -> tuple[float, float, float]:
 
 def _unit(deck: Deck, card: Card) -> None:
     """/UNIT: a local unit system, in which a card that names its ID gives its values."""
+    if card.key(1) in ("MASS", "LENGTH", "TIME"):
+        card.fail(f"the units of decks before version 10 are not read; {_GIVE}")
     uid = ident(card, 1, "unit_ID")
     if uid in deck.unit_systems:
         card.fail(f"unit system {uid} is defined twice")

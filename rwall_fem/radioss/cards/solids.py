@@ -98,11 +98,9 @@ def _solid_property(deck: Deck, raw: dict) -> dict:
     if isolid == 14 and raw["inpts"] not in (0, 222):
         card.fail(f"Inpts = {raw['inpts']}: Isolid 14 is read with 2 x 2 x 2 points (Inpts 222)",
                   line)  # fmt: skip
-    if value["itetra4"] not in (0,):
-        card.fail(f"Itetra4 = {value['itetra4']}: tetrahedra are one-point P1 elements "
-                  "(Itetra4 0)", line)  # fmt: skip
     facts = {"isolid": isolid, "icpre": value["icpre"], "element": dict(ISOLID[isolid]),
-             "where": card.header.where, "line": line.where}  # fmt: skip
+             "where": card.header.where, "line": line.where,
+             "itetra4": value["itetra4"]}  # fmt: skip
     h = raw["h"]
     if isolid in (1, 2):
         facts["element"]["hourglass_coefficient"] = h if h else 0.1
