@@ -257,6 +257,9 @@ def _element_group(deck: Deck, group: Group) -> np.ndarray:
 def _surface(deck: Deck, group: Group) -> np.ndarray:
     kind, _, flavour = group.kind.partition("/")
     if kind == "SEG":
+        missing = group.segments[deck.node_positions(group.segments) < 0]
+        if len(missing):
+            raise DeckError(f"{group.where}: {group.name}: node {missing[0]} refers to no /NODE")
         return group.segments
     keep, drop = _split(group.items)
     out = [_segment_items(deck, group, kind, flavour, keep)]

@@ -147,6 +147,10 @@ REFUSED = {
         r"/GRBRIC/BRIC/8: element 99 refers to no element of GRBRIC's kind",
     ),
     "a subset of nothing": (listed("SUBSET", 8, [12]), r"subset 12 refers to no /SUBSET"),
+    "a segment of no node": (
+        ["/SURF/SEG/3", "s", i10(1) + i10(1) + i10(2) + i10(999)] + listed("SURF", 8, [3]),
+        r"/SURF/SEG/3: node 999 refers to no /NODE",
+    ),
 }  # fmt: skip
 
 
