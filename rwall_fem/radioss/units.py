@@ -8,7 +8,7 @@ from __future__ import annotations
 from rwall_fem.radioss.reader import NumberError, parse_number
 from rwall_fem.units import DIMENSIONS, UnitSystem, code_size, parse_system
 
-__all__ = ["DIMENSIONS", "UnitSystem", "parse_unit", "units_text"]
+__all__ = ["parse_unit", "units_text"]
 
 
 def parse_unit(text: str, quantity: str) -> float | None:
