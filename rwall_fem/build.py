@@ -46,6 +46,15 @@ from rwall_fem.estimate import (
     steps_above_limit,
     unphysical_material,
 )
+from rwall_fem.loads import (
+    Factor,
+    NodalForce,
+    Pressure,
+    RayleighDamping,
+    added_masses,
+    damped_step_factor,
+    outer_faces,
+)
 from rwall_fem.mechanics import critical_time_step, shortest_edge
 from rwall_fem.meshing import (
     BodyMesh,
@@ -251,6 +260,11 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
         perturb(body, *spec.noise)
     X = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local].copy()
     masses = part_masses(V, parts)
+    if scene.added_masses:  # shared by the parts as their masses share the node
+        added = added_masses(scene.added_masses, lambda i, name: _named_nodes(
+            scene, f"added_mass[{i}]", name, V, body, len(X)), len(X), comm)  # fmt: skip
+        total = masses.sum(axis=1)
+        masses = masses + added[:, None] * masses / np.where(total > 0, total, 1.0)[:, None]
     mass = masses.sum(axis=1)
     lowest = comm.allreduce(float(mass.min(initial=np.inf)), op=MPI.MIN)
     if not lowest > 0.0:
@@ -349,7 +363,11 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     if reason := shared_velocities(internal, comm):
         raise SceneError(f"{scene.source}: part: {reason}")
     body_mass = comm.allreduce(float(solid.mass.sum()))
-    steps = step_size(scene, internal, solid.dt_stable, V=solid.V, body_mass=body_mass,
+    damping = scene.damping
+    stable = solid.dt_stable  # with damping, the damped limit (rwall_fem.loads)
+    if damping is not None:
+        stable *= damped_step_factor(damping.alpha, damping.beta, solid.dt_stable)
+    steps = step_size(scene, internal, stable, V=solid.V, body_mass=body_mass,
                       limits=limits)  # fmt: skip
     state = State(X=solid.X, mass=solid.mass, dt=steps.initial, u=solid.u.owned, v=solid.v.owned)
     held = internal.held[: solid.owned] > 0
@@ -361,7 +379,8 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
         internal=internal,
         comm=comm,
         step_size=steps,
-        forces=[] if scene.gravity is None else [Gravity(scene.gravity)],
+        forces=([] if scene.gravity is None else [Gravity(scene.gravity)])
+        + _loads(scene, solid),
         walls=[_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))],
         boundaries=[_boundary(scene, i, solid) for i in range(len(scene.boundaries))],
         info={
@@ -500,6 +519,47 @@ def _filter_fits(spec: WallSpec, where: str, dt: float) -> None:
             f"{where}.friction_filter.{how}: gives alpha = {alpha:.4g} with dt = "
             f"{dt:.4g} s; alpha must be in (0, 1]"
         )
+
+
+def _named_nodes(scene: Scene, where: str, name: str, V, body: BodyMesh, owned: int):
+    """The owned nodes of the node set ``name`` that ``where`` (a table of the scene)
+    names, or one line refusing an unknown set."""
+    if name not in body.groups:
+        known = ", ".join(sorted(body.groups)) or "none"
+        raise SceneError(
+            f"{scene.source}: {where}.group: unknown node set {name!r}; the mesh has: {known}"
+        )
+    return _owned(group_nodes(V, body, name), owned)
+
+
+def _loads(scene: Scene, solid: _Solid) -> list:
+    """The ``[[load]]`` forces and pressures, then the ``[damping]``, in that order."""
+    V, body, owned, comm = solid.V, solid.body, solid.owned, solid.comm
+    forces = []
+    for i, spec in enumerate(scene.loads):
+        where, factor = f"load[{i}]", Factor(spec.history)
+        nodes = _named_nodes(scene, where, spec.group, V, body, owned)
+        if spec.kind == "force":
+            force = np.asarray(spec.force)
+            if spec.per == "set":
+                force = force / max(comm.allreduce(len(nodes)), 1)
+            forces.append(NodalForce(where, nodes, force, factor))
+            continue
+        fdim = body.msh.topology.dim - 1
+        faces = outer_faces(V, body.facet_tags.find(body.groups[spec.group]))
+        if not comm.allreduce(len(faces)):
+            raise SceneError(
+                f"{scene.source}: {where}.group: the face group {spec.group!r} has no face "
+                f"on the outside of the body (of dimension {fdim}): a pressure acts on outer faces"
+            )
+        forces.append(Pressure(where, V, faces, spec.pressure, factor, solid.u))
+    damping = scene.damping
+    if damping is not None:
+        nodes = np.arange(owned, dtype=np.int32)
+        if damping.group is not None:
+            nodes = _named_nodes(scene, "damping", damping.group, V, body, owned)
+        forces.append(RayleighDamping(nodes, damping.alpha, damping.beta, solid.elastic))
+    return forces
 
 
 def _boundary(scene: Scene, i: int, solid: _Solid) -> VelocityBoundary:

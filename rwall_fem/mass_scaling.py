@@ -83,6 +83,9 @@ class MassScaling:
         changed = np.flatnonzero(added.sum(axis=1) > 0.0)
         for constraint in sim.constraints:  # their previous step, with the velocities before
             constraint.settle(s)
+        for force in sim.forces:
+            if hasattr(force, "settle"):
+                force.settle(s)
         before = s.mass[changed]
         after = before + added[changed].sum(axis=1)
         keep = (before / after)[:, None]

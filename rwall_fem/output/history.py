@@ -71,6 +71,8 @@ class History:
         self.erosion = getattr(sim.internal, "erosion", None)  # cells that may erode
         self.step_changes = getattr(sim.internal, "corrects", False)  # a varying step's
         works = ["external_work", "wall_work"]
+        self.damping = [f for f in sim.forces if getattr(f, "column", None) == "damping_work"]
+        works += ["damping_work"] if self.damping else []
         works += ["mass_scaling_work"] if scaled else []
         works += ["step_change_work"] if self.step_changes else []
         # A body of [[part]]s: the energies of each part, which add up to the body's.
@@ -97,6 +99,7 @@ class History:
             comm,
             {name: () for name in (*self.balance.stored, *self.balance.parts)}
             | {"external_work": (), "wall_work": (len(walls), 2), "mass_scaling_work": ()}
+            | {"damping_work": ()}
             | {"step_change_work": (), "eroded_cells": (), "parts": (len(self.part_columns),)}
             | {"signals": (len(SIGNALS),), "seconds": (), "failed": ()}
             | self.wall_table.sums,
@@ -127,12 +130,13 @@ class History:
         for name, value in sim.internal.energies(s).items():
             local[name][...] = value
         local["external_work"][...] = (
-            sum(f.work(s) for f in sim.forces)
+            sum(f.work(s) for f in sim.forces if f not in self.damping)
             + sum(w.driving_work for w in sim.walls)
             + sum(b.work for b in sim.boundaries)
         )
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
+        local["damping_work"][...] = sum(f.work(s) for f in self.damping)
         if self.mass_scaling is not None:
             local["mass_scaling_work"][...] = self.mass_scaling.work
         if self.step_changes:
@@ -157,6 +161,8 @@ class History:
                 energies["kinetic"] += kinetic
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
+        if self.damping:
+            energies["damping_work"] = float(total["damping_work"])
         extras = dict(zip(self.part_columns, total["parts"].tolist(), strict=True))
         if self.step_changes:
             energies["step_change_work"] = float(total["step_change_work"])

@@ -28,7 +28,7 @@ SUMMARY_KEYS = {
     **dict.fromkeys(("initial_momentum", "final_momentum", "momentum", "impulse",
                      "normal_impulse", "tangential_impulse", "reaction_impulse"), "impulse"),
     **dict.fromkeys(("plastic_work", "work", "normal_work", "friction_work", "driving_work",
-                     "mass_scaling_work"), "energy"),
+                     "mass_scaling_work", "damping_work"), "energy"),
     **dict.fromkeys(("deformed_bounds", "position", "deepest_penetration"), "length"),
     "velocity": "velocity",
 }  # fmt: skip

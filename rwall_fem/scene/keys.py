@@ -461,6 +461,31 @@ class Curve(ValueType):
 
 
 @dataclass(frozen=True)
+class Factor(ValueType):
+    """A history of a factor: rows [t, y] with increasing t, any finite y (linear between
+    rows, held outside them)."""
+
+    type_text = "rows [t, y]"
+
+    def read(self, value, ctx):
+        ok = isinstance(value, (list, tuple)) and len(value) >= 1
+        ok = ok and all(_numbers(r, 2) for r in value)
+        if ok:
+            t = [_float(r[0]) for r in value]
+            ok = all(b > a for a, b in zip(t, t[1:], strict=False))
+        if not ok:
+            raise Invalid(f"must be rows [t, y] with increasing t, got {show(value)}")
+        return tuple((_float(r[0]), _float(r[1])) for r in value)
+
+    def allowed_text(self):
+        return "finite; rows with increasing t"
+
+    def json(self):
+        row = {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}
+        return {"type": "array", "items": row, "minItems": 1}
+
+
+@dataclass(frozen=True)
 class Names(ValueType):
     """A list of node-set names (gmsh physical groups)."""
 

@@ -17,6 +17,7 @@ from rwall_fem.scene.keys import (
     Choice,
     Curve,
     Each,
+    Factor,
     Flag,
     Identifier,
     Integer,
@@ -43,11 +44,14 @@ __all__ = [
     "MESH_SHAPES",
     "SHAPE_KEYS",
     "SHAPE_REGIONS",
+    "AddedMassSpec",
     "BoundarySpec",
+    "Damping",
     "Element",
     "Failure",
     "Heating",
     "Initial",
+    "LoadSpec",
     "Material",
     "MeshSpec",
     "Motion",
@@ -772,6 +776,78 @@ class BoundarySpec:
     )
 
 
+# --- [[load]], [[added_mass]], [damping] ---------------------------------------------
+
+LOAD_KEYS = {"force": ("force", "per"), "pressure": ("pressure",)}
+
+
+@table(
+    "An external load (Radioss /CLOAD, /PLOAD): a force on the nodes of a named node set, or"
+    " a follower pressure on the outer faces of a named face group, times a factor of time;"
+    " its work is booked in external_work.",
+    variants=Variants("kind", LOAD_KEYS, common=("group", "history"), noun="a {} load"),
+)
+@dataclass(frozen=True)
+class LoadSpec:
+    kind: str = key(Choice(tuple(LOAD_KEYS)), doc="a nodal force, or a pressure on faces")
+    group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
+    force: tuple[float, float, float] | None = key(
+        Vector(), None, required=True, unit="N", doc="the force at factor 1 (see per)"
+    )
+    per: str = key(
+        Choice(("node", "set")),
+        "node",
+        doc="node: on each node of the set (Radioss /CLOAD); set: the total, spread equally",
+    )
+    pressure: float | None = key(
+        Real(), None, required=True, unit="Pa",
+        doc="at factor 1, on the current faces; positive pushes into the body",
+    )  # fmt: skip
+    history: tuple | None = key(
+        Factor(), None, doc="the factor f(t) of s: linear between rows, held outside them",
+        default_doc="1 at all times",
+    )  # fmt: skip
+
+
+@table(
+    "Mass added to the nodes of a named node set (Radioss /ADMAS): it moves with them, and"
+    " the summary's mass, the momentum and the kinetic energy include it."
+)
+@dataclass(frozen=True)
+class AddedMassSpec:
+    group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
+    mass: float = key(Real(low=0.0), unit="kg", doc="on each node, or the total (see per)")
+    per: str = key(
+        Choice(("node", "set")),
+        "node",
+        doc="node: on each node of the set (/ADMAS type 0); set: the total, spread equally",
+    )
+
+
+@table(
+    "Rayleigh damping (Radioss /DAMP): the forces -alpha m v - beta K0 v on the nodes of a"
+    " node set (K0 the stiffness at rest); their work is booked as damping_work."
+)
+@dataclass(frozen=True)
+class Damping:
+    alpha: float = key(
+        Real(low=0.0, low_open=False), 0.0, unit="1/s", doc="mass-proportional coefficient"
+    )
+    beta: float = key(
+        Real(low=0.0, low_open=False), 0.0, unit="s", doc="stiffness-proportional coefficient"
+    )
+    group: str | None = key(
+        Text("the name of a node set"), None, doc="the nodes damped", default_doc="every node"
+    )
+
+
+@rule(Damping)
+def _damping_does_something(v, raw, fail):
+    """alpha or beta is above 0."""
+    if v["alpha"] == 0.0 and v["beta"] == 0.0:
+        fail("alpha", "alpha and beta are both 0: give one above 0, or drop [damping]")
+
+
 # --- [[wall]] ------------------------------------------------------------------------
 
 
@@ -1083,6 +1159,16 @@ class Scene:
         Each(BoundarySpec), (), toml="boundary", doc="prescribed velocities of node sets"
     )
     walls: tuple[WallSpec, ...] = key(Each(WallSpec), (), toml="wall", doc="the rigid walls")
+    loads: tuple[LoadSpec, ...] = key(
+        Each(LoadSpec), (), toml="load", doc="nodal forces and pressures", default_doc="none"
+    )
+    added_masses: tuple[AddedMassSpec, ...] = key(
+        Each(AddedMassSpec), (), toml="added_mass", doc="masses added to node sets",
+        default_doc="none",
+    )  # fmt: skip
+    damping: Damping | None = key(
+        Sub(Damping), None, doc="Rayleigh damping", default_doc="none"
+    )
     parts: tuple[PartSpec, ...] = key(
         Each(PartSpec), (), toml="part", doc="the parts of the body", default_doc="one: the body"
     )
