@@ -51,6 +51,10 @@ FULL = {
     "initial": {"velocity": [0.0, 0.0, -1.0]},
     "gravity": {"acceleration": [0.0, 0.0, -9.81]},
     "boundary": [{"group": "sides", "velocity": [[0, 0, 0, 0], [1, 0, 0, 1]]}],
+    "load": [{"kind": "force", "group": "top", "force": [0, 0, 1], "per": "set",
+              "history": [[0, 0], [1e-5, 1]]}],
+    "added_mass": [{"group": "top", "mass": 1e-3, "per": "set"}],
+    "damping": {"alpha": 10.0, "beta": 1e-9, "group": "top"},
     "wall": [
         {
             "kind": "cylinder",
@@ -74,6 +78,7 @@ FAILING = {
     "failure": {"criterion": "johnson_cook", "d1": 0.05, "d2": 0.5, "d3": -1.5},
 }  # fmt: skip
 OTHERS = [
+    FULL | {"load": [{"kind": "pressure", "group": "top", "pressure": 1e5}]},
     FULL
     | {
         "mesh": {"shape": "round_bar", "radius": 0.01, "length": 0.1, "element_size": 0.01},
