@@ -4,6 +4,7 @@ import pytest
 from conftest import bar_scene, block_scene, run
 
 import rwall_fem.effects
+import rwall_fem.loads
 import rwall_fem.output.frames
 import rwall_fem.walls.motion
 
@@ -20,6 +21,9 @@ def nothing_optional(monkeypatch):
     """Make every optional effect fail loudly if it runs."""
     for owner, name in [
         (rwall_fem.effects.Gravity, "accelerate"),
+        (rwall_fem.loads.NodalForce, "accelerate"),
+        (rwall_fem.loads.Pressure, "accelerate"),
+        (rwall_fem.loads.RayleighDamping, "accelerate"),
         (rwall_fem.output.frames.Frames, "record"),
         (rwall_fem.walls.motion.MainNodeMotion, "advance"),
         (rwall_fem.walls.motion.PrescribedMotion, "predict"),

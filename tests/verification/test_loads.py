@@ -191,3 +191,29 @@ def test_unknown_sets_are_refused_in_one_line(table, message, shared_dir):
     raw = bar_scene(elements=2, h=H, speed=0.0, wall=False, end_time=1e-7) | table
     with pytest.raises(SceneError, match=message.replace("[", r"\[").replace("]", r"\]")):
         build_simulation(parse_scene(raw, source="test"), MPI.COMM_WORLD, shared_dir)
+
+
+def test_a_resumed_run_with_loads_equals_an_uninterrupted_one(shared_dir):
+    """What the loads and the damping carry from step to step is in the checkpoints."""
+    from pathlib import Path
+
+    from conftest import StopAt
+
+    raw = pulled_bar({"kind": "pressure", "pressure": -F / AREA})
+    raw["damping"]["beta"] = 1e-9
+    raw["load"].append({"kind": "force", "group": "top", "force": [1.0, 0.0, 0.0]})
+    raw["run"]["end_time"] = 2 * PERIOD
+    raw["output"] |= {"history_interval": 5, "checkpoint_steps": 50}
+    root = Path(shared_dir)
+    whole = run(raw, root / "whole")
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), MPI.COMM_WORLD,
+                           root / "stopped")  # fmt: skip
+    sim.recorders.append(StopAt(72))
+    assert sim.run().startswith("stopped")
+    MPI.COMM_WORLD.Barrier()
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), MPI.COMM_WORLD,
+                           root / "stopped")  # fmt: skip
+    sim.checkpoints.resume(sim)
+    assert sim.run() == "done"
+    assert np.array_equal(sim.state.u, whole.state.u)
+    assert sim.history.summary["energy"] == whole.history.summary["energy"]
