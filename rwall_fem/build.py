@@ -521,15 +521,17 @@ def _filter_fits(spec: WallSpec, where: str, dt: float) -> None:
         )
 
 
-def _named_nodes(scene: Scene, where: str, name: str, V, body: BodyMesh, owned: int):
-    """The owned nodes of the node set ``name`` that ``where`` (a table of the scene)
-    names, or one line refusing an unknown set."""
-    if name not in body.groups:
-        known = ", ".join(sorted(body.groups)) or "none"
-        raise SceneError(
-            f"{scene.source}: {where}.group: unknown node set {name!r}; the mesh has: {known}"
-        )
-    return _owned(group_nodes(V, body, name), owned)
+def _named_nodes(scene: Scene, where: str, names, V, body: BodyMesh, owned: int):
+    """The owned nodes of the union of the node sets ``names`` that ``where`` (a table of
+    the scene) names, each node once, or one line refusing an unknown set."""
+    for name in names:
+        if name not in body.groups:
+            known = ", ".join(sorted(body.groups)) or "none"
+            raise SceneError(
+                f"{scene.source}: {where}.group: unknown node set {name!r}; the mesh has: {known}"
+            )
+    nodes = [group_nodes(V, body, name) for name in names]
+    return _owned(np.unique(np.concatenate(nodes)).astype(np.int32), owned)
 
 
 def _loads(scene: Scene, solid: _Solid) -> list:
@@ -545,12 +547,13 @@ def _loads(scene: Scene, solid: _Solid) -> list:
                 force = force / max(comm.allreduce(len(nodes)), 1)
             forces.append(NodalForce(where, nodes, force, factor))
             continue
-        fdim = body.msh.topology.dim - 1
-        faces = outer_faces(V, body.facet_tags.find(body.groups[spec.group]))
+        tags = [body.facet_tags.find(body.groups[name]) for name in spec.group]
+        faces = outer_faces(V, np.unique(np.concatenate(tags)))
         if not comm.allreduce(len(faces)):
+            named = ", ".join(spec.group)
             raise SceneError(
-                f"{scene.source}: {where}.group: the face group {spec.group!r} has no face "
-                f"on the outside of the body (of dimension {fdim}): a pressure acts on outer faces"
+                f"{scene.source}: {where}.group: {named}: no face on the outside of the "
+                "body: a pressure acts on outer faces"
             )
         forces.append(Pressure(where, V, faces, spec.pressure, factor, solid.u))
     damping = scene.damping

@@ -501,6 +501,31 @@ class Names(ValueType):
 
 
 @dataclass(frozen=True)
+class NodeSets(ValueType):
+    """One node-set name, or a non-empty list of them (their union: a node is in it once)."""
+
+    type_text = "string or array of strings"
+
+    def read(self, value, ctx):
+        if isinstance(value, str) and value:
+            return (value,)
+        if (
+            isinstance(value, (list, tuple))
+            and value
+            and all(isinstance(v, str) and v for v in value)
+        ):
+            return tuple(dict.fromkeys(value))
+        raise Invalid(f"must be a node-set name or a list of them, got {show(value)}")
+
+    def allowed_text(self):
+        return "names of face groups of the mesh"
+
+    def json(self):
+        name = {"type": "string", "minLength": 1}
+        return {"anyOf": [name, {"type": "array", "items": name, "minItems": 1}]}
+
+
+@dataclass(frozen=True)
 class Letters(ValueType):
     """Some of the letters x, y, z, each at most once (returned sorted)."""
 

@@ -24,6 +24,7 @@ from rwall_fem.scene.keys import (
     Letters,
     MeshFile,
     Names,
+    NodeSets,
     Real,
     Sub,
     Text,
@@ -790,7 +791,7 @@ LOAD_KEYS = {"force": ("force", "per"), "pressure": ("pressure",)}
 @dataclass(frozen=True)
 class LoadSpec:
     kind: str = key(Choice(tuple(LOAD_KEYS)), doc="a nodal force, or a pressure on faces")
-    group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
+    group: tuple[str, ...] = key(NodeSets(), doc="a named face group of the mesh, or several")
     force: tuple[float, float, float] | None = key(
         Vector(), None, required=True, unit="N", doc="the force at factor 1 (see per)"
     )
@@ -815,7 +816,7 @@ class LoadSpec:
 )
 @dataclass(frozen=True)
 class AddedMassSpec:
-    group: str = key(Text("the name of a node set"), doc="a named face group of the mesh")
+    group: tuple[str, ...] = key(NodeSets(), doc="a named face group of the mesh, or several")
     mass: float = key(Real(low=0.0), unit="kg", doc="on each node, or the total (see per)")
     per: str = key(
         Choice(("node", "set")),
@@ -836,8 +837,8 @@ class Damping:
     beta: float = key(
         Real(low=0.0, low_open=False), 0.0, unit="s", doc="stiffness-proportional coefficient"
     )
-    group: str | None = key(
-        Text("the name of a node set"), None, doc="the nodes damped", default_doc="every node"
+    group: tuple[str, ...] | None = key(
+        NodeSets(), None, doc="the nodes damped: face groups", default_doc="every node"
     )
 
 
