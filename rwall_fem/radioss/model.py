@@ -192,6 +192,10 @@ class Deck:
     clamps: list[tuple[str, int, str]] = field(default_factory=list)  # components, group
     velocities: list[Prescribed] = field(default_factory=list)  # /IMPVEL
     gravity: list[Prescribed] = field(default_factory=list)  # /GRAV
+    loads: list[Prescribed] = field(default_factory=list)  # /CLOAD (y_scale in N)
+    pressures: list = field(default_factory=list)  # /PLOAD (cards.loads.Pressure)
+    added_masses: list = field(default_factory=list)  # /ADMAS (cards.loads.AddedMass)
+    dampings: list = field(default_factory=list)  # /DAMP (cards.loads.Damping)
     walls: list[Wall] = field(default_factory=list)
     end_time: float | None = None  # s
     dt_scale: float | None = None

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem.radioss.groups import node_ids, part_ids
+from rwall_fem.radioss.loads import load_groups, load_tables
 from rwall_fem.radioss.materials import element_table, material_table
 from rwall_fem.radioss.mesh import WRITER, FaceGroups, face_groups, write_msh
 from rwall_fem.radioss.model import Deck, Prescribed, Wall
@@ -120,6 +121,7 @@ def scene_of(deck: Deck) -> SceneParts:
 
     by_parts = _groups_as_parts(deck, parts) if separate else {}
     group_nodes = {gid: deck.groups[gid].nodes for gid in _used_groups(deck, by_parts)}
+    group_nodes |= load_groups(deck, cell, cells, body_nodes)  # and surfaces' nodes
     atoms, unreached = face_groups(cell, cells, {
         gid: np.intersect1d(nodes, body_nodes) for gid, nodes in group_nodes.items()
     })  # fmt: skip
@@ -140,6 +142,9 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["boundary"] = boundaries
         facts += [f"boundary on {b['group']}: components {b.get('components', 'xyz')}"
                   for b in boundaries]  # fmt: skip
+    tables, lines = load_tables(deck, cell, cells, atoms, body_nodes)
+    raw |= tables
+    facts += lines
     walls = [_wall(deck, w, atoms, by_parts, wall_velocity.get(w.main_node)) for w in deck.walls]
     if walls:
         raw["wall"] = walls

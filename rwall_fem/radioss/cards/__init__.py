@@ -31,6 +31,7 @@ from rwall_fem.radioss.cards import (
     failures,
     functions,
     groups,
+    loads,
     materials,
     nodes,
     parts,
@@ -44,7 +45,7 @@ __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supporte
 
 STARTER_FAMILIES = (
     begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
-    control,
+    control, loads,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 

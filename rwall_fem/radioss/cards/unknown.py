@@ -10,10 +10,9 @@ _WHY = {
     "and /TETRA4 (tetrahedra)",
     "interface": "contact interfaces are not read: bodies meet rigid walls (/RWALL) only",
     "kinematic": "kinematic conditions of this kind are not read: /BCS and /IMPVEL are",
-    "load": "loads and initial states of this kind are not read: /INIVEL/TRA, /BCS, /IMPVEL "
-    "and /GRAV are",
+    "load": "loads and initial states of this kind are not read: /INIVEL/TRA, /BCS, /IMPVEL, "
+    "/GRAV, /CLOAD, /PLOAD and /ADMAS are",
     "fluid": "ALE, SPH, fluids and heat are not read: rwall_fem's solids are Lagrangian",
-    "damping": "damping is not read: rwall_fem has none",
     "option": "this option is not read",
 }
 # A card's keyword (or first two) -> what it asks for.
@@ -23,12 +22,11 @@ KINDS = {
     "INTER": "interface",
     **dict.fromkeys(("RBODY", "RBE2", "RBE3", "RLINK", "CYL_JOINT", "GJOINT", "MERGE", "MPC",
                      "BCS/CYCLIC", "BCS/LAGMUL"), "kinematic"),
-    **dict.fromkeys(("CLOAD", "PLOAD", "ADMAS", "LOAD", "IMPDISP", "IMPACC", "PBLAST", "PFLUID",
+    **dict.fromkeys(("LOAD", "IMPDISP", "IMPACC", "PBLAST", "PFLUID",
                      "INIVEL/ROT", "INIVEL/AXIS", "INISTA", "INIBRI", "INIGRAV", "REFSTA",
                      "PRELOAD"), "load"),
     **dict.fromkeys(("ALE", "EULER", "EBCS", "SPH", "SPHBCS", "MONVOL", "AIRBAG", "EOS", "LEAK",
                      "THERM", "HEAT", "CONVEC", "RADIATION", "DFS"), "fluid"),
-    "DAMP": "damping",
     **dict.fromkeys(("AMS", "PERTURB", "ENCRYPT", "PARAMETER", "TRANSFORM", "DRAPE", "ADMESH",
                      "FXBODY", "EIG", "OPTIMIZATION"), "option"),
 }  # fmt: skip
