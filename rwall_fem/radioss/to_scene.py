@@ -24,6 +24,7 @@ from rwall_fem.radioss.model import Deck, Prescribed, Wall
 from rwall_fem.radioss.parts import DeckPart, deck_parts, initial_velocities, uniform_velocity
 from rwall_fem.radioss.plausible import unit_warning
 from rwall_fem.radioss.reader import DeckError
+from rwall_fem.radioss.void import drop_void_elements
 
 __all__ = ["SceneParts", "scene_of"]
 
@@ -59,6 +60,7 @@ class SceneParts:
 
 def scene_of(deck: Deck) -> SceneParts:
     """The scene the deck describes (mesh file key left for the caller to fill)."""
+    voids = drop_void_elements(deck)
     _check_references(deck)
     slip = unit_warning(deck)
     if slip is not None:
@@ -74,7 +76,8 @@ def scene_of(deck: Deck) -> SceneParts:
     parts = deck_parts(deck)
     used = {p.part.id for p in parts}
     for part in deck.parts.values():
-        if part.id not in used:
+        void = deck.materials.get(part.mat, {}).get("law") == "LAW0"  # left out, said so
+        if part.id not in used and not void:
             deck.warnings.append(f"{part.where}: /PART/{part.id}: has no elements")
     body_nodes = np.unique(cells)
     mains = {w.main_node for w in deck.walls if w.main_node}
@@ -84,6 +87,7 @@ def scene_of(deck: Deck) -> SceneParts:
     facts = [
         f"units: input {deck.input_units.describe()}, work {deck.work_units.describe()} "
         "(converted to SI)",
+        *voids,
     ]
     if separate:
         body = _parts(deck, parts, cell, facts)

@@ -155,3 +155,41 @@ def test_what_is_not_read_is_one_line(case, shared_dir):
     d = pulled("force")
     d.cards += cards
     refused_in_one_line(written(d, shared_dir), header, pattern)
+
+
+def void_bar(front: int) -> BarDeck:
+    """A steel bar falling at 5 m/s onto a plane at z = 0, its lowest ``front`` layers of
+    a void material (/MAT/VOID, /PROP/VOID); without them when ``front`` is 0, starting as
+    high as the bar's solid layers do."""
+    d = BarDeck(units="kg-mm-ms", nz=8 - (0 if front else 2), z0=0.0 if front else 2e-3,
+                front=front, end_time=3e-6)  # fmt: skip
+    d.part()
+    d.elastic(RHO, E, 0.3)
+    d.solid(24)
+    if front:
+        d.part(mat=2, prop=2, pid=2, title="void")
+        d.cards += ["/MAT/VOID/2", "nothing", "/PROP/VOID/2", "nothing"]
+    d.group(1, "PART", [1])
+    d.initial_velocity((0.0, 0.0, -5.0), 1)
+    d.wall("PLANE", m1=(0, 0, 1), dsearch=1.0, add=1)
+    return d
+
+
+def test_void_elements_are_left_out(shared_dir):
+    """A void part (no stiffness, no mass) changes nothing: the bar runs as the bar
+    without it, its free nodes left out."""
+    scene = load_deck(written(void_bar(2), shared_dir))
+    sim = build_simulation(scene, MPI.COMM_WORLD, shared_dir)
+    sim.run()
+    if MPI.COMM_WORLD.rank == 0:
+        (shared_dir / "bare").mkdir(exist_ok=True)
+    MPI.COMM_WORLD.Barrier()
+    bare = build_simulation(load_deck(written(void_bar(0), shared_dir / "bare")),
+                            MPI.COMM_WORLD, shared_dir / "bare")  # fmt: skip
+    bare.run()
+    assert sim.info["mass"] == pytest.approx(RHO * 2e-3 * 2e-3 * 6e-3, rel=1e-12)
+    assert sim.info["nodes"] == bare.info["nodes"] == 9 * 7
+    assert sim.state.dt == bare.state.dt
+    a, b = sim.history.energy, bare.history.energy
+    assert np.allclose(a, b, rtol=0, atol=1e-9 * np.abs(b).max())
+    assert sim.history.summary["energy"]["external_work"] == 0.0

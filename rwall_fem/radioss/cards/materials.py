@@ -17,7 +17,8 @@ __all__ = ["LAWS", "STARTER"]
 # Keyword -> law, for the laws read.
 LAWS = {"LAW1": "LAW1", "ELAST": "LAW1", "LAW2": "LAW2", "PLAS_JOHNS": "LAW2",
         "LAW36": "LAW36", "PLAS_TAB": "LAW36"}  # fmt: skip
-_SUPPORTED = "/MAT/LAW1 (ELAST), /MAT/LAW2 (PLAS_JOHNS), /MAT/LAW36 (PLAS_TAB)"
+_SUPPORTED = ("/MAT/LAW1 (ELAST), /MAT/LAW2 (PLAS_JOHNS), /MAT/LAW36 (PLAS_TAB), /MAT/LAW0 "
+              "(VOID)")
 
 
 def _material(deck: Deck, card: Card) -> None:
@@ -41,6 +42,16 @@ def _material(deck: Deck, card: Card) -> None:
     else:
         facts |= _tabulated(card, units)
     deck.materials[mid] = facts
+
+
+def _void(deck: Deck, card: Card) -> None:
+    """/MAT/VOID (/MAT/LAW0): no stiffness, no mass; its elements are left out of the mesh
+    (:mod:`rwall_fem.radioss.void`)."""
+    mid = ident(card, 2, "mat_ID")
+    if mid in deck.materials:
+        card.fail(f"material {mid} is defined twice")
+    deck.materials[mid] = {"law": "LAW0", "title": card.title(), "where": card.header.where,
+                           "density": 0.0}  # fmt: skip
 
 
 @catch_all
@@ -162,3 +173,4 @@ def _tabulated(card: Card, units: UnitSystem) -> dict:
 
 
 STARTER = {f"MAT/{keyword}": _material for keyword in LAWS} | {"MAT": _other_material}
+STARTER |= {"MAT/VOID": _void, "MAT/LAW0": _void}

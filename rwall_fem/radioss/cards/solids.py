@@ -68,7 +68,16 @@ def _property(deck: Deck, card: Card) -> None:
 
 @catch_all
 def _other_property(deck: Deck, card: Card) -> None:
-    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14)")
+    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14), /PROP/VOID "
+              "(/PROP/TYPE0)")
+
+
+def _void_property(deck: Deck, card: Card) -> None:
+    """/PROP/VOID (/PROP/TYPE0): the property of void elements, which are left out."""
+    pid = ident(card, 2, "prop_ID")
+    if pid in deck.properties:
+        card.fail(f"property {pid} is defined twice")
+    deck.properties[pid] = {"void": True, "where": card.header.where}
 
 
 def finish(deck: Deck) -> None:
@@ -138,5 +147,7 @@ STARTER = {
     "TETRA4": _elements,
     "PROP/SOLID": _property,
     "PROP/TYPE14": _property,
+    "PROP/VOID": _void_property,
+    "PROP/TYPE0": _void_property,
     "PROP": _other_property,
 }
