@@ -12,7 +12,8 @@ the balance closes to round-off whatever the force.
 - :class:`Pressure`: a follower pressure (Pa) on the outer faces of a face group, on the
   faces' current areas and normals: a quadrilateral of nodes x1..x4 takes
   -p (x3 - x1) x (x4 - x2) / 2 (exact for a bilinear face), a triangle -p (x2 - x1) x
-  (x3 - x1) / 2, in equal shares to its nodes (Radioss's one-point face);
+  (x3 - x1) / 2, in equal shares to its distinct nodes (Radioss's one-point face; a
+  quadrilateral with a repeated node is a triangle);
 - :class:`RayleighDamping`: -alpha m v - beta K0 v^{n-1/2} on a node set, K0 the stiffness
   at rest (one more pass of the elastic kernels per step when beta > 0);
 - :func:`added_masses`: the masses of ``[[added_mass]]``, added to the nodes before the
@@ -160,6 +161,13 @@ class Pressure(_MidStepWork):
         self.name = name
         self.pressure, self.factor = float(pressure), factor
         self.faces, self.u = faces, u
+        # Each distinct node of a face takes an equal share: a quadrilateral with a repeated
+        # node (a degenerate hexahedron's face) is a triangle, its nodes a third each.
+        corners = faces.shape[1]
+        repeat = np.zeros(faces.shape, dtype=bool)
+        for k in range(1, corners):  # 3 or 4 corners, all faces at once
+            repeat[:, k] = (faces[:, :k] == faces[:, k : k + 1]).any(axis=1)
+        self.shares = np.where(repeat, 0.0, 1.0) / (~repeat).sum(axis=1, keepdims=True)
         self.X = V.tabulate_dof_coordinates()  # owned and ghost rows, m
         self.f = GhostedField(V)
         self.f.array[self.faces.ravel()] = 1.0
@@ -173,9 +181,9 @@ class Pressure(_MidStepWork):
         f.array.fill(0.0)
         p = self.pressure * self.factor(state.t)
         if len(self.faces):
-            share = (-p / self.faces.shape[1]) * area_vectors(self.X + self.u.array, self.faces)
+            force = -p * area_vectors(self.X + self.u.array, self.faces)
             for corner in range(self.faces.shape[1]):  # 3 or 4 corners, all faces at once
-                np.add.at(f.array, self.faces[:, corner], share)
+                np.add.at(f.array, self.faces[:, corner], self.shares[:, corner, None] * force)
         f.scatter_reverse_add()
         loaded = f.owned[self.nodes]
         state.a[self.nodes] += loaded * state.inv_mass[self.nodes, None]
