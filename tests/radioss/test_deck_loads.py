@@ -193,3 +193,16 @@ def test_void_elements_are_left_out(shared_dir):
     a, b = sim.history.energy, bare.history.energy
     assert np.allclose(a, b, rtol=0, atol=1e-9 * np.abs(b).max())
     assert sim.history.summary["energy"]["external_work"] == 0.0
+
+
+def tetrahedra_as_bricks(lines):
+    k = next(i for i, text in enumerate(lines) if text.startswith("/BRICK"))
+    for layer in (3, 5):
+        a, b, c, d, e, f, g, h = (int(lines[k + 1 + layer][10 * j : 10 * j + 10])
+                                  for j in range(1, 9))  # fmt: skip
+        lines[k + 1 + layer] = i10(layer + 1) + "".join(i10(q) for q in (a, b, c, c, g, g, g, g))
+
+
+def test_degenerate_bricks_are_one_line_naming_them(shared_dir):
+    refused_in_one_line(written(pulled("force"), shared_dir, tetrahedra_as_bricks), "/BRICK",
+                        r"2 elements repeat a node \(degenerate: 4, 6\): only 8-node")

@@ -41,9 +41,13 @@ def _elements(deck: Deck, card: Card) -> None:
     sorted_nodes = np.sort(nodes, axis=1)
     repeated = np.flatnonzero((np.diff(sorted_nodes, axis=1) == 0).any(axis=1))
     if len(repeated):
+        shown = ", ".join(map(str, ids[repeated[:10]])) + (", ..." if len(repeated) > 10 else "")
+        why = ("a wedge or tetrahedron written as a brick is not: DOLFINx 0.5 mishandles "
+               "such cells on several ranks; write tetrahedra as /TETRA4" if count == 8 else
+               "a tetrahedron with a repeated node has no volume")  # fmt: skip
         card.fail(
-            f"element {ids[repeated[0]]} repeats a node (a degenerate element): only "
-            f"{count}-node elements with distinct nodes are read",
+            f"{len(repeated)} elements repeat a node (degenerate: {shown}): only {count}-node "
+            f"elements with distinct nodes are read ({why})",
             card.lines[repeated[0]],
         )
     cell = "hexahedron" if count == 8 else "tetrahedron"
