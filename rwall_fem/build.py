@@ -366,7 +366,14 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     damping = scene.damping
     stable = solid.dt_stable  # with damping, the damped limit (rwall_fem.loads)
     if damping is not None:
-        stable *= damped_step_factor(damping.alpha, damping.beta, solid.dt_stable)
+        factor = damped_step_factor(damping.alpha, damping.beta, solid.dt_stable)
+        if factor < 1e-6:
+            raise SceneError(
+                f"{scene.source}: damping: alpha = {damping.alpha:g} 1/s, beta = "
+                f"{damping.beta:g} s damp the mesh's highest mode so much that the stable step "
+                f"would be {factor:.3g} of the undamped {solid.dt_stable:.4g} s; lower them"
+            )
+        stable *= factor
     steps = step_size(scene, internal, stable, V=solid.V, body_mass=body_mass,
                       limits=limits)  # fmt: skip
     state = State(X=solid.X, mass=solid.mass, dt=steps.initial, u=solid.u.owned, v=solid.v.owned)

@@ -219,7 +219,7 @@ def damped_step_factor(alpha: float, beta: float, dt_stable: float) -> float:
     stable for omega dt <= 2 (sqrt(1 + xi^2) - xi) (LS-DYNA's and Radioss's rule)."""
     omega = 2.0 / dt_stable
     xi = alpha / (2.0 * omega) + beta * omega / 2.0
-    return math.sqrt(1.0 + xi * xi) - xi
+    return 1.0 / (math.hypot(1.0, xi) + xi)  # sqrt(1 + xi^2) - xi without cancellation
 
 
 def added_masses(specs, nodes_of, owned: int, comm) -> np.ndarray:

@@ -24,6 +24,12 @@ def drop_void_elements(deck: Deck) -> list[str]:
     """Remove the elements of void parts from ``deck.bodies``; a line per void part, and a
     refusal when nothing else is left or a part with stiffness has a void property."""
     void = sorted({b.part for b in deck.bodies if _is_void(deck, b.part)})
+    kept = [b for b in deck.bodies if b.part not in void]
+    for pid in sorted({b.part for b in kept}):
+        part = deck.parts.get(pid)
+        if part is not None and deck.properties.get(part.prop, {}).get("void"):
+            raise DeckError(f"{part.where}: /PART/{pid}: prop_ID {part.prop} is a /PROP/VOID, "
+                            f"and its material {part.mat} is not void: give it a /PROP/SOLID")
     if not void:
         return []
     facts = []
@@ -32,15 +38,9 @@ def drop_void_elements(deck: Deck) -> list[str]:
         part = deck.parts[pid]
         facts.append(f"part {pid} ({part.where}): {count} elements of a void material (/MAT "
                      f"{part.mat}, law 0): no stiffness, no mass: left out of the mesh")
-    kept = [b for b in deck.bodies if b.part not in void]
     if not kept:
         raise DeckError(f"{deck.starter}: every element is of a void material (/MAT/VOID, "
                         "LAW0): there is no body to run")  # fmt: skip
-    for pid in sorted({b.part for b in kept}):
-        part = deck.parts.get(pid)
-        if part is not None and deck.properties.get(part.prop, {}).get("void"):
-            raise DeckError(f"{part.where}: /PART/{pid}: prop_ID {part.prop} is a /PROP/VOID, "
-                            f"and its material {part.mat} is not void: give it a /PROP/SOLID")
     before = np.unique(np.concatenate([b.nodes.ravel() for b in deck.bodies]))
     after = np.unique(np.concatenate([b.nodes.ravel() for b in kept]))
     free = len(before) - len(after)
