@@ -129,14 +129,11 @@ def outer_faces(V, facets: np.ndarray) -> np.ndarray:
     f_to_c = msh.topology.connectivity(tdim - 1, tdim)
     c_to_f = msh.topology.connectivity(tdim, tdim - 1)
     cell_dofs = _compat.cell_nodes(V)
-    faces = np.zeros((len(facets), table.shape[1]), dtype=np.int32)
-    centres = np.zeros((len(facets), 3))
     X = V.tabulate_dof_coordinates()
-    for k, facet in enumerate(facets):  # once, when the scene is built
-        cell = f_to_c.links(facet)[0]
-        local = int(np.flatnonzero(c_to_f.links(cell) == facet)[0])
-        faces[k] = cell_dofs[cell][table[local]]
-        centres[k] = X[cell_dofs[cell]].mean(axis=0)
+    cells = f_to_c.array[f_to_c.offsets[facets]]  # an exterior facet's one cell
+    local = np.argmax(c_to_f.array.reshape(-1, len(table))[cells] == facets[:, None], axis=1)
+    faces = np.take_along_axis(cell_dofs[cells], table[local], axis=1).astype(np.int32)
+    centres = X[cell_dofs[cells]].mean(axis=1)
     outward = np.einsum("ij,ij->i", area_vectors(X, faces), X[faces].mean(axis=1) - centres)
     faces[outward < 0] = faces[outward < 0][:, ::-1]
     return faces
