@@ -62,6 +62,7 @@ from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
+from rwall_fem.rigid_body import RigidBodyError, RigidContact, build_rigid_bodies
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
 from rwall_fem.time_step import step_size
@@ -355,6 +356,9 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     held = internal.held[: solid.owned] > 0
     for k, part in enumerate(solid.parts):
         state.v[held[:, k]] = part.velocity
+    walls = [_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))]
+    boundaries = [_boundary(scene, i, solid) for i in range(len(scene.boundaries))]
+    rigid = _rigid_bodies(scene, solid, state, walls, boundaries)
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
@@ -362,8 +366,10 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
         comm=comm,
         step_size=steps,
         forces=[] if scene.gravity is None else [Gravity(scene.gravity)],
-        walls=[_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))],
-        boundaries=[_boundary(scene, i, solid) for i in range(len(scene.boundaries))],
+        walls=walls,
+        boundaries=boundaries,
+        rigid_bodies=rigid,
+        rigid_contact=RigidContact(rigid, walls, solid.owned, comm) if rigid else None,
         info={
             "scene": scene.source,
             "version": __version__,
@@ -378,6 +384,62 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
             "dt_element_estimate": steps.at_rest,
         },
     )
+
+
+def _rigid_bodies(scene: Scene, solid: _Solid, state: State, walls, boundaries) -> list:
+    """The scene's [[rigid_body]]s on their owned nodes (named sets, every node of the named
+    parts, the nodes inside a box at the start), and what they may not meet: a boundary
+    condition on their nodes, a wall that is tied, with friction or carried by a main node
+    (``docs/theory.md``, "Rigid bodies"), mass scaling."""
+    specs, comm, owned = scene.rigid_bodies, solid.comm, solid.owned
+    if not specs:
+        return []
+    names = [part.name for part in solid.parts]
+    selections = []
+    for i, spec in enumerate(specs):
+        where = f"{scene.source}: rigid_body[{i}]"
+        chosen = np.zeros(owned, dtype=bool)
+        for name in spec.sets:
+            if name not in solid.body.groups:
+                known = ", ".join(sorted(solid.body.groups)) or "none"
+                raise SceneError(f"{where}.sets: unknown node set {name!r}; the mesh has: {known}")
+            chosen[_owned(group_nodes(solid.V, solid.body, name), owned)] = True
+        for name in spec.parts:
+            if name not in names:
+                raise SceneError(f"{where}.parts: unknown part {name!r}; the parts: "
+                                 f"{', '.join(names)}")  # fmt: skip
+            chosen |= solid.elastic.held[:owned, names.index(name)] > 0
+        if spec.box is not None:
+            slack = _ROUND_OFF * solid.size
+            low, high = np.array(spec.box.low) - slack, np.array(spec.box.high) + slack
+            chosen |= np.all((state.X >= low) & (state.X <= high), axis=1)
+        selections.append(np.flatnonzero(chosen))
+    try:
+        bodies = build_rigid_bodies(specs, selections, state, comm, scene.gravity, solid.size)
+    except RigidBodyError as err:
+        raise SceneError(f"{scene.source}: {err}") from None
+    if scene.run.dt_min_action == "mass_scaling":
+        raise SceneError(f"{scene.source}: run.dt_min_action: 'mass_scaling' with "
+                         "[[rigid_body]] is not supported (a rigid body's mass is fixed); use "
+                         "'stop' or 'erode'")  # fmt: skip
+    for body in bodies:
+        for b in boundaries:
+            shared = comm.allreduce(len(np.intersect1d(b.nodes, body.nodes)))
+            if shared:
+                raise SceneError(f"{scene.source}: {b.name}: prescribes {shared} nodes of "
+                                 f"{body.name}: a boundary condition on a rigid body's nodes "
+                                 "is not supported")  # fmt: skip
+        for w in walls:
+            shared = comm.allreduce(len(np.intersect1d(w.nodes, body.nodes)))
+            if shared and (w.slide != "free" or w.motion.dynamic):
+                how = "carried by a main node" if w.motion.dynamic else f"slide {w.slide!r}"
+                raise SceneError(
+                    f"{scene.source}: {w.name}: {shared} of its secondary nodes are nodes of "
+                    f"{body.name}, and the wall is {how}: a rigid body meets fixed or "
+                    "prescribed walls of free sliding (exclude its nodes with "
+                    "secondary.exclude, or make the wall so)"
+                )
+    return bodies
 
 
 def _add_recorders(

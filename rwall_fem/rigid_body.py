@@ -1,0 +1,437 @@
+"""Rigid bodies: node sets that move as one rigid body (Radioss ``/RBODY``).
+
+``docs/theory.md`` ("Rigid bodies") derives what is done here. A rigid body is a set of
+nodes of the mesh (its *secondary* nodes, each owned by one rank) and a reference point,
+its centre of mass c, with a mass M and an inertia tensor J0 about c (kg, kg m^2; from the
+nodes' lumped masses and any mass and inertia added at the main node). Its state is c and
+the rotation R at t^n, the velocity V^{n-1/2} and the angular momentum L^{n-1/2} (spatial
+frame); its nodes' positions are always ``c + R (X - c0)``.
+
+One step, in the pipeline of constraints (:class:`RigidBody`, then the walls, then
+:class:`RigidContact`, then the boundary conditions):
+
+1. :meth:`RigidBody.constrain` gathers the force and the moment about c of the nodal
+   forces ``m a`` (internal forces and gravity; over the ranks: one ``Allreduce`` of six
+   numbers) and predicts ``V^{n+1/2} = V^{n-1/2} + dt^n F / M``, ``L^{n+1/2} = L^{n-1/2} +
+   dt^n T``, ``omega^{n+1/2} = R J0^-1 R^T L^{n+1/2}``, ``c^{n+1} = c^n + dt^{n+1/2}
+   V^{n+1/2}``, ``R^{n+1} = exp(dt^{n+1/2} omega^{n+1/2}) R^n`` (Rodrigues), and sets the
+   nodes' accelerations so that the update moves them exactly to ``c^{n+1} + R^{n+1} (X -
+   c0)``;
+2. the walls treat the secondary nodes they find in contact, each with its own mass;
+3. :meth:`RigidContact.constrain` takes what the walls did to the body's nodes over the
+   body as a whole: the change (dV, domega) of the least kinetic energy for which every
+   node a wall treated leaves with at least the normal velocity that wall asked for (a
+   least-distance problem, solved by non-negative least squares: the contact impulses
+   are its multipliers), so the body stops at the wall within the step, as a node does,
+   and exactly what it receives is booked by the walls (impulses, works); then the
+   motion of step 1 is redone with the corrected V and L.
+
+Energy: the body's kinetic energy is its own column ``rigid_body`` of ``energy.csv``, the
+shadow ``1/2 M V^{n-1/2} . V^{n+1/2} + 1/4 (L^{n-1/2} . omega^{n+1/2} + L^{n+1/2} .
+omega^{n-1/2})``; its nodes are taken out of ``kinetic``, and out of the momentum, which
+gets ``M V`` instead. Gravity acts on M (the body applies it: the nodes' share of it is
+taken out of their forces first).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from mpi4py import MPI
+
+__all__ = ["RigidBody", "RigidContact", "least_distance", "rotation"]
+
+
+def rotation(theta: np.ndarray) -> np.ndarray:
+    """The rotation matrix exp([theta]x) of the rotation vector ``theta`` (rad), by
+    Rodrigues's formula (its series near zero)."""
+    angle2 = float(theta @ theta)
+    K = np.array([[0.0, -theta[2], theta[1]], [theta[2], 0.0, -theta[0]],
+                  [-theta[1], theta[0], 0.0]])  # fmt: skip
+    if angle2 < 1e-12:
+        a, b = 1.0 - angle2 / 6.0, 0.5 - angle2 / 24.0
+    else:
+        angle = math.sqrt(angle2)
+        a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle2
+    return np.eye(3) + a * K + b * (K @ K)
+
+
+def _nnls(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x >= 0 minimising |A x - b| (Lawson and Hanson's active-set method); A has few rows
+    (7), so at most that many entries of x are positive and the loops are short."""
+    m, n = A.shape
+    x = np.zeros(n)
+    passive = np.zeros(n, dtype=bool)
+    scale = max(float(np.abs(A).max(initial=0.0)), 1e-300)
+    tol = 1e-12 * scale * max(m, n)
+    w = A.T @ (b - A @ x)
+    for _ in range(3 * m + 30):
+        free = np.where(passive, -np.inf, w)
+        j = int(np.argmax(free))
+        if not free[j] > tol:
+            break
+        passive[j] = True
+        for _ in range(3 * m + 30):
+            z = np.zeros(n)
+            z[passive] = np.linalg.lstsq(A[:, passive], b, rcond=None)[0]
+            if (z[passive] > 0.0).all():
+                break
+            q = passive & (z <= 0.0)
+            alpha = float(np.min(x[q] / (x[q] - z[q])))
+            x = x + alpha * (z - x)
+            passive &= x > tol
+            x[~passive] = 0.0
+        x = z
+        w = A.T @ (b - A @ x)
+    return x
+
+
+def least_distance(E: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The y of least |y| with E y >= f, and the multipliers mu >= 0 with y = E^T mu
+    (Lawson and Hanson's reduction of the least-distance problem to non-negative least
+    squares). E: (k, n), f: (k,)."""
+    k, n = E.shape
+    G = np.vstack([E.T, f[None, :]])
+    h = np.zeros(n + 1)
+    h[-1] = 1.0
+    u = _nnls(G, h)
+    r = G @ u - h
+    if not r[-1] < 0.0:  # incompatible constraints (never for a wall's: y = big dV works)
+        return np.zeros(n), np.zeros(k)
+    mu = u / -r[-1]
+    return E.T @ mu, mu
+
+
+def _skew(w: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+class RigidBody:
+    """The rigid body ``name`` of the owned secondary ``nodes`` (local indices) of
+    ``state``, with its mass (kg), inertia tensor about its centre of mass (kg m^2, 3 x 3),
+    centre ``center`` (m), initial velocity ``velocity`` (m/s) and angular velocity
+    ``angular_velocity`` (rad/s), under ``gravity`` (m/s^2 or None). The same on every
+    rank but for ``nodes``. Build it with :func:`rwall_fem.rigid_bodies.rigid_body`."""
+
+    def __init__(self, name: str, nodes: np.ndarray, state, comm, *, mass: float,
+                 inertia: np.ndarray, center: np.ndarray, velocity: np.ndarray,
+                 angular_velocity: np.ndarray, gravity=None):  # fmt: skip
+        self.name, self.comm = name, comm
+        self.nodes = np.asarray(nodes, dtype=np.int64)
+        self.mass = float(mass)
+        self.inertia0 = np.array(inertia, dtype=float)  # J0 about c, in the frame of t = 0
+        self.inverse0 = np.linalg.inv(self.inertia0)
+        self.center0 = np.array(center, dtype=float)
+        self.offsets = state.X[self.nodes] - self.center0  # X - c0, m
+        self.gravity = None if gravity is None else np.asarray(gravity, dtype=float)
+        # The state at t^n (c, R) and over the latest step (V, L, omega: n - 1/2).
+        self.center = self.center0.copy()
+        self.R = np.eye(3)
+        self.velocity = np.array(velocity, dtype=float)
+        self.omega = np.array(angular_velocity, dtype=float)
+        self.angular_momentum = self.inertia0 @ self.omega
+        # Those of the step before (n - 1/2 after the update of step n), for the shadow
+        # kinetic energy, and the nodes' velocities v^{n-1/2} (their kinetic energy).
+        self.previous = (self.velocity.copy(), self.angular_momentum.copy(), self.omega.copy())
+        self.nodes_before = np.zeros((len(self.nodes), 3))
+        # The gravity's work of M V less that of the nodes' m v (kg m; finished steps, and
+        # the latest step's first half).
+        self._gravity_integral = np.zeros(3)
+        self._half = 0.0  # dt^{n-1}/2 of the latest step, s
+        self._predicted = None  # c^{n+1}, R^{n+1} of the latest prediction
+        self.node_velocity = np.zeros((len(self.nodes), 3))  # v^{n+1/2} it gave them, m/s
+        self.force = np.zeros(6)  # F (N) and T (N m) of the latest step
+
+    # --- the step -----------------------------------------------------------------------
+
+    def spatial_inertia(self) -> np.ndarray:
+        """R J0 R^T (kg m^2): the inertia about c at t^n in the global frame."""
+        return self.R @ self.inertia0 @ self.R.T
+
+    def angular_velocity(self, L: np.ndarray) -> np.ndarray:
+        """omega = R J0^-1 R^T L (rad/s) at the rotation of t^n."""
+        return self.R @ (self.inverse0 @ (self.R.T @ L))
+
+    def arms(self) -> np.ndarray:
+        """x - c of the owned nodes at t^n (m): R (X - c0)."""
+        return self.offsets @ self.R.T
+
+    def constrain(self, state) -> None:
+        """Gather the nodal forces, predict the motion over the step, move the nodes with it."""
+        nodes, dt_v = self.nodes, state.dt_velocity
+        v = state.v[nodes]
+        self._book_gravity(state, v)
+        self.previous = (self.velocity, self.angular_momentum, self.omega)
+        self.nodes_before = v
+        m = state.mass[nodes, None]
+        forces = m * state.a[nodes]
+        if self.gravity is not None:
+            forces -= m * self.gravity  # the body applies gravity to all its mass below
+        local = np.concatenate([forces.sum(axis=0), np.cross(self.arms(), forces).sum(axis=0)])
+        total = np.empty(6)
+        self.comm.Allreduce(local, total, op=MPI.SUM)
+        if self.gravity is not None:
+            total[:3] += self.mass * self.gravity
+        self.force = total
+        self.velocity = self.previous[0] + dt_v * total[:3] / self.mass
+        self.angular_momentum = self.previous[1] + dt_v * total[3:]
+        self.omega = self.angular_velocity(self.angular_momentum)
+        self._move(state)
+
+    def correct(self, state, dv: np.ndarray, dL: np.ndarray) -> None:
+        """Add the contact impulses' changes of V (m/s) and L (kg m^2/s) and move again."""
+        self.velocity = self.velocity + dv
+        self.angular_momentum = self.angular_momentum + dL
+        self.omega = self.angular_velocity(self.angular_momentum)
+        self._move(state)
+
+    def _move(self, state) -> None:
+        """Set the nodes' accelerations so that the update takes them to c^{n+1} + R^{n+1}
+        (X - c0), from V^{n+1/2} and omega^{n+1/2}."""
+        dt, dt_v, nodes = state.dt, state.dt_velocity, self.nodes
+        center = self.center + dt * self.velocity
+        R = rotation(dt * self.omega) @ self.R
+        self._predicted = (center, R)
+        target = center + self.offsets @ R.T
+        velocity = (target - state.X[nodes] - state.u[nodes]) / dt
+        self.node_velocity = velocity  # before the walls, m/s
+        state.a[nodes] = (velocity - self.nodes_before) / dt_v
+
+    def commit(self) -> None:
+        """Take the motion of the step: c^{n+1} and R^{n+1} (after the walls)."""
+        self.center, self.R = self._predicted
+
+    # --- books --------------------------------------------------------------------------
+
+    @property
+    def kinetic(self) -> float:
+        """The shadow kinetic energy of the latest update (J; the same on every rank)."""
+        V0, L0, w0 = self.previous
+        translation = 0.5 * self.mass * float(V0 @ self.velocity)
+        turning = 0.25 * float(L0 @ self.omega + self.angular_momentum @ w0)
+        return translation + turning
+
+    def initial_kinetic(self) -> float:
+        """1/2 M V.V + 1/2 omega.L (J) at the start."""
+        return 0.5 * self.mass * float(self.velocity @ self.velocity) + 0.5 * float(
+            self.omega @ self.angular_momentum
+        )
+
+    def nodal_kinetic(self, state) -> float:
+        """What the update booked as the kinetic energy of this rank's secondary nodes (J):
+        1/2 sum m v^{n-1/2} . v^{n+1/2}, taken out of ``kinetic``."""
+        m = state.mass[self.nodes]
+        return 0.5 * float(np.einsum("i,ij,ij->", m, self.nodes_before, state.v[self.nodes]))
+
+    def nodal_momentum(self, state) -> np.ndarray:
+        """sum m v (kg m/s) of this rank's secondary nodes, taken out of the momentum."""
+        return state.mass[self.nodes] @ state.v[self.nodes]
+
+    @property
+    def momentum(self) -> np.ndarray:
+        """M V^{n+1/2} (kg m/s; the same on every rank)."""
+        return self.mass * self.velocity
+
+    def _book_gravity(self, state, v: np.ndarray) -> None:
+        """Before the step's update: book the latest step's second half and this step's
+        first half of M V^{n-1/2} - sum m v^{n-1/2} (the nodes' share is in the gravity's
+        own books; M V split evenly over the ranks, which the caller sums)."""
+        if self.gravity is None:
+            return
+        half = 0.5 * state.dt_velocity
+        difference = self.mass * self.velocity / self.comm.size - state.mass[self.nodes] @ v
+        self._gravity_integral += (self._half + half) * difference
+        self._half = half
+
+    def gravity_work(self, state) -> float:
+        """The work of gravity on the added mass's momentum beyond the nodes' (J), summed
+        over the ranks by the caller (each rank holds its nodes' share)."""
+        if self.gravity is None:
+            return 0.0
+        return float(self.gravity @ self._gravity_integral)
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The motion, the latest step's velocities and the books."""
+        V0, L0, w0 = self.previous
+        return {
+            "motion": np.concatenate([self.center, self.R.ravel(), self.velocity,
+                                      self.angular_momentum, self.omega, V0, L0, w0]),
+            "nodes_before": self.nodes_before,
+            "gravity": np.concatenate([self._gravity_integral, [self._half]]),
+        }  # fmt: skip
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        motion = arrays["motion"]
+        self.center, self.R = motion[0:3].copy(), motion[3:12].reshape(3, 3).copy()
+        self.velocity, self.angular_momentum, self.omega = (
+            motion[12:15].copy(), motion[15:18].copy(), motion[18:21].copy()
+        )  # fmt: skip
+        self.previous = (motion[21:24].copy(), motion[24:27].copy(), motion[27:30].copy())
+        self.nodes_before = arrays["nodes_before"].copy()
+        self._gravity_integral = arrays["gravity"][:3].copy()
+        self._half = float(arrays["gravity"][3])
+
+
+class RigidContact:
+    """After the walls: what they did to the nodes of the rigid ``bodies`` is taken by each
+    body as a whole (see the module's docstring), and the bodies' motion is committed.
+    ``walls`` are the walls that may treat their nodes (fixed or prescribed, free sliding:
+    the scene refuses others). ``owned`` is the number of owned nodes."""
+
+    name = "rigid_contact"
+
+    def __init__(self, bodies: list[RigidBody], walls: list, owned: int, comm):
+        self.bodies, self.walls, self.comm = bodies, walls, comm
+        self.body_of = np.full(owned, -1, dtype=np.int64)
+        # Each secondary node's row in the bodies' node lists, one after the other.
+        self._row_of = np.full(owned, -1, dtype=np.int64)
+        start = 0
+        for b, body in enumerate(bodies):
+            self.body_of[body.nodes] = b
+            self._row_of[body.nodes] = start + np.arange(len(body.nodes))
+            start += len(body.nodes)
+
+    def constrain(self, state) -> None:
+        rows = self._contacts(state)
+        if rows is not None:
+            self._take(state, rows)
+        for body in self.bodies:
+            body.commit()
+
+    def _contacts(self, state):
+        """This rank's rows (wall, position in its contacts, body, node) of the nodes of the
+        bodies that a wall treated at this step; None when no rank has any."""
+        found = []
+        for w, wall in enumerate(self.walls):
+            if not wall.contacts:
+                continue
+            touching = wall.touching
+            which = self.body_of[touching]
+            at = np.flatnonzero(which >= 0)
+            if len(at):
+                found.append(np.column_stack([np.full(len(at), w), at, which[at], touching[at]]))
+        rows = np.concatenate(found) if found else np.zeros((0, 4), dtype=np.int64)
+        if not self.comm.allreduce(len(rows)):
+            return None
+        return rows
+
+    def _take(self, state, rows: np.ndarray) -> None:
+        """Solve each touched body's contact over all ranks' rows; give the walls the
+        impulses the body received."""
+        mine = np.zeros((len(rows), 8))  # body, n, (x - c) x n, the normal velocity asked
+        for w, wall in enumerate(self.walls):
+            mask = rows[:, 0] == w
+            if not mask.any():
+                continue
+            normals, wanted = wall.contact_rows(rows[mask, 1])
+            nodes = rows[mask, 3]
+            which = rows[mask, 2]
+            centers = np.array([b.center for b in self.bodies])[which]
+            predicted = np.concatenate([b.node_velocity for b in self.bodies])[
+                self._row_of[nodes]
+            ]
+            arms = state.X[nodes] + state.u[nodes] - centers
+            mine[mask, 0] = which
+            mine[mask, 1:4] = normals
+            mine[mask, 4:7] = np.cross(arms, normals)
+            mine[mask, 7] = wanted - np.einsum("ij,ij->i", normals, predicted)
+        gathered = self.comm.allgather(mine)
+        offset = sum(len(g) for g in gathered[: self.comm.rank])
+        table = np.concatenate(gathered)
+        impulses = np.zeros(len(table))
+        for b, body in enumerate(self.bodies):
+            chosen = table[:, 0] == b
+            if not chosen.any():
+                continue
+            G, demand = table[chosen, 1:7], table[chosen, 7]
+            root = np.linalg.cholesky(body.spatial_inertia())
+            scale = np.zeros((6, 6))  # L^-T of the mass matrix diag(M I, J) = L L^T
+            scale[:3, :3] = np.eye(3) / math.sqrt(body.mass)
+            scale[3:, 3:] = np.linalg.inv(root).T
+            _, mu = least_distance(G @ scale, demand)
+            impulses[chosen] = mu
+            change = G.T @ mu  # the sum of the impulses, and their moment about c
+            body.correct(state, change[:3] / body.mass, change[3:])
+        mu = impulses[offset : offset + len(rows)]
+        normals = mine[:, 1:4]
+        for w, wall in enumerate(self.walls):
+            mask = rows[:, 0] == w
+            if mask.any():
+                wall.reassign(rows[mask, 1], mu[mask, None] * normals[mask])
+
+
+def _tensor(six) -> np.ndarray:
+    """The symmetric 3 x 3 tensor of [Jxx, Jyy, Jzz, Jxy, Jyz, Jxz] (kg m^2; the off-diagonal
+    components are the tensor's, -integral of x y dm, as Radioss reads them)."""
+    xx, yy, zz, xy, yz, xz = six
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+
+
+def _point_inertia(mass, arms: np.ndarray) -> np.ndarray:
+    """sum m (|r|^2 I - r r^T) (kg m^2) of point masses ``mass`` at ``arms`` (k, 3)."""
+    mass = np.broadcast_to(mass, len(arms))
+    second = np.einsum("i,ij,ik->jk", mass, arms, arms)
+    return np.trace(second) * np.eye(3) - second
+
+
+class RigidBodyError(ValueError):
+    """A rigid body that cannot be built: one line naming its key."""
+
+
+def build_rigid_bodies(specs, selections: list[np.ndarray], state, comm, gravity=None,
+                       size: float = 1.0) -> list[RigidBody]:  # fmt: skip
+    """The rigid bodies of the scene's ``specs`` (:class:`~rwall_fem.scene.RigidBodySpec`),
+    of the owned nodes ``selections`` (one array of local indices each, chosen by the
+    caller from the sets, parts and box), their nodes' initial velocities set to the rigid
+    motion. ``size`` (m) is the body's size, for the tolerance of a singular inertia.
+    RigidBodyError (collective) for an empty body, a node in two bodies, no mass, or an
+    inertia tensor that is not positive definite."""
+    taken = np.zeros(len(state.mass), dtype=np.int64) - 1
+    bodies = []
+    for i, (spec, nodes) in enumerate(zip(specs, selections, strict=True)):
+        where = f"rigid_body[{i}]"
+        count = comm.allreduce(len(nodes))
+        if not count:
+            raise RigidBodyError(f"{where}: no node of the mesh is in its sets, parts or box: "
+                                 "a rigid body needs nodes")  # fmt: skip
+        shared = taken[nodes]
+        others = comm.allreduce(np.unique(shared[shared >= 0]).tolist())
+        if others:
+            overlap = comm.allreduce(int((shared >= 0).sum()))
+            raise RigidBodyError(f"{where}: {overlap} of its nodes are also in rigid_body"
+                                 f"[{min(others)}]: a node belongs to one rigid body")  # fmt: skip
+        taken[nodes] = i
+        m, X, v = state.mass[nodes], state.X[nodes], state.v[nodes]
+        sums = comm.allreduce(np.concatenate([[m.sum()], m @ X, m @ v]))
+        node_mass, first, momentum = sums[0], sums[1:4], sums[4:7]
+        nodes_center = first / node_mass
+        added = _tensor(spec.inertia)
+        if spec.node_masses:
+            point = nodes_center if spec.main_node is None else np.array(spec.main_node)
+            mass = node_mass + spec.mass
+            if spec.center == "nodes":
+                center, point = nodes_center, nodes_center
+            else:
+                center = (first + spec.mass * point) / mass
+            inertia = comm.allreduce(_point_inertia(m, X - center))
+            inertia = inertia + added + _point_inertia(spec.mass, (point - center)[None, :])
+        else:
+            mass, center, inertia = spec.mass, np.array(spec.main_node), added
+        if not mass > 0.0:
+            raise RigidBodyError(f"{where}.mass: the body has no mass (node_masses = false and "
+                                 "mass = 0 kg); give it a mass > 0")  # fmt: skip
+        eigen = np.linalg.eigvalsh(inertia)
+        if not eigen[0] > 1e-9 * max(eigen[-1], mass * size**2):
+            raise RigidBodyError(
+                f"{where}.inertia: the inertia tensor about its centre of mass is not positive "
+                f"definite (principal moments {', '.join(f'{e:.4g}' for e in eigen)} kg m^2: "
+                "its nodes on a line, or node_masses = false without inertia); add inertia"
+            )
+        velocity = momentum / node_mass
+        omega = np.array(spec.angular_velocity, dtype=float)
+        state.v[nodes] = velocity + np.cross(omega, X - center)
+        bodies.append(RigidBody(where, nodes, state, comm, mass=mass, inertia=inertia,
+                                center=center, velocity=velocity, angular_velocity=omega,
+                                gravity=gravity))  # fmt: skip
+    return bodies
