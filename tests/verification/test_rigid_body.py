@@ -7,7 +7,7 @@
   round-off), and then the wall carries the weight;
 - a body spinning freely about a principal axis turns at constant omega (the nodes on
   the exact rotation exp(omega t)); about no principal axis its angular momentum stays
-  constant to round-off and its kinetic energy within 5e-7;
+  constant to round-off and its kinetic energy within 2e-6;
 - a deformable bar with a rigid end of mass M strikes a wall: until the wave reflected at
   the end returns, the end's velocity is the closed form of a mass on a bar, v0 - 2 v0
   exp(-(t - L/c)/tau) with tau = M / (rho c A), and the wall's force is rho c A v0.
@@ -25,9 +25,10 @@ from rwall_fem import build_simulation, parse_scene
 from rwall_fem.rigid_body import rotation
 from rwall_fem.study.cases import SOFT
 
-# The free spin's kinetic energy, relative: 1.3e-7 measured over 3000 steps at |omega| dt
-# = 2.2e-3 (the scheme's error; the angular momentum is exact).
-KINETIC_DRIFT = 5e-7
+# The free spin's kinetic energy, relative: 5.1e-7 measured over 1500 steps at |omega| dt
+# = 4.3e-3 (1.3e-7 over 3000 steps at half the step: the scheme's error, second order; the
+# angular momentum is exact).
+KINETIC_DRIFT = 2e-6
 STEEL = {"model": "linear_elastic", "density": 7850.0, "young": 210e9, "poisson": 0.0}
 
 
@@ -125,14 +126,14 @@ def _spinning(omega, end_time, shared_dir):
 
 
 def test_spin_about_a_principal_axis_is_the_exact_rotation(shared_dir):
-    omega = np.array([0.0, 0.0, 60.0])  # rad/s: about 1.1 turns in the run
-    sim = _spinning(omega, 0.12, shared_dir)
+    omega = np.array([0.0, 0.0, 120.0])  # rad/s: about 1.1 turns in the run
+    sim = _spinning(omega, 0.06, shared_dir)
     s, body = sim.state, sim.rigid_bodies[0]
     T = s.t + s.dt  # the positions are u^{n+1}
     R = rotation(omega * T)
     x = body.center0 + (s.X - body.center0) @ R.T
     assert np.abs(s.X + s.u - x).max() < 1e-12 * 0.01
-    assert np.allclose(body.omega, omega, rtol=0, atol=1e-12 * 60)
+    assert np.allclose(body.omega, omega, rtol=0, atol=1e-12 * 120)
     energy = sim.history.energy
     names = sim.history.balance.columns
     K = energy[:, names.index("rigid_body")]
@@ -141,19 +142,19 @@ def test_spin_about_a_principal_axis_is_the_exact_rotation(shared_dir):
 
 
 def test_spin_about_no_principal_axis_keeps_its_angular_momentum(shared_dir):
-    omega = np.array([20.0, 30.0, 40.0])  # rad/s, |omega| dt about 2e-3
-    sim = _spinning(omega, 0.12, shared_dir)
+    omega = np.array([40.0, 60.0, 80.0])  # rad/s, |omega| dt about 4e-3
+    sim = _spinning(omega, 0.06, shared_dir)
     body = sim.rigid_bodies[0]
     L0 = body.inertia0 @ omega
     assert np.abs(body.angular_momentum - L0).max() < 1e-11 * np.linalg.norm(L0)
     # The nodes turn with the body: their own angular momentum about c is the body's to
-    # the order of the chord velocities (|omega| dt ~ 2e-3).
+    # the order of the chord velocities (|omega| dt ~ 4e-3).
     s = sim.state
     m = s.mass[:, None]
     x = s.X + s.u - s.dt * s.v / 2  # at mid-step
     local = np.sum(np.cross(x - body.center + s.dt * body.velocity / 2, m * s.v), axis=0)
     nodes = sim.comm.allreduce(local)
-    assert np.linalg.norm(nodes - L0) < 3e-3 * np.linalg.norm(L0)
+    assert np.linalg.norm(nodes - L0) < 5e-3 * np.linalg.norm(L0)
     names = sim.history.balance.columns
     K = sim.history.energy[:, names.index("rigid_body")]
     K0 = 0.5 * omega @ L0
