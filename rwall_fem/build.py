@@ -389,8 +389,7 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
 def _rigid_bodies(scene: Scene, solid: _Solid, state: State, walls, boundaries) -> list:
     """The scene's [[rigid_body]]s on their owned nodes (named sets, every node of the named
     parts, the nodes inside a box at the start), and what they may not meet: a boundary
-    condition on their nodes, a wall that is tied, with friction or carried by a main node
-    (``docs/theory.md``, "Rigid bodies"), mass scaling."""
+    condition on their nodes, mass scaling."""
     specs, comm, owned = scene.rigid_bodies, solid.comm, solid.owned
     if not specs:
         return []
@@ -429,16 +428,6 @@ def _rigid_bodies(scene: Scene, solid: _Solid, state: State, walls, boundaries) 
                 raise SceneError(f"{scene.source}: {b.name}: prescribes {shared} nodes of "
                                  f"{body.name}: a boundary condition on a rigid body's nodes "
                                  "is not supported")  # fmt: skip
-        for w in walls:
-            shared = comm.allreduce(len(np.intersect1d(w.nodes, body.nodes)))
-            if shared and (w.slide != "free" or w.motion.dynamic):
-                how = "carried by a main node" if w.motion.dynamic else f"slide {w.slide!r}"
-                raise SceneError(
-                    f"{scene.source}: {w.name}: {shared} of its secondary nodes are nodes of "
-                    f"{body.name}, and the wall is {how}: a rigid body meets fixed or "
-                    "prescribed walls of free sliding (exclude its nodes with "
-                    "secondary.exclude, or make the wall so)"
-                )
     return bodies
 
 

@@ -19,12 +19,16 @@ One step, in the pipeline of constraints (:class:`RigidBody`, then the walls, th
    c0)``;
 2. the walls treat the secondary nodes they find in contact, each with its own mass;
 3. :meth:`RigidContact.constrain` takes what the walls did to the body's nodes over the
-   body as a whole: the change (dV, domega) of the least kinetic energy for which every
-   node a wall treated leaves with at least the normal velocity that wall asked for (a
-   least-distance problem, solved by non-negative least squares: the contact impulses
-   are its multipliers), so the body stops at the wall within the step, as a node does,
-   and exactly what it receives is booked by the walls (impulses, works); then the
-   motion of step 1 is redone with the corrected V and L.
+   body as a whole. From fixed and prescribed walls of free sliding: the change (dV,
+   domega) of the least kinetic energy for which every node such a wall treated leaves
+   with at least the normal velocity the wall asked for (a least-distance problem,
+   solved by non-negative least squares: the contact impulses are its multipliers), so
+   the body stops at the wall within the step, as a node does, and exactly what it
+   receives is booked by the walls (impulses, works). From walls that are tied, with
+   friction or carried by a main node: the impulses they gave the nodes, each with its
+   own mass, as they are (what Radioss does with a wall's secondary nodes that belong to
+   a rigid body: momentum is exact, but the body is stopped over several steps). Then
+   the motion of step 1 is redone with the corrected V and L.
 
 Energy: the body's kinetic energy is its own column ``rigid_body`` of ``energy.csv``, the
 shadow ``1/2 M V^{n-1/2} . V^{n+1/2} + 1/4 (L^{n-1/2} . omega^{n+1/2} + L^{n+1/2} .
@@ -331,26 +335,33 @@ class RigidContact:
         return rows
 
     def _take(self, state, rows: np.ndarray) -> None:
-        """Solve each touched body's contact over all ranks' rows; give the walls the
-        impulses the body received."""
+        """Give each touched body what the walls did to its nodes (collective: every rank
+        calls it when some rank has rows): the impulses of walls that are tied, with
+        friction or carried by a main node as they are; then over all ranks' rows of the
+        fixed and prescribed walls of free sliding, the least-distance change, whose
+        impulses those walls then book."""
+        exact = np.array([w.slide == "free" and not w.motion.dynamic for w in self.walls])
+        as_given = ~exact[rows[:, 0]]
+        self._redistribute(state, rows[as_given])
+        rows = rows[~as_given]
         mine = np.zeros((len(rows), 8))  # body, n, (x - c) x n, the normal velocity asked
+        predicted = np.concatenate([b.node_velocity for b in self.bodies])
         for w, wall in enumerate(self.walls):
             mask = rows[:, 0] == w
             if not mask.any():
                 continue
             normals, wanted = wall.contact_rows(rows[mask, 1])
-            nodes = rows[mask, 3]
-            which = rows[mask, 2]
+            nodes, which = rows[mask, 3], rows[mask, 2]
             centers = np.array([b.center for b in self.bodies])[which]
-            predicted = np.concatenate([b.node_velocity for b in self.bodies])[
-                self._row_of[nodes]
-            ]
             arms = state.X[nodes] + state.u[nodes] - centers
             mine[mask, 0] = which
             mine[mask, 1:4] = normals
             mine[mask, 4:7] = np.cross(arms, normals)
-            mine[mask, 7] = wanted - np.einsum("ij,ij->i", normals, predicted)
+            velocity = predicted[self._row_of[nodes]]
+            mine[mask, 7] = wanted - np.einsum("ij,ij->i", normals, velocity)
         gathered = self.comm.allgather(mine)
+        if not sum(len(g) for g in gathered):
+            return
         offset = sum(len(g) for g in gathered[: self.comm.rank])
         table = np.concatenate(gathered)
         impulses = np.zeros(len(table))
@@ -374,6 +385,24 @@ class RigidContact:
             if mask.any():
                 wall.reassign(rows[mask, 1], mu[mask, None] * normals[mask])
 
+    def _redistribute(self, state, rows: np.ndarray) -> None:
+        """The bodies take the impulses (N s) that walls of other kinds gave their nodes
+        ``rows``, and their moments, as they are (collective)."""
+        local = np.zeros((len(self.bodies), 6))
+        for w, wall in enumerate(self.walls):
+            mask = rows[:, 0] == w
+            if not mask.any():
+                continue
+            impulses = wall.contact_impulses(rows[mask, 1])
+            nodes, which = rows[mask, 3], rows[mask, 2]
+            centers = np.array([b.center for b in self.bodies])[which]
+            arms = state.X[nodes] + state.u[nodes] - centers
+            np.add.at(local, which, np.hstack([impulses, np.cross(arms, impulses)]))
+        total = np.empty_like(local)
+        self.comm.Allreduce(local, total, op=MPI.SUM)
+        for b, body in enumerate(self.bodies):
+            if total[b].any():
+                body.correct(state, total[b, :3] / body.mass, total[b, 3:])
 
 def _tensor(six) -> np.ndarray:
     """The symmetric 3 x 3 tensor of [Jxx, Jyy, Jzz, Jxy, Jyz, Jxz] (kg m^2; the off-diagonal

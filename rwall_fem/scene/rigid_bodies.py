@@ -65,7 +65,16 @@ class RigidBodySpec:
     )
 
 
-@rule(RigidBodySpec)
+@rule(
+    RigidBodySpec,
+    json=[
+        {"anyOf": [{"required": ["sets"]}, {"required": ["parts"]}, {"required": ["box"]}]},
+        {
+            "if": {"properties": {"node_masses": {"const": False}}, "required": ["node_masses"]},
+            "then": {"required": ["main_node"]},
+        },
+    ],
+)
 def _some_nodes(v, raw, fail):
     """At least one of sets, parts and box; node_masses = false needs main_node."""
     if not v["sets"] and not v["parts"] and v["box"] is None:

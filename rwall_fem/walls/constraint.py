@@ -323,6 +323,15 @@ class RigidWall:
         normals = passes.normals[positions]
         return normals, passes.target[positions] + normals @ self.motion.velocity
 
+    def contact_impulses(self, positions: np.ndarray) -> np.ndarray:
+        """The impulses (N s, normal and tangential) the wall gave its contacts
+        ``positions`` (rows of :attr:`touching`) in the latest step."""
+        passes = self._passes
+        impulses = passes.normal[positions]
+        if self.slide != "free":
+            impulses = impulses + passes.tangential[positions]
+        return impulses
+
     def reassign(self, positions: np.ndarray, impulses: np.ndarray) -> None:
         """The contacts ``positions`` of the latest step received ``impulses`` (N s, (k, 3))
         rather than those the wall gave them (their rigid body took the wall's push as a

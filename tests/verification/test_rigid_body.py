@@ -203,3 +203,32 @@ def test_bar_with_a_rigid_end_mass(shared_dir):
     change = np.array(s["final_momentum"]) - np.array(s["initial_momentum"])
     push = -np.array(s["walls"][0]["normal_impulse"])
     assert np.allclose(change, push, rtol=0, atol=1e-10 * M * v0)
+
+
+def test_friction_wall_gives_its_impulses_to_the_body(shared_dir):
+    """A rigid block lands obliquely on a Coulomb plane: the wall treats the nodes with
+    their own masses and the body takes those impulses as they are (Radioss's way with a
+    wall's secondary nodes of a rigid body): the momentum books close to round-off, the
+    body is stopped over a few steps, not within one, and slides and tips on."""
+    raw = {
+        "run": {"end_time": 0.01, "dt": 4e-5},
+        "mesh": {"shape": "bar", "origin": [0.0, 0.0, 1e-4], "size": [0.01, 0.01, 0.01],
+                 "element_size": 0.0025, "cell": "hexahedron"},
+        "material": SOFT,
+        "initial": {"velocity": [1.0, 0.0, -0.2]},
+        "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1],
+                  "slide": "friction", "friction": 0.3}],
+        "rigid_body": [{"box": {"low": [-1, -1, -1], "high": [1, 1, 1]}}],
+        "output": {"plot": False},
+    }  # fmt: skip
+    sim, probe = _run_probed(raw, shared_dir)
+    s, body = sim.history.summary, sim.rigid_bodies[0]
+    w = s["walls"][0]
+    push = -np.array(w["normal_impulse"]) - np.array(w["tangential_impulse"])
+    change = np.array(s["final_momentum"]) - np.array(s["initial_momentum"])
+    assert np.allclose(change, push, rtol=0, atol=1e-12 * body.mass)
+    assert math.isclose(push[2], body.mass * 0.2, rel_tol=1e-3)  # the normal velocity taken
+    assert 0.2 * push[2] < -push[0] < 0.4 * push[2]  # friction, about mu N
+    assert abs(body.velocity[2]) < 1e-3 and body.velocity[0] > 0.8  # stopped, sliding
+    assert probe.low.min() > -0.2 * 1e-3  # the creep: about M / m_bottom steps of travel
+    assert s["energy"]["max_balance_error"] < 1e-6
