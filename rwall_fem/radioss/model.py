@@ -193,6 +193,7 @@ class Deck:
     velocities: list[Prescribed] = field(default_factory=list)  # /IMPVEL
     gravity: list[Prescribed] = field(default_factory=list)  # /GRAV
     walls: list[Wall] = field(default_factory=list)
+    rigid_bodies: list = field(default_factory=list)  # /RBODY (cards/rigid_bodies.py)
     end_time: float | None = None  # s
     dt_scale: float | None = None
     dt_min: float | None = None  # s

@@ -34,6 +34,7 @@ from rwall_fem.radioss.cards import (
     materials,
     nodes,
     parts,
+    rigid_bodies,
     run,
     solids,
     walls,
@@ -44,7 +45,7 @@ __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supporte
 
 STARTER_FAMILIES = (
     begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
-    control,
+    control, rigid_bodies,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 
