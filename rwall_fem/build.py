@@ -608,7 +608,8 @@ def _secondary_nodes(
 
 
 def _constraint_facts(sim: Simulation) -> list[str]:
-    """A line per wall and boundary condition: what it is and how many nodes it holds."""
+    """A line per wall, boundary condition and rigid body: what it is and how many nodes
+    it holds."""
     comm = sim.comm
     lines = []
     for w in sim.walls:
@@ -618,6 +619,10 @@ def _constraint_facts(sim: Simulation) -> list[str]:
         count = comm.allreduce(len(b.nodes))
         axes = "".join("xyz"[i] for i in b.axes)
         lines.append(f"{b.name}: {count} nodes, components {axes}")
+    for r in sim.rigid_bodies:
+        count = comm.allreduce(len(r.nodes))
+        center = ", ".join(f"{c:.4g}" for c in r.center0)
+        lines.append(f"{r.name}: {count} nodes, {r.mass:.6g} kg, centre of mass ({center}) m")
     return lines
 
 
