@@ -98,7 +98,8 @@ def test_rigid_block_falls_on_a_wall(shared_dir):
     wall_push = -np.array(s["walls"][0]["normal_impulse"])  # on the body, N s
     change = np.array(s["final_momentum"]) - np.array(s["initial_momentum"])
     T = s["time"] + s["dt"]  # the momentum is that of v^{n+1/2}
-    assert np.allclose(change, wall_push + M * np.array([0, 0, -g]) * T, rtol=0, atol=1e-12 * M * v0)
+    weight = M * np.array([0.0, 0.0, -g]) * T
+    assert np.allclose(change, wall_push + weight, rtol=0, atol=1e-12 * M * v0)
     # Energy: the stop destroys 1/2 M v^2 (wall work), and so does each stop at rest; the
     # balance closes to round-off.
     energy = s["energy"]
@@ -191,13 +192,13 @@ def test_bar_with_a_rigid_end_mass(shared_dir):
     V = -probe.v[1:, 2]  # toward the wall
     exact = np.where(mid < L / c, v0, -v0 + 2 * v0 * np.exp(-(mid - L / c) / tau))
     window = (mid > 1.15 * L / c) & (mid < 2.9 * L / c)
-    assert np.abs(V[window] - exact[window]).max() < 0.04 * v0
+    assert np.abs(V[window] - exact[window]).max() < 0.02 * v0  # 0.0093 v0 measured
     assert np.abs(V[mid < 0.9 * L / c] - v0).max() < 1e-12 * v0  # the wave has not arrived
     # The wall's push up to 2 L / c, against rho c A v0 (2 L / c): impulse_z is cumulative.
     rows = sim.history.wall(0)
     before = rows[rows[:, COLUMN["time"]] <= 1.95 * L / c]
     push = -before[-1, COLUMN["impulse_z"]]
-    assert math.isclose(push, rho * c * A * v0 * before[-1, 0], rel_tol=0.03)
+    assert math.isclose(push, rho * c * A * v0 * before[-1, 0], rel_tol=0.015)  # 0.0064
     s = sim.history.summary
     assert s["energy"]["max_balance_error"] < 1e-10
     change = np.array(s["final_momentum"]) - np.array(s["initial_momentum"])

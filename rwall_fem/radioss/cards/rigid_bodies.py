@@ -113,7 +113,8 @@ def scene_tables(deck: Deck, atoms, by_parts: dict[int, list[str]], body_nodes: 
         clamped = held & ({r.main_node} | set(group.nodes.tolist()))
         if clamped:
             raise DeckError(f"{r.where}: {name}: a /BCS or /IMPVEL holds its node "
-                            f"{min(clamped)}: a rigid body with imposed motion is not supported")  # fmt: skip
+                            f"{min(clamped)}: a rigid body with imposed motion is not "
+                            "supported")  # fmt: skip
         point = deck.coordinates[row]
         table: dict = {}
         if r.group in by_parts:
