@@ -242,7 +242,7 @@ def test_a_resumed_run_equals_an_uninterrupted_one(shared_dir, monkeypatch):
     import rwall_fem.output.history
 
     raw = {
-        "run": {"end_time": 0.012, "dt": 4e-5},
+        "run": {"end_time": 0.006, "dt": 4e-5},
         "mesh": {"shape": "bar", "origin": [0.0, 0.0, 2e-4], "size": [0.005, 0.005, 0.01],
                  "element_size": 0.0025, "cell": "hexahedron"},
         "material": SOFT,
