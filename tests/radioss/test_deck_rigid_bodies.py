@@ -92,14 +92,22 @@ def test_rigid_body_refusals(shared_dir):
         (dict(icog=5), r"/RBODY/7: ICoG = 5: 1 \(default\), 2, 3 or 4"),
         (dict(node=4242), r"/RBODY/7: node_ID 4242 refers to no /NODE"),
         (dict(node=1), r"/RBODY/7: node_ID 1 is a node of the elements outside grnd_ID 2"),
+        (dict(icog=4, mass=0.0), r"/RBODY/7: ICoG = 4 makes Mass the body's whole mass, and "
+                                 "it is 0"),
+        (dict(icog=4), r"model_0000\.rad:\d+: /RBODY/7: ICoG = 4 makes J the body's whole "
+                       "inertia, and it is not positive definite"),
     ]):  # fmt: skip
         d = bar_with_rigid_top("SI")
         d.cards = d.cards[: -5]  # the /RBODY written by bar_with_rigid_top
-        rigid_body(d, 7, 2, mass=5e-3, **change)
+        rigid_body(d, 7, 2, **({"mass": 5e-3} | change))
         _refused(d, shared_dir / str(k), match)
     d = bar_with_rigid_top("SI")
     d.cards += ["/RBODY/LAGMUL/8", "lagrange", i10(MAIN) + i10(2)]
     _refused(d, shared_dir / "lagmul", r"/RBODY/LAGMUL/8: rigid bodies by Lagrange multipliers")
+    d = bar_with_rigid_top("SI")
+    rigid_body(d, 8, 2)
+    _refused(d, shared_dir / "twice", r"/RBODY/8: 9 of its nodes are also in /RBODY/7 \(.*"
+             r"model_0000\.rad:\d+\): a node belongs to one rigid body")  # fmt: skip
     d = bar_with_rigid_top("SI")
     d.clamp(1, "111000", 2)
     _refused(d, shared_dir / "clamped", r"/RBODY/7: a /BCS or /IMPVEL holds its node")

@@ -67,6 +67,12 @@ def _rigid_body(deck: Deck, card: Card) -> None:
         card.fail(f"Mass = {mass:g}: an added mass is >= 0", line)
     if icog not in (0, 1, 2, 3, 4):
         card.fail(f"ICoG = {icog}: 1 (default), 2, 3 or 4", line)
+    if icog == 4 and mass <= 0:
+        card.fail("ICoG = 4 makes Mass the body's whole mass, and it is 0: give Mass > 0", line)
+    J = np.array([[jxx, jxy, jxz], [jxy, jyy, jyz], [jxz, jyz, jzz]])
+    if icog == 4 and not np.linalg.eigvalsh(J)[0] > 0:
+        card.fail("ICoG = 4 makes J the body's whole inertia, and it is not positive definite: "
+                  "give Jxx..Jxz", card.lines[2])  # fmt: skip
     for name, value, what in (
         ("Ispher", ispher, "the inertia is the full tensor of the nodes and J"),
         ("Ikrem", ikrem, "the elements inside a rigid body keep computing"),
@@ -101,9 +107,19 @@ def scene_tables(deck: Deck, atoms, by_parts: dict[int, list[str]], body_nodes: 
         held |= set(deck.groups[gid].nodes.tolist())
     for p in deck.velocities:
         held |= set(deck.groups[p.group].nodes.tolist())
+    owner: dict[int, RigidBodyCard] = {}
     for r in deck.rigid_bodies:
         name = f"/RBODY/{r.id}"
         group = deck.groups[r.group]
+        mine = np.intersect1d(group.nodes, body_nodes)
+        taken = [owner[n] for n in mine.tolist() if n in owner]
+        if taken:
+            other = taken[0]
+            shared = sum(o is other for o in taken)
+            raise DeckError(f"{r.where}: {name}: {shared} of its nodes are also in "
+                            f"/RBODY/{other.id} ({other.where}): a node belongs to one rigid "
+                            "body")  # fmt: skip
+        owner |= dict.fromkeys(mine.tolist(), r)
         row = deck.node_positions(np.array([r.main_node]))[0]
         if row < 0:
             raise DeckError(f"{r.where}: {name}: node_ID {r.main_node} refers to no /NODE")
@@ -139,9 +155,8 @@ def scene_tables(deck: Deck, atoms, by_parts: dict[int, list[str]], body_nodes: 
                 "turns it about its centre of mass, the mass and inertia placed as ICoG 1"
             )
         tables.append(table)
-        nodes = len(np.intersect1d(group.nodes, body_nodes))
         facts.append(
-            f"rigid body: {name} ({r.where}) -> [[rigid_body]], {nodes} nodes of group "
+            f"rigid body: {name} ({r.where}) -> [[rigid_body]], {len(mine)} nodes of group "
             f"{r.group}, main node {r.main_node}, added {r.mass:g} kg, ICoG {r.icog}"
         )
     return tables
