@@ -13,7 +13,8 @@ One step, in the pipeline of constraints (:class:`RigidBody`, then the walls, th
 1. :meth:`RigidBody.constrain` gathers the force and the moment about c of the nodal
    forces ``m a`` (internal forces and gravity; over the ranks: one ``Allreduce`` of six
    numbers) and predicts ``V^{n+1/2} = V^{n-1/2} + dt^n F / M``, ``L^{n+1/2} = L^{n-1/2} +
-   dt^n T``, ``omega^{n+1/2} = R J0^-1 R^T L^{n+1/2}``, ``c^{n+1} = c^n + dt^{n+1/2}
+   dt^n T``, ``omega^{n+1/2} = R' J0^-1 R'^T L^{n+1/2}`` at the mid-step rotation ``R' =
+   exp(dt^{n+1/2}/2 omega^{n+1/2}) R^n`` (a fixed point), ``c^{n+1} = c^n + dt^{n+1/2}
    V^{n+1/2}``, ``R^{n+1} = exp(dt^{n+1/2} omega^{n+1/2}) R^n`` (Rodrigues), and sets the
    nodes' accelerations so that the update moves them exactly to ``c^{n+1} + R^{n+1} (X -
    c0)``;
@@ -147,7 +148,6 @@ class RigidBody:
         self._half = 0.0  # dt^{n-1}/2 of the latest step, s
         self._predicted = None  # c^{n+1}, R^{n+1} of the latest prediction
         self.node_velocity = np.zeros((len(self.nodes), 3))  # v^{n+1/2} it gave them, m/s
-        self.force = np.zeros(6)  # F (N) and T (N m) of the latest step
 
     # --- the step -----------------------------------------------------------------------
 
@@ -188,7 +188,6 @@ class RigidBody:
         self.comm.Allreduce(local, total, op=MPI.SUM)
         if self.gravity is not None:
             total[:3] += self.mass * self.gravity
-        self.force = total
         self.velocity = self.previous[0] + dt_v * total[:3] / self.mass
         self.angular_momentum = self.previous[1] + dt_v * total[3:]
         self.omega = self.angular_velocity(self.angular_momentum, state.dt)
