@@ -62,7 +62,8 @@ from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
-from rwall_fem.rigid_body import RigidBodyError, RigidContact, build_rigid_bodies
+from rwall_fem.rigid_body import RigidBodyError, build_rigid_bodies
+from rwall_fem.rigid_contact import RigidContact
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
 from rwall_fem.time_step import step_size
