@@ -80,7 +80,11 @@ class RigidBody:
         self.inertia0 = np.array(inertia, dtype=float)  # J0 about c, in the frame of t = 0
         self.inverse0 = np.linalg.inv(self.inertia0)
         self.center0 = np.array(center, dtype=float)
-        self.offsets = state.X[self.nodes] - self.center0  # X - c0, m
+        self.positions0 = state.X[self.nodes]  # X, m
+        self.offsets = self.positions0 - self.center0  # X - c0, m
+        self.node_mass = state.mass[self.nodes]  # kg (fixed: no mass scaling with a body)
+        self._first_moment = self.node_mass @ self.offsets  # this rank's sum m (X - c0), kg m
+        self._arms = self.offsets.copy()  # x - c at t^n, m: R (X - c0)
         self.gravity = None if gravity is None else np.asarray(gravity, dtype=float)
         # The state at t^n (c, R) and over the latest step (V, L, omega: n - 1/2).
         self.center = self.center0.copy()
@@ -96,7 +100,7 @@ class RigidBody:
         # the latest step's first half).
         self._gravity_integral = np.zeros(3)
         self._half = 0.0  # dt^{n-1}/2 of the latest step, s
-        self._predicted = None  # c^{n+1}, R^{n+1} of the latest prediction
+        self._predicted = None  # c^{n+1}, R^{n+1} and the arms of the latest prediction
         self.node_velocity = np.zeros((len(self.nodes), 3))  # v^{n+1/2} it gave them, m/s
 
     # --- the step -----------------------------------------------------------------------
@@ -118,10 +122,6 @@ class RigidBody:
                 break
         return omega
 
-    def arms(self) -> np.ndarray:
-        """x - c of the owned nodes at t^n (m): R (X - c0)."""
-        return self.offsets @ self.R.T
-
     def constrain(self, state) -> None:
         """Gather the nodal forces, predict the motion over the step, move the nodes with it."""
         nodes, dt_v = self.nodes, state.dt_velocity
@@ -129,11 +129,13 @@ class RigidBody:
         self._book_gravity(state, v)
         self.previous = (self.velocity, self.angular_momentum, self.omega)
         self.nodes_before = v
-        m = state.mass[nodes, None]
-        forces = m * state.a[nodes]
-        if self.gravity is not None:
-            forces -= m * self.gravity  # the body applies gravity to all its mass below
-        local = np.concatenate([forces.sum(axis=0), np.cross(self.arms(), forces).sum(axis=0)])
+        forces = self.node_mass[:, None] * state.a[nodes]
+        S = self._arms.T @ forces  # sum (x - c) f^T: the moment is its antisymmetric part
+        local = np.array([*forces.sum(axis=0), S[1, 2] - S[2, 1], S[2, 0] - S[0, 2],
+                          S[0, 1] - S[1, 0]])  # fmt: skip
+        if self.gravity is not None:  # the body applies gravity to all its mass below
+            local[:3] -= self.node_mass.sum() * self.gravity
+            local[3:] -= np.cross(self.R @ self._first_moment, self.gravity)
         total = np.empty(6)
         self.comm.Allreduce(local, total, op=MPI.SUM)
         if self.gravity is not None:
@@ -156,15 +158,15 @@ class RigidBody:
         dt, dt_v, nodes = state.dt, state.dt_velocity, self.nodes
         center = self.center + dt * self.velocity
         R = rotation(dt * self.omega) @ self.R
-        self._predicted = (center, R)
-        target = center + self.offsets @ R.T
-        velocity = (target - state.X[nodes] - state.u[nodes]) / dt
+        arms = self.offsets @ R.T
+        self._predicted = (center, R, arms)
+        velocity = (center + arms - self.positions0 - state.u[nodes]) / dt
         self.node_velocity = velocity  # before the walls, m/s
         state.a[nodes] = (velocity - self.nodes_before) / dt_v
 
     def commit(self) -> None:
         """Take the motion of the step: c^{n+1} and R^{n+1} (after the walls)."""
-        self.center, self.R = self._predicted
+        self.center, self.R, self._arms = self._predicted
 
     # --- books --------------------------------------------------------------------------
 
@@ -185,12 +187,12 @@ class RigidBody:
     def nodal_kinetic(self, state) -> float:
         """What the update booked as the kinetic energy of this rank's secondary nodes (J):
         1/2 sum m v^{n-1/2} . v^{n+1/2}, taken out of ``kinetic``."""
-        m = state.mass[self.nodes]
-        return 0.5 * float(np.einsum("i,ij,ij->", m, self.nodes_before, state.v[self.nodes]))
+        v = state.v[self.nodes]
+        return 0.5 * float(np.einsum("i,ij,ij->", self.node_mass, self.nodes_before, v))
 
     def nodal_momentum(self, state) -> np.ndarray:
         """sum m v (kg m/s) of this rank's secondary nodes, taken out of the momentum."""
-        return state.mass[self.nodes] @ state.v[self.nodes]
+        return self.node_mass @ state.v[self.nodes]
 
     @property
     def momentum(self) -> np.ndarray:
@@ -204,7 +206,7 @@ class RigidBody:
         if self.gravity is None:
             return
         half = 0.5 * state.dt_velocity
-        difference = self.mass * self.velocity / self.comm.size - state.mass[self.nodes] @ v
+        difference = self.mass * self.velocity / self.comm.size - self.node_mass @ v
         self._gravity_integral += (self._half + half) * difference
         self._half = half
 
@@ -228,6 +230,7 @@ class RigidBody:
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         motion = arrays["motion"]
         self.center, self.R = motion[0:3].copy(), motion[3:12].reshape(3, 3).copy()
+        self._arms = self.offsets @ self.R.T
         self.velocity, self.angular_momentum, self.omega = (
             motion[12:15].copy(), motion[15:18].copy(), motion[18:21].copy()
         )  # fmt: skip
