@@ -62,7 +62,7 @@ from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
-from rwall_fem.rigid_body import RigidBodyError, build_rigid_bodies
+from rwall_fem.rigid_body import RigidBodyError, build_rigid_bodies, deactivate_rigid_cells
 from rwall_fem.rigid_contact import RigidContact
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
@@ -360,6 +360,7 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     walls = [_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))]
     boundaries = [_boundary(scene, i, solid) for i in range(len(scene.boundaries))]
     rigid = _rigid_bodies(scene, solid, state, walls, boundaries)
+    inactive = deactivate_rigid_cells(internal, rigid, solid.V, comm) if rigid else 0
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
@@ -383,6 +384,7 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
             "mass": body_mass,
             "dt_stable": solid.dt_stable,
             "dt_element_estimate": steps.at_rest,
+            **({"rigid_cells": inactive} if rigid else {}),
         },
     )
 
@@ -624,6 +626,8 @@ def _constraint_facts(sim: Simulation) -> list[str]:
         count = comm.allreduce(len(r.nodes))
         center = ", ".join(f"{c:.4g}" for c in r.center0)
         lines.append(f"{r.name}: {count} nodes, {r.mass:.6g} kg, centre of mass ({center}) m")
+    if sim.rigid_bodies:
+        lines.append(f"rigid bodies: {sim.info['rigid_cells']} cells inside them not computed")
     return lines
 
 

@@ -45,7 +45,13 @@ import math
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["RigidBody", "RigidBodyError", "build_rigid_bodies", "rotation"]
+__all__ = [
+    "RigidBody",
+    "RigidBodyError",
+    "build_rigid_bodies",
+    "deactivate_rigid_cells",
+    "rotation",
+]
 
 _ITERATIONS = 8  # of the mid-step angular velocity (each gains about omega dt / 2 digits)
 
@@ -314,3 +320,29 @@ def build_rigid_bodies(specs, selections: list[np.ndarray], state, comm, gravity
                                 center=center, velocity=velocity, angular_velocity=omega,
                                 gravity=gravity))  # fmt: skip
     return bodies
+
+
+def deactivate_rigid_cells(internal, bodies: list[RigidBody], V, comm) -> int:
+    """Stop computing the cells of the internal force ``internal`` (a
+    :class:`~rwall_fem.body.Body`) whose nodes all belong to one of the rigid ``bodies``, as
+    Radioss does: their forces are internal to the body, and a small-strain material would
+    give them forces under a rigid rotation. Parts whose cells may erode keep theirs.
+    Returns how many cells were deactivated (over the ranks; collective)."""
+    from rwall_fem.elements import GhostedField
+
+    tag = GhostedField(V)  # each node's body, from 1 (0: none), on the ghosts too
+    for b, body in enumerate(bodies):
+        tag.owned[body.nodes, 0] = b + 1
+    tag.scatter_forward()
+    which = tag.array[:, 0]
+    count = 0
+    for force in internal.elements:
+        if force.erosion is not None:
+            continue
+        mine = which[force.cells]
+        rigid = (mine[:, 0] > 0) & (mine == mine[:, :1]).all(axis=1)
+        if rigid.any():
+            force.deactivate(np.flatnonzero(rigid))
+        count += int(rigid.sum())
+    return comm.allreduce(count)
+

@@ -75,7 +75,7 @@ def _rigid_body(deck: Deck, card: Card) -> None:
                   "give Jxx..Jxz", card.lines[2])  # fmt: skip
     for name, value, what in (
         ("Ispher", ispher, "the inertia is the full tensor of the nodes and J"),
-        ("Ikrem", ikrem, "the elements inside a rigid body keep computing"),
+        ("Ikrem", ikrem, "the elements inside a rigid body are not computed here"),
         ("surf_ID", surface, "an envelope surface is for contact interfaces, not read"),
         ("Ioptoff", ioptoff, "no domain decomposition to manage"),
     ):
