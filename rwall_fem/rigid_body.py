@@ -35,7 +35,8 @@ Energy: the body's kinetic energy is its own column ``rigid_body`` of ``energy.c
 shadow ``1/2 M V^{n-1/2} . V^{n+1/2} + 1/4 (L^{n-1/2} . omega^{n+1/2} + L^{n+1/2} .
 omega^{n-1/2})``; its nodes are taken out of ``kinetic``, and out of the momentum, which
 gets ``M V`` instead. Gravity acts on M (the body applies it: the nodes' share of it is
-taken out of their forces first).
+taken out of their forces first). The cells whose nodes all belong to one body are not
+computed (:func:`deactivate_rigid_cells`), as Radioss deactivates them.
 """
 
 from __future__ import annotations
