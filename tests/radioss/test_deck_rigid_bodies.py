@@ -88,7 +88,8 @@ def test_rigid_body_refusals(shared_dir):
     for k, (change, match) in enumerate([
         (dict(sensor=3), r"model_0000\.rad:\d+: /RBODY/7: sens_ID = 3: a rigid body switched "
                          "by a sensor is not supported"),
-        (dict(extra=i10(0) + i10(1)), r"/RBODY/7: Ifail = 1: the failure of a rigid body"),
+        (dict(extra=i10(0) + i10(0) + i10(1)), r"/RBODY/7: Ifail = 1: the failure of a rigid "
+                                               "body"),
         (dict(icog=5), r"/RBODY/7: ICoG = 5: 1 \(default\), 2, 3 or 4"),
         (dict(node=4242), r"/RBODY/7: node_ID 4242 refers to no /NODE"),
         (dict(node=1), r"/RBODY/7: node_ID 1 is a node of the elements outside grnd_ID 2"),
@@ -118,13 +119,14 @@ def test_rigid_body_flags(shared_dir):
     main node's mass and inertia alone, ICoG 3 warns; Ispher 1 is noticed."""
     d = bar_with_rigid_top("SI")
     d.cards = d.cards[:-5]
-    rigid_body(d, 7, 2, mass=5e-3, icog=3, ispher=1)
+    rigid_body(d, 7, 2, mass=5e-3, icog=3, ispher=1, extra=i10(0) + i10(2))  # Iexpams 2
     said = []
     scene = load_deck(written(d, shared_dir / "icog3"), report=said)
     assert scene.rigid_bodies[0].center == "with_main_node"
     assert any("/RBODY/7: ICoG = 3 turns the body about its main node" in w
                for w in said[0].warnings)  # fmt: skip
     assert any("/RBODY/7: Ispher = 1: not honoured" in n for n in said[0].notices)
+    assert any("/RBODY/7: Iexpams = 2: not honoured" in n for n in said[0].notices)
     for icog, key, value in ((2, "center", "nodes"), (4, "node_masses", False)):
         d = bar_with_rigid_top("SI")
         d.cards = d.cards[:-5]

@@ -2,14 +2,14 @@
 scene's ``[[rigid_body]]`` tables they become (``docs/radioss.md``, "Rigid bodies").
 
 The card's lines: the title; ``node_ID sens_ID Skew_ID Ispher Mass grnd_ID Ikrem ICoG
-surf_ID``; ``Jxx Jyy Jzz``; ``Jxy Jyz Jxz``; optionally ``Ioptoff Ifail``. The body's
+surf_ID``; ``Jxx Jyy Jzz``; ``Jxy Jyz Jxz``; optionally ``Ioptoff Iexpams Ifail``. The body's
 nodes are the group's; its main node is where Mass and J are added: at its own position
 (ICoG 1, the default), at the centre of mass of the group's nodes (ICoG 2), or as the
 body's whole mass and inertia (ICoG 4). ICoG 3 keeps the main node where it is and turns
 the body about it; here a body turns about its centre of mass, as ICoG 1 (one warning
 line when the two differ). A sensor, a skew with inertia, Ifail (failure of the body) and
-/RBODY/LAGMUL are refused; Ispher, Ikrem, surf_ID and Ioptoff are noticed in one line
-each when set.
+/RBODY/LAGMUL are refused; Ispher, Ikrem, surf_ID, Ioptoff and Iexpams are noticed in one
+line each when set.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def _rigid_body(deck: Deck, card: Card) -> None:
     )
     jxx, jyy, jzz = card.read(2, "f:Jxx f:Jyy f:Jzz", "Jxx Jyy Jzz")
     jxy, jyz, jxz = card.read(3, "f:Jxy f:Jyz f:Jxz", "Jxy Jyz Jxz")
-    ioptoff, ifail = card.read_optional(4, "i:Ioptoff i:Ifail")
+    ioptoff, iexpams, ifail = card.read_optional(4, "i:Ioptoff i:Iexpams i:Ifail")
     inertia = [jxx, jyy, jzz, jxy, jyz, jxz]
     if node <= 0:
         card.fail("node_ID (the main node) is missing", line)
@@ -78,6 +78,7 @@ def _rigid_body(deck: Deck, card: Card) -> None:
         ("Ikrem", ikrem, "the elements inside a rigid body are not computed here"),
         ("surf_ID", surface, "an envelope surface is for contact interfaces, not read"),
         ("Ioptoff", ioptoff, "no domain decomposition to manage"),
+        ("Iexpams", iexpams, "no advanced mass scaling here"),
     ):
         if value and not (name == "Ispher" and value == 2):  # Ispher 2 is Radioss's default
             deck.notice(card, f"{name} = {value}: not honoured ({what})")
