@@ -80,9 +80,9 @@ def test_rigid_block_falls_on_a_wall(shared_dir):
     body, s = sim.rigid_bodies[0], sim.history.summary
     M = body.mass
     assert math.isclose(M, SOFT["density"] * 1e-6, rel_tol=1e-12)  # the nodes' lumped masses
-    # Free flight: V^{n-1/2} = -v0 - g n dt, h^n = gap - v0 n dt - g dt^2 n (n - 1)/2.
+    # Free flight: V^{n-1/2} = -v0 - g n dt, h^n = gap - v0 n dt - g dt^2 n (n + 1)/2.
     n = np.arange(len(probe.t))
-    free = probe.low - (gap - v0 * n * dt - g * dt**2 * n * (n - 1) / 2) < 1e-12
+    free = np.abs(probe.low - (gap - v0 * n * dt - g * dt**2 * n * (n + 1) / 2)) < 1e-15
     flight = n[probe.low > 2 * v0 * dt]  # steps before the body reaches the wall's reach
     assert np.allclose(probe.v[flight, 2], -v0 - g * n[flight] * dt, rtol=0, atol=1e-12)
     assert free[flight].all()
