@@ -71,6 +71,8 @@ from rwall_fem.output.history import History
 from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
+from rwall_fem.rigid_body import RigidBodyError, build_rigid_bodies, deactivate_rigid_cells
+from rwall_fem.rigid_contact import RigidContact
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
 from rwall_fem.solver import Simulation, State
 from rwall_fem.time_step import step_size
@@ -380,6 +382,10 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     held = internal.held[: solid.owned] > 0
     for k, part in enumerate(solid.parts):
         state.v[held[:, k]] = part.velocity
+    walls = [_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))]
+    boundaries = [_boundary(scene, i, solid) for i in range(len(scene.boundaries))]
+    rigid = _rigid_bodies(scene, solid, state, walls, boundaries)
+    inactive = deactivate_rigid_cells(internal, rigid, solid.V, comm) if rigid else 0
     return Simulation(
         state=state,
         end_time=scene.run.end_time,
@@ -388,8 +394,10 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
         step_size=steps,
         forces=([] if scene.gravity is None else [Gravity(scene.gravity)])
         + _loads(scene, solid),
-        walls=[_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))],
-        boundaries=[_boundary(scene, i, solid) for i in range(len(scene.boundaries))],
+        walls=walls,
+        boundaries=boundaries,
+        rigid_bodies=rigid,
+        rigid_contact=RigidContact(rigid, walls, solid.owned, comm) if rigid else None,
         info={
             "scene": scene.source,
             "version": __version__,
@@ -402,8 +410,54 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
             "mass": body_mass,
             "dt_stable": solid.dt_stable,
             "dt_element_estimate": steps.at_rest,
+            **({"rigid_cells": inactive} if rigid else {}),
         },
     )
+
+
+def _rigid_bodies(scene: Scene, solid: _Solid, state: State, walls, boundaries) -> list:
+    """The scene's [[rigid_body]]s on their owned nodes (named sets, every node of the named
+    parts, the nodes inside a box at the start), and what they may not meet: a boundary
+    condition on their nodes, mass scaling."""
+    specs, comm, owned = scene.rigid_bodies, solid.comm, solid.owned
+    if not specs:
+        return []
+    names = [part.name for part in solid.parts]
+    selections = []
+    for i, spec in enumerate(specs):
+        where = f"{scene.source}: rigid_body[{i}]"
+        chosen = np.zeros(owned, dtype=bool)
+        for name in spec.sets:
+            if name not in solid.body.groups:
+                known = ", ".join(sorted(solid.body.groups)) or "none"
+                raise SceneError(f"{where}.sets: unknown node set {name!r}; the mesh has: {known}")
+            chosen[_owned(group_nodes(solid.V, solid.body, name), owned)] = True
+        for name in spec.parts:
+            if name not in names:
+                raise SceneError(f"{where}.parts: unknown part {name!r}; the parts: "
+                                 f"{', '.join(names)}")  # fmt: skip
+            chosen |= solid.elastic.held[:owned, names.index(name)] > 0
+        if spec.box is not None:
+            slack = _ROUND_OFF * solid.size
+            low, high = np.array(spec.box.low) - slack, np.array(spec.box.high) + slack
+            chosen |= np.all((state.X >= low) & (state.X <= high), axis=1)
+        selections.append(np.flatnonzero(chosen))
+    try:
+        bodies = build_rigid_bodies(specs, selections, state, comm, scene.gravity, solid.size)
+    except RigidBodyError as err:
+        raise SceneError(f"{scene.source}: {err}") from None
+    if scene.run.dt_min_action == "mass_scaling":
+        raise SceneError(f"{scene.source}: run.dt_min_action: 'mass_scaling' with "
+                         "[[rigid_body]] is not supported (a rigid body's mass is fixed); use "
+                         "'stop' or 'erode'")  # fmt: skip
+    for body in bodies:
+        for b in boundaries:
+            shared = comm.allreduce(len(np.intersect1d(b.nodes, body.nodes)))
+            if shared:
+                raise SceneError(f"{scene.source}: {b.name}: prescribes {shared} nodes of "
+                                 f"{body.name}: a boundary condition on a rigid body's nodes "
+                                 "is not supported")  # fmt: skip
+    return bodies
 
 
 def _add_recorders(
@@ -627,7 +681,8 @@ def _secondary_nodes(
 
 
 def _constraint_facts(sim: Simulation) -> list[str]:
-    """A line per wall and boundary condition: what it is and how many nodes it holds."""
+    """A line per wall, boundary condition and rigid body: what it is and how many nodes
+    it holds."""
     comm = sim.comm
     lines = []
     for w in sim.walls:
@@ -637,6 +692,12 @@ def _constraint_facts(sim: Simulation) -> list[str]:
         count = comm.allreduce(len(b.nodes))
         axes = "".join("xyz"[i] for i in b.axes)
         lines.append(f"{b.name}: {count} nodes, components {axes}")
+    for r in sim.rigid_bodies:
+        count = comm.allreduce(len(r.nodes))
+        center = ", ".join(f"{c:.4g}" for c in r.center0)
+        lines.append(f"{r.name}: {count} nodes, {r.mass:.6g} kg, centre of mass ({center}) m")
+    if sim.rigid_bodies:
+        lines.append(f"rigid bodies: {sim.info['rigid_cells']} cells inside them not computed")
     return lines
 
 

@@ -231,10 +231,24 @@ class ElementForce:
         # stored elastic, hourglass, plastic dissipation, internal energy of eroded cells (J)
         self._energy = np.zeros(4)
         self.erosion: ErodedCells | None = None
+        self._computed: np.ndarray | None = None  # the cells computed, when some are not
         if self.failure is not None:
             self._erode()
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
         self._accelerate = None
+
+    def deactivate(self, cells: np.ndarray) -> None:
+        """Compute its cells ``cells`` (indices among its cells) no more, from the start: the
+        cells whose nodes all move with one rigid body (:mod:`rwall_fem.rigid_body`), as
+        Radioss deactivates them. Not for a force whose cells may erode (it keeps its own
+        list of the cells it computes)."""
+        if self.erosion is not None:
+            raise ValueError("the cells of a force whose cells may erode stay computed")
+        keep = np.ones(self.num_cells, dtype=bool)
+        keep[cells] = False
+        self._computed = np.flatnonzero(keep).astype(np.int32)
+        self.params.live = self.ffi.cast("int32_t *", self._computed.ctypes.data)
+        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -378,7 +392,10 @@ class ElementForce:
         def ptr(array, kind="double *"):
             return ffi.cast(kind, array.ctypes.data)
 
-        computed = self.num_cells if self.erosion is None else self.erosion.computed
+        if self.erosion is not None:
+            computed = self.erosion.computed
+        else:
+            computed = self.num_cells if self._computed is None else len(self._computed)
         common = (computed, ptr(self.cells, "int32_t *"), ptr(self.X), ptr(u))
         rest = (self.params, ptr(f), ptr(energy), ptr(step))
         family = "tet4" if t.cell == "tetrahedron" else "hex8"
@@ -540,7 +557,10 @@ class ElementForce:
         """
         if self.plastic:
             raise TypeError("an elasto-plastic force depends on the path, not on u alone")
-        computed = self.num_cells if self.erosion is None else self.erosion.computed
+        if self.erosion is not None:
+            computed = self.erosion.computed
+        else:
+            computed = self.num_cells if self._computed is None else len(self._computed)
         if self._probe is None or self._probe[5] != computed:
             V = self.V
             fields = (GhostedField(V), GhostedField(V), GhostedField(V))

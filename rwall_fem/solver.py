@@ -6,8 +6,8 @@ One step, in the order of ``docs/theory.md`` (section "The step"):
    step on the way;
 2. the step size chooses ``dt^{n+1/2}`` from those estimates (:mod:`rwall_fem.time_step`),
    adding mass to the cells below ``run.dt_min`` when the scene asks for mass scaling;
-3. body forces add to ``a^n``, constraints edit it: the rigid walls, then the velocity
-   boundary conditions;
+3. body forces add to ``a^n``, constraints edit it: the rigid bodies, the rigid walls,
+   what the walls did to the rigid bodies, then the velocity boundary conditions;
 4. recorders sample the steps they are due (fields, frames: ``u^n``, ``v^{n-1/2}``);
 5. the update ``v^{n+1/2} = v^{n-1/2} + dt^n a^n`` with ``dt^n = (dt^{n-1/2} +
    dt^{n+1/2}) / 2``, ``u^{n+1} = u^n + dt^{n+1/2} v^{n+1/2}``, in one compiled pass that
@@ -285,6 +285,9 @@ class Simulation:
     forces: list[BodyForce] = field(default_factory=list)
     walls: list[Constraint] = field(default_factory=list)  # RigidWall
     boundaries: list[Constraint] = field(default_factory=list)  # VelocityBoundary
+    # Rigid bodies (rwall_fem.rigid_body), before the walls; their contact after the walls.
+    rigid_bodies: list[Constraint] = field(default_factory=list)
+    rigid_contact: Constraint | None = None
     recorders: list[Recorder] = field(default_factory=list)
     # What was built: scene, cells, nodes, mass (kg), dt_stable (s), ... (summary.json)
     info: dict = field(default_factory=dict)
@@ -318,8 +321,10 @@ class Simulation:
 
     @property
     def constraints(self) -> list[Constraint]:
-        """Walls, then boundary conditions: a clamp acts last and wins over a wall."""
-        return [*self.walls, *self.boundaries]
+        """Rigid bodies, walls, what the walls did to the rigid bodies, then boundary
+        conditions: a clamp acts last and wins over a wall."""
+        contact = [self.rigid_contact] if self.rigid_contact is not None else []
+        return [*self.rigid_bodies, *self.walls, *contact, *self.boundaries]
 
     @property
     def effects(self) -> list[str]:
@@ -336,6 +341,7 @@ class Simulation:
         pieces |= {f"force[{i}]": f for i, f in enumerate(forces)}
         pieces |= {f"wall[{i}]": w for i, w in enumerate(self.walls)}
         pieces |= {f"boundary[{i}]": b for i, b in enumerate(self.boundaries)}
+        pieces |= {f"rigid_body[{i}]": r for i, r in enumerate(self.rigid_bodies)}
         if self.history is not None:
             pieces["history"] = self.history
         recorders = [r for r in self.recorders if hasattr(r, "checkpoint_state")]

@@ -41,6 +41,8 @@ DIMENSIONS = {
     "force": (1, 1, -2),
     "impulse": (1, 1, -1),  # and momentum
     "energy": (1, 2, -2),
+    "inertia": (1, 2, 0),  # kg m^2
+    "angular_momentum": (1, 2, -1),  # kg m^2/s
 }
 
 

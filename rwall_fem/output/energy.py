@@ -3,7 +3,9 @@
 ``docs/theory.md`` (section "Energy balance") derives the booking:
 
 - the kinetic energy is the shadow value K^n = 1/2 sum m v^{n-1/2} . v^{n+1/2} (booked by
-  the update of step n), walls carried by a main node included;
+  the update of step n), walls carried by a main node included; the rigid bodies' nodes
+  are not in it: their bodies' kinetic energy is the column ``rigid_body``
+  (:mod:`rwall_fem.rigid_body`);
 - the stored energies come from the internal force: ``"internal"`` (the strain energy of
   the element kernels: 1/2 u.Ku for linear elasticity, the integral of the energy density
   for the hyperelastic models; for a force without stored energy, its work at mid-step
@@ -39,11 +41,16 @@ __all__ = ["EnergyBalance", "initial_kinetic_energy"]
 TINY = float(np.finfo(float).tiny)  # the smallest normal double: E_ref is never below it
 
 
-def initial_kinetic_energy(state, walls, comm) -> float:
-    """1/2 m v^2 (J) of the body at the start, plus that of walls carried by a main node."""
-    body = comm.allreduce(0.5 * float(np.sum(state.mass[:, None] * state.v**2)))
+def initial_kinetic_energy(state, walls, comm, rigid=()) -> float:
+    """1/2 m v^2 (J) of the body at the start, plus that of walls carried by a main node;
+    the nodes of ``rigid`` bodies count as their bodies, 1/2 M V^2 + 1/2 omega . L."""
+    nodal = 0.5 * state.mass[:, None] * state.v**2
+    body = comm.allreduce(
+        float(np.sum(nodal)) - sum(float(np.sum(nodal[r.nodes])) for r in rigid)
+    )
     moving = [w.motion for w in walls if w.motion.dynamic]
-    return body + sum(0.5 * mo.mass * mo.velocity @ mo.velocity for mo in moving)
+    walls_energy = sum(0.5 * mo.mass * mo.velocity @ mo.velocity for mo in moving)
+    return body + walls_energy + sum(r.initial_kinetic() for r in rigid)
 
 
 class EnergyBalance:

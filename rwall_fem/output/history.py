@@ -65,7 +65,8 @@ class History:
         self.guards = guards
         self.plot = plot  # draw histories.png at the end
         comm, walls = sim.comm, sim.walls
-        self.initial_momentum = momentum(sim.state, walls, comm)
+        rigid = self.rigid = sim.rigid_bodies
+        self.initial_momentum = momentum(sim.state, walls, comm, rigid)
         self.mass_scaling = getattr(sim.step_size, "mass_scaling", None)
         scaled = self.mass_scaling is not None
         self.erosion = getattr(sim.internal, "erosion", None)  # cells that may erode
@@ -79,8 +80,8 @@ class History:
         explicit = getattr(sim.internal, "explicit", False)
         self.part_columns = sim.internal.part_columns() if explicit else ()
         self.balance = EnergyBalance(
-            initial_kinetic_energy(sim.state, walls, comm),
-            stored=("kinetic", *sim.internal.energy_names),
+            initial_kinetic_energy(sim.state, walls, comm, rigid),
+            stored=("kinetic", *(("rigid_body",) if rigid else ()), *sim.internal.energy_names),
             parts=sim.internal.energy_parts,
             works=works,
             extras=(("added_mass", "added_mass_percent") if scaled else ())
@@ -126,13 +127,14 @@ class History:
         if not (self.steps.due(s) or stopping) and not self._stop_requested(sim, s):
             return
         local = self._sums.local
-        local["kinetic"][...] = s.kinetic
+        local["kinetic"][...] = s.kinetic - sum(r.nodal_kinetic(s) for r in self.rigid)
         for name, value in sim.internal.energies(s).items():
             local[name][...] = value
         local["external_work"][...] = (
             sum(f.work(s) for f in sim.forces if f not in self.damping)
             + sum(w.driving_work for w in sim.walls)
             + sum(b.work for b in sim.boundaries)
+            + sum(r.gravity_work(s) for r in self.rigid)
         )
         for i, w in enumerate(sim.walls):
             local["wall_work"][i] = w.normal_work, w.friction_work
@@ -159,6 +161,8 @@ class History:
             if w.motion.dynamic:  # the same on every rank: not part of the sum
                 kinetic = 0.5 * w.motion.mass * w.motion.previous_velocity @ w.motion.velocity
                 energies["kinetic"] += kinetic
+        if self.rigid:  # the same on every rank: not part of the sum
+            energies["rigid_body"] = sum(r.kinetic for r in self.rigid)
         energies["external_work"] = float(total["external_work"])
         energies["wall_work"] = float(total["wall_work"].sum())
         if self.damping:

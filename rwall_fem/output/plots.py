@@ -26,9 +26,12 @@ def plot_histories(directory: str | Path) -> Path:
     figure, axes = plt.subplots(rows, 1, figsize=(8, 3.2 * rows), sharex=True, squeeze=False)
     t = energy["time"] * 1e3
     ax = axes[0, 0]
-    for name in ("kinetic", "internal", "external_work", "wall_work"):
+    rigid = ("rigid_body",) if "rigid_body" in energy.dtype.names else ()
+    for name in ("kinetic", *rigid, "internal", "external_work", "wall_work"):
         ax.plot(t, energy[name], label=name.replace("_", " "))
     total = energy["kinetic"] + energy["internal"] - energy["external_work"] - energy["wall_work"]
+    if rigid:
+        total = total + energy["rigid_body"]
     ax.plot(t, total, "k--", label="K + U - W_ext - W_wall")
     ax.set_ylabel("energy (J)")
     ax.legend(fontsize=8, loc="best")

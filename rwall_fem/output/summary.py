@@ -39,9 +39,13 @@ __all__ = [
 ]
 
 
-def momentum(state, walls, comm) -> np.ndarray:
-    """Momentum (kg m/s) of the body plus that of the walls carried by a main node."""
-    total = comm.allreduce(np.sum(state.mass[:, None] * state.v, axis=0))
+def momentum(state, walls, comm, rigid=()) -> np.ndarray:
+    """Momentum (kg m/s) of the body plus that of the walls carried by a main node; the
+    nodes of ``rigid`` bodies count as their bodies, M V."""
+    local = np.sum(state.mass[:, None] * state.v, axis=0)
+    for r in rigid:
+        local = local - r.nodal_momentum(state)
+    total = comm.allreduce(local) + sum(r.momentum for r in rigid)
     for w in walls:
         if w.motion.dynamic:
             total = total + w.motion.mass * w.motion.velocity
@@ -71,13 +75,14 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         "wall_seconds": comm.allreduce(sim.wall_seconds, MPI.MAX),
         "effects": sim.effects,
         "initial_momentum": initial_momentum.tolist(),
-        "final_momentum": momentum(s, sim.walls, comm).tolist(),
+        "final_momentum": momentum(s, sim.walls, comm, sim.rigid_bodies).tolist(),
         "energy": energy,
         "deformed_bounds": deformed_bounds(s, comm),
         **_plasticity(sim.internal, comm),
         **_erosion(sim.internal, comm),
         **_parts(sim, latest, comm),
         "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
+        "rigid_bodies": [_rigid_body(r, comm) for r in sim.rigid_bodies],
         "boundaries": [
             {
                 "name": b.name,
@@ -87,6 +92,22 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
             }
             for b in sim.boundaries
         ],
+    }
+
+
+def _rigid_body(body, comm) -> dict:
+    """A rigid body's nodes, mass (kg), inertia about its centre (kg m^2, global frame), and
+    its centre (m), velocity (m/s), angular velocity (rad/s) and momenta at the end."""
+    return {
+        "name": body.name,
+        "nodes": comm.allreduce(len(body.nodes)),
+        "mass": body.mass,
+        "inertia": body.spatial_inertia().tolist(),
+        "center": body.center.tolist(),
+        "velocity": body.velocity.tolist(),
+        "angular_velocity": body.omega.tolist(),
+        "momentum": body.momentum.tolist(),
+        "angular_momentum": body.angular_momentum.tolist(),
     }
 
 

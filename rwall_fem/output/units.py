@@ -31,6 +31,10 @@ SUMMARY_KEYS = {
                      "mass_scaling_work", "damping_work"), "energy"),
     **dict.fromkeys(("deformed_bounds", "position", "deepest_penetration"), "length"),
     "velocity": "velocity",
+    "center": "length",
+    "inertia": "inertia",
+    "angular_velocity": "rate",
+    "angular_momentum": "angular_momentum",
 }  # fmt: skip
 _UNITLESS_ENERGY = ("balance_error", "max_balance_error", "energy_error_percent", "eroded_cells")
 

@@ -197,6 +197,7 @@ class Deck:
     added_masses: list = field(default_factory=list)  # /ADMAS (cards.loads.AddedMass)
     dampings: list = field(default_factory=list)  # /DAMP (cards.loads.Damping)
     walls: list[Wall] = field(default_factory=list)
+    rigid_bodies: list = field(default_factory=list)  # /RBODY (cards/rigid_bodies.py)
     end_time: float | None = None  # s
     dt_scale: float | None = None
     dt_min: float | None = None  # s

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rwall_fem.radioss.cards.rigid_bodies import scene_tables as rigid_body_tables
 from rwall_fem.radioss.groups import node_ids, part_ids
 from rwall_fem.radioss.loads import load_groups, load_tables
 from rwall_fem.radioss.materials import element_table, material_table
@@ -154,6 +155,8 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["wall"] = walls
         for w, table in zip(deck.walls, walls, strict=True):
             facts.append(_wall_fact(w, table))
+    if deck.rigid_bodies:
+        raw["rigid_body"] = rigid_body_tables(deck, atoms, by_parts, body_nodes, facts)
     facts.append(
         f"run: end time {deck.end_time:g} s"
         + (f", dt scale {deck.dt_scale:g}" if deck.dt_scale is not None else "")
@@ -264,17 +267,17 @@ def _names(parts: list[DeckPart]) -> str:
 
 
 def _groups_as_parts(deck: Deck, parts: list[DeckPart]) -> dict[int, list[str]]:
-    """The /GRNOD/PART (SUBSET, MAT, PROP) groups that walls take as their grnd_ID1, as the
-    names of their parts (``secondary.parts``: every node of those parts' elements, as the
-    group's)."""
+    """The /GRNOD/PART (SUBSET, MAT, PROP) groups that walls take as their grnd_ID1 and
+    rigid bodies as theirs, as the names of their parts (``secondary.parts``, a rigid
+    body's ``parts``: every node of those parts' elements, as the group's)."""
     names = {p.part.id: p.name for p in parts}
     out = {}
-    for w in deck.walls:
-        g = deck.groups.get(w.add_group)
+    for gid in [w.add_group for w in deck.walls] + [r.group for r in deck.rigid_bodies]:
+        g = deck.groups.get(gid)
         if g is not None and g.kind in ("PART", "SUBSET", "MAT", "PROP"):
             user = f"{g.where}: {g.name}: {g.kind.lower()}"
             chosen = part_ids(deck, g.kind, g.items, user).tolist()
-            out[w.add_group] = [names[pid] for pid in chosen if pid in names]
+            out[gid] = [names[pid] for pid in chosen if pid in names]
     return out
 
 
@@ -314,6 +317,8 @@ def _used_groups(deck: Deck, by_parts: dict[int, list[str]]) -> list[int]:
              for w in deck.walls if w.exclude_group]  # fmt: skip
     uses += [(g, where, "/BCS: grnd_ID") for _, g, where in deck.clamps]
     uses += [(p.group, p.where, f"{p.card}: grnd_ID") for p in deck.velocities]
+    uses += [(r.group, r.where, f"/RBODY/{r.id}: grnd_ID") for r in deck.rigid_bodies
+             if r.group not in by_parts]  # fmt: skip
     for gid, where, what in uses:
         _group(deck, gid, where, what)
     return list(dict.fromkeys(gid for gid, _, _ in uses))

@@ -14,6 +14,7 @@ and the JSON Schema ``scene.schema.json`` beside this file
 from rwall_fem.scene.keys import SceneError
 from rwall_fem.scene.overrides import apply_override
 from rwall_fem.scene.read import load_scene, parse_scene
+from rwall_fem.scene.rigid_bodies import RigidBodySpec
 from rwall_fem.scene.schema import (
     MATERIAL_MODELS,
     MESH_SHAPES,
@@ -48,6 +49,7 @@ __all__ = [
     "Motion",
     "Output",
     "PartSpec",
+    "RigidBodySpec",
     "RunSettings",
     "Scene",
     "SceneError",

@@ -37,6 +37,7 @@ from rwall_fem.scene.keys import (
     show,
     table,
 )
+from rwall_fem.scene.rigid_bodies import RigidBodySpec
 from rwall_fem.units import parse_system
 
 __all__ = [
@@ -1172,6 +1173,9 @@ class Scene:
     )
     parts: tuple[PartSpec, ...] = key(
         Each(PartSpec), (), toml="part", doc="the parts of the body", default_doc="one: the body"
+    )
+    rigid_bodies: tuple[RigidBodySpec, ...] = key(
+        Each(RigidBodySpec), (), toml="rigid_body", doc="node sets that move as rigid bodies"
     )
     output: Output = key(Sub(Output), factory=Output, doc="pictures, fields, histories")
 

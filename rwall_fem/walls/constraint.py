@@ -315,6 +315,39 @@ class RigidWall:
             self.first_contact = min(self.first_contact, state.t)
             self.last_contact = state.t
 
+    def contact_rows(self, positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The normals and the normal velocities (m/s, absolute) that the wall asked of its
+        contacts ``positions`` (rows of :attr:`touching`) in the latest step: what a
+        rigid body owning those nodes must give them (:mod:`rwall_fem.rigid_body`)."""
+        passes = self._passes
+        normals = passes.normals[positions]
+        return normals, passes.target[positions] + normals @ self.motion.velocity
+
+    def contact_impulses(self, positions: np.ndarray) -> np.ndarray:
+        """The impulses (N s, normal and tangential) the wall gave its contacts
+        ``positions`` (rows of :attr:`touching`) in the latest step."""
+        passes = self._passes
+        impulses = passes.normal[positions]
+        if self.slide != "free":
+            impulses = impulses + passes.tangential[positions]
+        return impulses
+
+    def reassign(self, positions: np.ndarray, impulses: np.ndarray) -> None:
+        """The contacts ``positions`` of the latest step received ``impulses`` (N s, (k, 3))
+        rather than those the wall gave them (their rigid body took the wall's push as a
+        whole): the wall's impulse and works are booked with these. Free sliding only."""
+        passes = self._passes
+        change = impulses - passes.normal[positions]
+        passes.normal[positions] = impulses  # the latest step's, booked again at the next
+        total = change.sum(axis=0)
+        before = self.motion.previous_velocity
+        self.normal_impulse -= total
+        relative = passes.previous[positions] - before
+        self.normal_work += 0.5 * float(np.einsum("ij,ij->", change, relative))
+        if self.motion.prescribed:
+            self.driving_work += 0.5 * float(total @ before)
+            self._pending_driving += 0.5 * float(total @ self.motion.velocity)
+
     def _follow(self, state, passes, wall_velocity, wall_next) -> None:
         """Keep the near set valid for this step's test; select it again when the nodes
         and the wall may have travelled, relative to each other, more than its budget.

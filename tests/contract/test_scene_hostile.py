@@ -68,6 +68,19 @@ FULL = {
             "motion": {"mass": 1.0, "velocity": [0.0, 0.0, -1.0]},
         }
     ],
+    "rigid_body": [
+        {
+            "sets": ["hole"],
+            "parts": ["body"],
+            "box": {"low": [-0.03, -0.03, 0.0], "high": [-0.02, -0.02, 0.004]},
+            "main_node": [0.0, 0.0, 0.01],
+            "mass": 0.1,
+            "inertia": [1e-5, 1e-5, 1e-5, 0.0, 0.0, 0.0],
+            "center": "nodes",
+            "node_masses": True,
+            "angular_velocity": [0.0, 0.0, 1.0],
+        }
+    ],
     "output": {"frames": 1},
 }
 

@@ -35,6 +35,7 @@ from rwall_fem.radioss.cards import (
     materials,
     nodes,
     parts,
+    rigid_bodies,
     run,
     solids,
     walls,
@@ -45,7 +46,7 @@ __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supporte
 
 STARTER_FAMILIES = (
     begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
-    control, loads,
+    control, loads, rigid_bodies,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 

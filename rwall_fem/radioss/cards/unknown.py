@@ -20,7 +20,7 @@ KINDS = {
     **dict.fromkeys(("SHELL", "SH3N", "BEAM", "SPRING", "TRUSS", "QUAD", "TRIA", "BRIC20",
                      "TETRA10", "PENTA6", "SHEL16", "SPHCEL", "XELEM"), "element"),
     "INTER": "interface",
-    **dict.fromkeys(("RBODY", "RBE2", "RBE3", "RLINK", "CYL_JOINT", "GJOINT", "MERGE", "MPC",
+    **dict.fromkeys(("RBE2", "RBE3", "RLINK", "CYL_JOINT", "GJOINT", "MERGE", "MPC",
                      "BCS/CYCLIC", "BCS/LAGMUL"), "kinematic"),
     **dict.fromkeys(("LOAD", "IMPDISP", "IMPACC", "PBLAST", "PFLUID",
                      "INIVEL/ROT", "INIVEL/AXIS", "INISTA", "INIBRI", "INIGRAV", "REFSTA",
