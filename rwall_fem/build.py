@@ -206,6 +206,7 @@ class _Solid:
     elastic: Body
     dt_stable: float
     size: float
+    shells: bool = False  # a body of shells (rwall_fem.shells): elastic is its ShellBody
 
     @property
     def owned(self) -> int:
@@ -234,6 +235,14 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
             where = "mesh.file" if spec.file is not None else "mesh"
             raise SceneError(f"{scene.source}: {where}: {err}") from None
     cell = body.msh.topology.cell_type.name
+    if body.msh.topology.dim == 2:
+        from rwall_fem.shells.build import shell_solid
+
+        return shell_solid(scene, comm, body)
+    if spec is not None and spec.file is not None:
+        from rwall_fem.shells.build import solid_keys_on_shells
+
+        solid_keys_on_shells(scene, cell)
     if cell not in ("tetrahedron", "hexahedron"):
         raise SceneError(
             f"{scene.source}: mesh: {cell} cells; allowed: tetrahedra or hexahedra (a volume)"
@@ -343,7 +352,8 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     they act."""
     comm = solid.comm
     internal = solid.elastic
-    if any(part.material.model != "linear_elastic" for part in solid.parts):
+    nonlinear = any(part.material.model != "linear_elastic" for part in solid.parts)
+    if nonlinear and not solid.shells:
         internal = Body(solid.V, solid.parts, solid.u, solid.v, explicit=bool(scene.parts))
     internal.part_masses = solid.part_masses.copy()
     if reason := shared_velocities(internal, comm):
@@ -355,7 +365,13 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     held = internal.held[: solid.owned] > 0
     for k, part in enumerate(solid.parts):
         state.v[held[:, k]] = part.velocity
+    update = None
+    if solid.shells:
+        from rwall_fem.shells.update import ShellUpdate
+
+        update = ShellUpdate(state, internal)
     return Simulation(
+        update=update,
         state=state,
         end_time=scene.run.end_time,
         internal=internal,
@@ -533,7 +549,7 @@ def _secondary_nodes(
                 )
     selected = np.zeros(owned, dtype=bool)
     if sec.search_distance is None and not sec.add and not sec.parts:
-        if erodes:  # erosion bares the inside: every node may meet the wall
+        if erodes or solid.shells:  # erosion bares the inside; a shell's nodes are all on it
             selected[:] = True
         else:
             selected[_owned(boundary_nodes(V), owned)] = True

@@ -41,7 +41,7 @@ def test_every_key_carries_a_doc_and_numbers_a_unit():
         "dt_scale", "max_energy_error", "poisson", "hourglass_coefficient", "axis", "friction",
         "coefficient", "steps", "hardening_exponent", "strain_rate_coefficient",
         "softening_exponent", "taylor_quinney", "max_added_mass", "plastic_strain",
-        "d1", "d2", "d3", "d4", "d5",
+        "d1", "d2", "d3", "d4", "d5", "hourglass_coefficients", "shear_factor",
     }  # fmt: skip
     for where, _, cls in tables():
         assert cls.__table__.doc, where
