@@ -68,8 +68,6 @@ def _unsupported(scene) -> None:
 
 def _section(scene, i: int, spec, cell: str) -> ShellSection:
     """Part ``i``'s section from its [element] (the scene's when it gives none)."""
-    from rwall_fem.shells.elements import ShellTechnology
-
     element = spec.element
     where = f"part[{i}].element" if scene.parts else "element"
     thickness = element.thickness
@@ -80,6 +78,8 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             f"{scene.source}: {where}.thickness: missing: a mesh file of surfaces (shells) "
             "needs the shells' thickness (m)"
         )
+    from rwall_fem.shells.elements import ShellTechnology
+
     formulation = element.formulation or ("bsc" if cell == "triangle" else "bwc")
     hm, hf, hr = element.hourglass_coefficients
     try:
