@@ -341,8 +341,9 @@ def _step_fact(sim: Simulation) -> str:
         if step.mode == "adaptive"
         else "fixed"
     )
+    source = "L_c / c" if info["cell"] in ("quadrilateral", "triangle") else "eigenvalue"
     return (
-        f"time step {how}; at rest: stable {info['dt_stable']:.4g} s (eigenvalue), smallest "
+        f"time step {how}; at rest: stable {info['dt_stable']:.4g} s ({source}), smallest "
         f"L/c of a cell {info['dt_element_estimate']:.4g} s; dt = {sim.state.dt:.4g} s"
     )
 

@@ -228,13 +228,19 @@ class ShellBody:
         return 0.0
 
     def cell_fields(self, state) -> dict[str, np.ndarray]:
-        """Values per owned cell for the outputs: the parts' cell fields and, for a body of
-        parts, ``"part"``, the part's index."""
+        """Values per owned cell for the outputs: the parts' cell fields (the plane stresses
+        of a surface as ``<name>_xx``, ``_yy``, ``_xy``) and, for a body of parts,
+        ``"part"``, the part's index."""
         owned = self.V.mesh.topology.index_map(self.V.mesh.topology.dim).size_local
         fields: dict[str, np.ndarray] = {}
         for part, force in zip(self.parts, self.elements, strict=True):
             for name, values in force.cell_fields(state).items():
-                fields.setdefault(name, np.zeros(owned))[part.cells] = values
+                if values.ndim == 2:  # the plane stresses of a surface, local frame: Pa
+                    for component, row in zip(("xx", "yy", "xy"), values, strict=True):
+                        fields.setdefault(f"{name}_{component}", np.zeros(owned))[
+                            part.cells] = row  # fmt: skip
+                else:
+                    fields.setdefault(name, np.zeros(owned))[part.cells] = values
         if self.explicit:
             index = np.zeros(owned)
             for k, part in enumerate(self.parts):

@@ -81,17 +81,13 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
     from rwall_fem.shells.elements import ShellTechnology
 
     formulation = element.formulation or ("bsc" if cell == "triangle" else "bwc")
-    hm, hf, hr = element.hourglass_coefficients
     try:
         technology = ShellTechnology.choose(
             cell,
+            formulation,
             points=element.points,
-            hm=hm,
-            hf=hf,
-            hr=hr,
-            warping=formulation == "bwc",
+            hourglass=element.hourglass_coefficients,
             shear_factor=element.shear_factor,
-            plastic=spec.material.plastic,
         )
     except ValueError as err:
         raise SceneError(f"{scene.source}: {where}: {err}") from None
