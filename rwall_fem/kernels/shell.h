@@ -1,0 +1,151 @@
+/* What the shell kernels share: their constants, the plane-stress J2 return and the
+ * through-thickness rule (docs/theory.md, "Shells").
+ *
+ * Plane stress (sigma_zz = 0) in the cell's local frame; in-plane stresses and strains are
+ * (xx, yy, xy) with the engineering shear strain gamma_xy = 2 eps_xy.  Hooke's law is
+ * sigma = C eps, C = E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]].
+ *
+ * The J2 return is exact for plane stress (Simo and Taylor 1985; Simo and Hughes,
+ * Computational Inelasticity, section 3.4): with p = sxx + syy, d = syy - sxx and the
+ * trial stress of the elastic predictor, the stress after a plastic multiplier g is
+ *     p(g) = p_tr / (1 + k1 g),  d(g) = d_tr / (1 + 2 G g),  sxy(g) = sxy_tr / (1 + 2 G g),
+ * k1 = E / (3 (1 - nu)), G = E / (2 (1 + nu)); its von Mises stress is
+ *     q(g)^2 = p(g)^2 / 4 + 3 d(g)^2 / 4 + 3 sxy(g)^2
+ * and the equivalent plastic strain grows by (2/3) g q(g).  g solves
+ *     F(g) = q(g) - sigma_y(eps_p + (2/3) g q(g)) = 0,
+ * F decreasing in g: Newton's method kept inside the bracket [0, (q_tr / sigma_y0 - 1) / k1]
+ * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2).  The normal stress through
+ * the thickness is zero at every step by construction, and the plastic flow of the 3-D J2
+ * law with sigma_zz = 0 is reproduced exactly (the thickness strain follows from it).
+ * The flow stress is capped at s->max_flow_stress (Radioss LAW2's SIG_max0).
+ */
+#ifndef RWALL_SHELL_H
+#define RWALL_SHELL_H
+
+#include "failure.h"
+
+#define SHELL_MAX_POINTS 10
+#define SHELL_POINT_SLOTS 5 /* sxx, syy, sxy (Pa), eps_p, temperature (K) */
+
+/* The shell's constants of one kernel call (beside the material's element_params). */
+typedef struct
+{
+  const double *thickness; /* per cell, m */
+  int points;              /* N: integration points through the thickness (plastic kernels) */
+  double zeta[SHELL_MAX_POINTS];   /* their heights over t, bottom to top (scaled: see below) */
+  double weight[SHELL_MAX_POINTS]; /* their weights, summing to 1 */
+  double young, poisson;   /* E (Pa), nu */
+  double shear_factor;     /* of the transverse shear, 5/6 */
+  double bar_speed;        /* sqrt(E / (rho (1 - nu^2))), m/s */
+  double hm, hf, hr;       /* viscous hourglass coefficients: membrane, out-of-plane, rotation */
+  double max_flow_stress;  /* Pa (+inf: no cap) */
+  double fail_fraction;    /* a cell fails when this share of its points has failed */
+  int warping;             /* 1: project out the rigid motion (warped cells), 0: plain BT */
+  int omit_energy;         /* 1: skip the stored-energy sum (0 by default) */
+} shell_params;
+
+/* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
+INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
+{
+  const double E = s->young, nu = s->poisson, c = E / (1.0 - nu * nu), G = 0.5 * E / (1.0 + nu);
+  out[0] += scale * (c * (de[0] + nu * de[1]));
+  out[1] += scale * (c * (de[1] + nu * de[0]));
+  out[2] += scale * (G * de[2]);
+}
+
+/* sigma . C^-1 sigma (J/m^3 times 2) of a plane stress. */
+INLINE vec compliance_product(const shell_params *s, vec sxx, vec syy, vec sxy)
+{
+  const double E = s->young, nu = s->poisson;
+  return (1.0 / E) * (sxx * sxx + syy * syy - (2.0 * nu) * sxx * syy
+                      + (2.0 * (1.0 + nu)) * sxy * sxy);
+}
+
+/* The capped flow stress and its slope (0 where the cap holds). */
+INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, vec e, vec rate,
+                              vec T, vec *slope)
+{
+  const vec y = flow_stress(p, e, rate, T, slope);
+  const ivec capped = y > s->max_flow_stress;
+  *slope = vselect(capped, VZERO, *slope);
+  return vselect(capped, VZERO + s->max_flow_stress, y);
+}
+
+/* The exact plane-stress J2 return of the trial stress sig[3] (xx, yy, xy; Pa, in/out) at
+ * plastic strain eps_p, strain rate `rate` (1/s) and temperature T (K): returns the plastic
+ * strain increment (0 in elastic lanes); *flow = the flow stress after the step. */
+INLINE vec plane_stress_return(const element_params *p, const shell_params *s, vec sig[3],
+                               vec eps_p, vec rate, vec T, vec *flow)
+{
+  const double E = s->young, nu = s->poisson;
+  const double k1 = E / (3.0 * (1.0 - nu)), g2 = E / (1.0 + nu);
+  const vec pp = sig[0] + sig[1], dd = sig[1] - sig[0], xy = sig[2];
+  const vec P1 = 0.25 * pp * pp, P2 = 0.75 * dd * dd + 3.0 * xy * xy;
+  const vec q_trial = vsqrt(P1 + P2);
+  vec slope;
+  const vec y0 = capped_flow_stress(p, s, eps_p, rate, T, &slope);
+  const ivec plastic = q_trial > y0;
+  *flow = y0;
+  if (!any_lane(plastic))
+    return VZERO;
+  /* F(0) = q_tr - y0 > 0; first guess from the linearisation at g = 0 */
+  const vec safe_q = vselect(plastic, q_trial, VZERO + 1.0);
+  vec lo = VZERO, hi = (safe_q / vmax(y0, VZERO + 1e-300) - 1.0) * (1.0 / k1);
+  vec g = (safe_q - y0)
+          / ((P1 * k1 + P2 * g2) / safe_q + (2.0 / 3.0) * vmax(slope, VZERO) * safe_q);
+  g = vselect(plastic, vmin(vmax(g, VZERO), hi), VZERO);
+  vec q = safe_q;
+  for (int iteration = 0; iteration < 50; ++iteration)
+  {
+    const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
+    q = vsqrt(P1 * a * a + P2 * b * b);
+    const vec dq = -(P1 * k1 * a * a * a + P2 * g2 * b * b * b) / q;
+    const vec e = eps_p + (2.0 / 3.0) * g * q;
+    vec h;
+    const vec F = q - capped_flow_stress(p, s, e, rate, T, &h);
+    lo = vselect(F > 0.0, g, lo);
+    hi = vselect(F < 0.0, g, hi);
+    const vec dF = dq - vmax(h, VZERO) * (2.0 / 3.0) * (q + g * dq);
+    vec next = g - F / dF;
+    next = vselect((next <= lo) | (next >= hi), 0.5 * (lo + hi), next);
+    const vec change = vabs(next - g);
+    g = vselect(plastic, next, VZERO);
+    if (!any_lane(plastic & (change > 1e-15 * g + 1e-300)))
+      break;
+  }
+  const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
+  q = vsqrt(P1 * a * a + P2 * b * b);
+  const vec p_new = pp * a, d_new = dd * b;
+  sig[0] = 0.5 * (p_new - d_new);
+  sig[1] = 0.5 * (p_new + d_new);
+  sig[2] = xy * b;
+  const vec d = vselect(plastic, (2.0 / 3.0) * g * q, VZERO);
+  vec unused;
+  *flow = capped_flow_stress(p, s, eps_p + d, rate, T, &unused);
+  return d;
+}
+
+/* One step at a through-thickness point: the stress sig[3] (in/out), eps_p and T (in/out)
+ * from the strain increment de[3] (xx, yy, gamma_xy) over p->dt; what the step did in
+ * *done (for the failure criteria).  Returns the plastic dissipation density (J/m^3). */
+INLINE vec shell_point_update(const element_params *p, const shell_params *s, vec sig[3],
+                              vec *eps_p, vec *T, const vec de[3], point_step *done)
+{
+  hooke_add(s, VZERO + 1.0, de, sig);
+  /* equivalent deviatoric strain rate with the incompressible thickness strain */
+  const vec dz = -(de[0] + de[1]);
+  const vec dd = de[0] * de[0] + de[1] * de[1] + dz * dz + 0.5 * de[2] * de[2];
+  const vec rate = p->dt > 0.0 ? vsqrt((2.0 / 3.0) * dd) * (1.0 / p->dt) : VZERO;
+  vec flow;
+  const vec d = plane_stress_return(p, s, sig, *eps_p, rate, *T, &flow);
+  *eps_p += d;
+  const vec dissipation = flow * d;
+  done->increment = d;
+  done->rate = rate;
+  done->triaxiality = vselect(d > 0.0, ((1.0 / 3.0) * (sig[0] + sig[1])) / flow, VZERO);
+  if (p->thermal)
+    *T += (p->taylor_quinney / (p->density * p->specific_heat)) * dissipation;
+  return dissipation;
+}
+
+#endif

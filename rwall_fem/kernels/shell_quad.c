@@ -1,0 +1,479 @@
+/* Internal force of the Belytschko-Lin-Tsay quadrilateral shell (one in-plane point,
+ * co-rotational frame, viscous hourglass control), batched over cells like the solids'.
+ *
+ * Notation (docs/theory.md, "Shells"): nodes I = 0..3 counter-clockwise (the caller
+ * reorders DOLFINx's (0, 1, 3, 2)).  Each cycle the cell gets a local frame: e3 along
+ * d02 x d13 (the diagonals), e1 along the projected xi direction x1 + x2 - x0 - x3,
+ * e2 = e3 x e1.  The local coordinates (x_I, y_I, z_I) of the nodes about the centroid
+ * have z_I = h (1, -1, 1, -1) (h = 0: a flat cell; h != 0: a warped one).  At the
+ * centre, with 2A = x20 y31 - x31 y20 (A the projected area),
+ *     b1 = (y13, y20, y31, y02) / 2A,  b2 = (x31, x02, x13, x20) / 2A   (dN_I/dx, dN_I/dy).
+ * Mindlin kinematics: a fibre at height z moves with v + z (theta_y, -theta_x, 0), so the
+ * velocity strains are, with v, theta the nodal velocities in the local frame,
+ *     membrane   d = (b1.vx, b2.vy, b2.vx + b1.vy),
+ *     curvature  k = (b1.ty, -b2.tx, b2.ty - b1.tx),
+ *     shear      g = (b1.vz + mean ty, b2.vz - mean tx),
+ * and the strain at height z is d + z k.  Stress resultants N (membrane), M (moments) and
+ * Q (transverse shear, shear factor 5/6, elastic) act back through the transposed relations
+ * (the power A (N.d + M.k + Q.g) equals f.v + m.theta).  The element has no drilling
+ * stiffness: its moment about e3 is zero.
+ *
+ * Warping (s->warping, Belytschko-Wong-Chiang's correction by the rigid-body projection of
+ * Belytschko and Leviathan): a rigid rotation (Ox, Oy) about the in-plane axes gives the
+ * nodes of a warped cell the in-plane velocities (Oy z_I, -Ox z_I), which plain BT takes for
+ * an hourglass motion (and whose forces are not in moment equilibrium).  The rigid rotation
+ * of the cell is Ox = b2.vz, Oy = -b1.vz; its part is removed from the in-plane velocities,
+ *     vx'_I = vx_I - z_I Oy,  vy'_I = vy_I + z_I Ox,
+ * before the strains and hourglass rates are taken, and the forces come back through the
+ * transpose (fz_J += b1_J sum_I z_I fx_I + b2_J sum_I z_I fy_I): any rigid motion then gives
+ * exactly zero strain rates, and the nodal forces and moments of any stress are in
+ * equilibrium.
+ *
+ * Hourglass (viscous, Belytschko-Tsay): gamma_I = (G_I - (G.x) b1_I - (G.y) b2_I) / 4 with
+ * G = (1, -1, 1, -1), orthogonal to every linear field; rates qm = gamma.v' (in-plane),
+ * qw = gamma.vz, qr = gamma.theta; generalized forces C q with C = 4 rho c t sqrt(A) times
+ * hm (membrane), hf (out of plane) and hr t^2 / 12 (rotations), c the bar speed.  hm = 0.01
+ * is 1 % of the damping that is critical for a mode of frequency 2 c / sqrt(A) of a square
+ * cell; their dissipation dt C q.q is the hourglass energy.
+ *
+ * Rate form over the step dt = p->dt: the strain increments are dt times the velocity
+ * strains of v, theta (v^{n-1/2}) in the mid-step configuration x - dt v / 2 (a rigid
+ * motion gives none, whatever its rotation); the resultants, kept in the local frame, are
+ * updated; their forces are those of the current configuration x = X + u.  The hourglass
+ * rates and forces are those of the mid-step configuration, where a rigid motion has
+ * exactly none (in the current one it would have rates of order dt |omega|^2 L, and a
+ * spinning body would dissipate).
+ *
+ * Elastic cells keep the resultants (state rows 0..7: Nxx, Nyy, Nxy, Mxx, Myy, Mxy, Qx, Qy).
+ * Elasto-plastic cells keep Qx, Qy (rows 0, 1) and, at each of s->points points through the
+ * thickness (heights zeta_k t, weights w_k, shell.h), SHELL_POINT_SLOTS rows from
+ * 2 + SHELL_POINT_SLOTS k: the stress (plane, exact J2 return of shell.h), plastic strain and
+ * temperature; N = t sum w_k sigma_k, M = t^2 sum w_k zeta_k sigma_k; with a failure
+ * criterion the damage of point k at row p->damage_slot + k.  A point whose damage reaches 1
+ * carries no stress from then on (its elastic energy is booked as dissipated), and a cell
+ * fails when the share s->fail_fraction of its points has failed; erosion as failure.h
+ * (the nodal moments and rotations count in the energy the cell leaves with).
+ *
+ * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
+ * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable
+ * step is L_c / c with Radioss's L_c = max(A / longest diagonal, shortest side or diagonal)
+ * in the current configuration (times p->calibration), noted in `step` (step.h).
+ */
+#include "shell.h"
+
+static const double WARP_SIGN[4] = {1.0, -1.0, 1.0, -1.0};
+
+typedef struct
+{
+  vec e[3][3];                 /* e1, e2, e3: their global components */
+  vec x[4], y[4], z[4];        /* local coordinates of the nodes about the centroid, m */
+  vec area;                    /* projected area A, m^2 */
+  vec b1[4], b2[4];            /* dN_I/dx, dN_I/dy at the centre, 1/m */
+} quad_frame_t;
+
+/* The local frame and centre gradients of the cells at x[3 I + i]. */
+INLINE void quad_frame(const vec *restrict x, quad_frame_t *g)
+{
+  vec c[3], d1[3], d2[3], t[3];
+  for (int i = 0; i < 3; ++i)
+  {
+    c[i] = 0.25 * (x[i] + x[3 + i] + x[6 + i] + x[9 + i]);
+    d1[i] = x[6 + i] - x[i];
+    d2[i] = x[9 + i] - x[3 + i];
+    t[i] = x[3 + i] + x[6 + i] - x[i] - x[9 + i];
+  }
+  vec *e1 = g->e[0], *e2 = g->e[1], *e3 = g->e[2];
+  cross(d1, d2, e3);
+  const vec inv_n = 1.0 / vsqrt(dot3(e3, e3));
+  for (int i = 0; i < 3; ++i)
+    e3[i] *= inv_n;
+  const vec tn = dot3(t, e3);
+  for (int i = 0; i < 3; ++i)
+    t[i] -= tn * e3[i];
+  const vec inv_t = 1.0 / vsqrt(dot3(t, t));
+  for (int i = 0; i < 3; ++i)
+    e1[i] = t[i] * inv_t;
+  cross(e3, e1, e2);
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec r[3] = {x[3 * I] - c[0], x[3 * I + 1] - c[1], x[3 * I + 2] - c[2]};
+    g->x[I] = dot3(r, e1);
+    g->y[I] = dot3(r, e2);
+    g->z[I] = dot3(r, e3);
+  }
+  const vec *X = g->x, *Y = g->y;
+  const vec two_area = (X[2] - X[0]) * (Y[3] - Y[1]) - (X[3] - X[1]) * (Y[2] - Y[0]);
+  const vec inv = 1.0 / two_area;
+  g->area = 0.5 * two_area;
+  g->b1[0] = (Y[1] - Y[3]) * inv, g->b1[1] = (Y[2] - Y[0]) * inv;
+  g->b1[2] = (Y[3] - Y[1]) * inv, g->b1[3] = (Y[0] - Y[2]) * inv;
+  g->b2[0] = (X[3] - X[1]) * inv, g->b2[1] = (X[0] - X[2]) * inv;
+  g->b2[2] = (X[1] - X[3]) * inv, g->b2[3] = (X[2] - X[0]) * inv;
+}
+
+/* The local components out[I][k] of the nodal vectors a[3 I + i] (k < 3). */
+INLINE void to_local(const quad_frame_t *g, const vec *restrict a, vec out[4][3])
+{
+  for (int I = 0; I < 4; ++I)
+    for (int k = 0; k < 3; ++k)
+      out[I][k] = g->e[k][0] * a[3 * I] + g->e[k][1] * a[3 * I + 1] + g->e[k][2] * a[3 * I + 2];
+}
+
+/* Remove the rigid rotation about the in-plane axes from the in-plane velocities (in place). */
+INLINE void project_rigid(const quad_frame_t *g, vec vl[4][3])
+{
+  vec ox = VZERO, oy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    ox += g->b2[I] * vl[I][2];
+    oy -= g->b1[I] * vl[I][2];
+  }
+  for (int I = 0; I < 4; ++I)
+  {
+    vl[I][0] -= g->z[I] * oy;
+    vl[I][1] += g->z[I] * ox;
+  }
+}
+
+/* The transpose of project_rigid on local nodal forces fl (in place). */
+INLINE void project_rigid_forces(const quad_frame_t *g, vec fl[4][3])
+{
+  vec sx = VZERO, sy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    sx += g->z[I] * fl[I][0];
+    sy += g->z[I] * fl[I][1];
+  }
+  for (int I = 0; I < 4; ++I)
+    fl[I][2] += g->b1[I] * sx + g->b2[I] * sy;
+}
+
+/* Membrane (xx, yy, gamma_xy), curvature and transverse shear velocity strains. */
+INLINE void quad_strain_rates(const quad_frame_t *g, const vec vl[4][3], const vec wl[4][3],
+                              vec d[3], vec k[3], vec gs[2])
+{
+  for (int i = 0; i < 3; ++i)
+    d[i] = k[i] = VZERO;
+  gs[0] = gs[1] = VZERO;
+  vec tx = VZERO, ty = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec b1 = g->b1[I], b2 = g->b2[I];
+    d[0] += b1 * vl[I][0];
+    d[1] += b2 * vl[I][1];
+    d[2] += b2 * vl[I][0] + b1 * vl[I][1];
+    k[0] += b1 * wl[I][1];
+    k[1] -= b2 * wl[I][0];
+    k[2] += b2 * wl[I][1] - b1 * wl[I][0];
+    gs[0] += b1 * vl[I][2];
+    gs[1] += b2 * vl[I][2];
+    tx += wl[I][0];
+    ty += wl[I][1];
+  }
+  gs[0] += 0.25 * ty;
+  gs[1] -= 0.25 * tx;
+}
+
+/* Add the local forces fl[I] and moments ml[I] (x, y) to the global fe[3 I + i] (forces)
+ * and fe[12 + 3 I + i] (moments). */
+INLINE void add_global(const quad_frame_t *g, const vec fl[4][3], const vec ml[4][2],
+                       vec *restrict fe)
+{
+  for (int I = 0; I < 4; ++I)
+    for (int i = 0; i < 3; ++i)
+    {
+      fe[3 * I + i] += fl[I][0] * g->e[0][i] + fl[I][1] * g->e[1][i] + fl[I][2] * g->e[2][i];
+      fe[12 + 3 * I + i] += ml[I][0] * g->e[0][i] + ml[I][1] * g->e[1][i];
+    }
+}
+
+/* The nodal forces and moments of the resultants N, M, Q on the cells of frame g, added
+ * to fe (global). */
+INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec N[3],
+                                  const vec M[3], const vec Q[2], vec *restrict fe)
+{
+  vec fl[4][3], ml[4][2];
+  const vec A = g->area;
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec b1 = A * g->b1[I], b2 = A * g->b2[I];
+    fl[I][0] = b1 * N[0] + b2 * N[2];
+    fl[I][1] = b2 * N[1] + b1 * N[2];
+    fl[I][2] = b1 * Q[0] + b2 * Q[1];
+    ml[I][0] = -b2 * M[1] - b1 * M[2] - (0.25 * A) * Q[1];
+    ml[I][1] = b1 * M[0] + b2 * M[2] + (0.25 * A) * Q[0];
+  }
+  if (warping)
+    project_rigid_forces(g, fl);
+  add_global(g, fl, ml, fe);
+}
+
+/* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
+ * velocities vl (projected when warping) and angular velocities wl; returns their power, W. */
+INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double density,
+                          vec thickness, int warping, const vec vl[4][3], const vec wl[4][3],
+                          vec *restrict fe)
+{
+  vec gx = VZERO, gy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    gx += WARP_SIGN[I] * g->x[I];
+    gy += WARP_SIGN[I] * g->y[I];
+  }
+  vec gamma[4], q[5] = {VZERO, VZERO, VZERO, VZERO, VZERO};
+  for (int I = 0; I < 4; ++I)
+  {
+    gamma[I] = 0.25 * (WARP_SIGN[I] - gx * g->b1[I] - gy * g->b2[I]);
+    for (int k = 0; k < 3; ++k)
+      q[k] += gamma[I] * vl[I][k];
+    q[3] += gamma[I] * wl[I][0];
+    q[4] += gamma[I] * wl[I][1];
+  }
+  const vec C = (4.0 * density * s->bar_speed) * thickness * vsqrt(g->area);
+  const vec Cm = s->hm * C, Cf = s->hf * C, Cr = (s->hr / 12.0) * C * thickness * thickness;
+  const vec Q[5] = {Cm * q[0], Cm * q[1], Cf * q[2], Cr * q[3], Cr * q[4]};
+  vec fl[4][3], ml[4][2];
+  for (int I = 0; I < 4; ++I)
+  {
+    for (int k = 0; k < 3; ++k)
+      fl[I][k] = gamma[I] * Q[k];
+    ml[I][0] = gamma[I] * Q[3];
+    ml[I][1] = gamma[I] * Q[4];
+  }
+  if (warping)
+    project_rigid_forces(g, fl);
+  add_global(g, fl, ml, fe);
+  vec power = VZERO;
+  for (int k = 0; k < 5; ++k)
+    power += Q[k] * q[k];
+  return power;
+}
+
+/* Radioss's characteristic length (m) of the cells of frame g. */
+INLINE vec quad_length(const quad_frame_t *g)
+{
+  vec l2[6];
+  static const int PAIRS[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
+  for (int e = 0; e < 6; ++e)
+  {
+    const vec dx = g->x[PAIRS[e][1]] - g->x[PAIRS[e][0]];
+    const vec dy = g->y[PAIRS[e][1]] - g->y[PAIRS[e][0]];
+    const vec dz = g->z[PAIRS[e][1]] - g->z[PAIRS[e][0]];
+    l2[e] = dx * dx + dy * dy + dz * dz;
+  }
+  vec shortest = l2[0];
+  for (int e = 1; e < 6; ++e)
+    shortest = vmin(shortest, l2[e]);
+  const vec dynamic = g->area * g->area / vmax(l2[4], l2[5]);
+  return vsqrt(vmax(dynamic, shortest));
+}
+
+INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict cells,
+                       const double *restrict X, const double *restrict u,
+                       const double *restrict v, const double *restrict w,
+                       const element_params *p, const shell_params *s, double *restrict state,
+                       int64_t stride, double *restrict f, double *restrict m,
+                       double *restrict energy, double *restrict step)
+{
+  const double dt = p->dt, ks = s->shear_factor * 0.5 * s->young / (1.0 + s->poisson);
+  const int warping = s->warping, npt = s->points;
+  double stored_total = 0.0, hourglass_total = 0.0, plastic_total = 0.0;
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
+  {
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
+    gather(cells, 4, &b, X, Xe);
+    gather(cells, 4, &b, u, ue);
+    gather(cells, 4, &b, v, ve);
+    gather(cells, 4, &b, w, we);
+    for (int i = 0; i < 12; ++i)
+    {
+      x[i] = Xe[i] + ue[i];
+      xm[i] = x[i] - (0.5 * dt) * ve[i];
+      du[i] = dt * ve[i];
+      du[12 + i] = dt * we[i];
+    }
+    for (int i = 0; i < 24; ++i)
+      fe[i] = VZERO;
+    const vec t = cell_values(s->thickness, &b);
+    quad_frame_t g;
+    quad_frame(xm, &g);
+    vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
+    to_local(&g, ve, vl);
+    to_local(&g, we, wl);
+    if (warping)
+      project_rigid(&g, vl);
+    quad_strain_rates(&g, vl, wl, d, k, gs);
+    vec hourglass = VZERO;
+    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0)
+      hourglass = dt * quad_hourglass(&g, s, p->density, t, warping, vl, wl, fe);
+    const vec mid_area = g.area;
+    for (int i = 0; i < 3; ++i)
+    {
+      d[i] *= dt;
+      k[i] *= dt;
+    }
+    vec N[3] = {VZERO, VZERO, VZERO}, M[3] = {VZERO, VZERO, VZERO}, Q[2];
+    vec elastic = VZERO, dissipated = VZERO, damage = VZERO;
+    if (!plastic)
+    {
+      for (int i = 0; i < 3; ++i)
+      {
+        N[i] = load_slot(state, stride, &b, i);
+        M[i] = load_slot(state, stride, &b, 3 + i);
+      }
+      Q[0] = load_slot(state, stride, &b, 6);
+      Q[1] = load_slot(state, stride, &b, 7);
+      hooke_add(s, t, d, N);
+      hooke_add(s, (1.0 / 12.0) * t * t * t, k, M);
+      for (int i = 0; i < 3; ++i)
+      {
+        store_slot(state, stride, &b, i, N[i]);
+        store_slot(state, stride, &b, 3 + i, M[i]);
+      }
+      Q[0] += (ks * dt) * t * gs[0];
+      Q[1] += (ks * dt) * t * gs[1];
+      store_slot(state, stride, &b, 6, Q[0]);
+      store_slot(state, stride, &b, 7, Q[1]);
+      if (!s->omit_energy)
+        elastic = compliance_product(s, N[0], N[1], N[2]) * (0.5 / t)
+                  + compliance_product(s, M[0], M[1], M[2]) * (6.0 / (t * t * t));
+    }
+    else
+    {
+      Q[0] = load_slot(state, stride, &b, 0) + (ks * dt) * t * gs[0];
+      Q[1] = load_slot(state, stride, &b, 1) + (ks * dt) * t * gs[1];
+      store_slot(state, stride, &b, 0, Q[0]);
+      store_slot(state, stride, &b, 1, Q[1]);
+      vec failed_points = VZERO;
+      for (int pt = 0; pt < npt; ++pt)
+      {
+        const int base = 2 + SHELL_POINT_SLOTS * pt;
+        const vec z = s->zeta[pt] * t, wt = s->weight[pt] * t;
+        vec sig[3], eps_p, T, de[3];
+        for (int i = 0; i < 3; ++i)
+        {
+          sig[i] = load_slot(state, stride, &b, base + i);
+          de[i] = d[i] + z * k[i];
+        }
+        eps_p = load_slot(state, stride, &b, base + 3);
+        T = load_slot(state, stride, &b, base + 4);
+        vec D = VZERO;
+        if (p->failure)
+          D = load_slot(state, stride, &b, p->damage_slot + pt);
+        const ivec dead = D >= 1.0;
+        point_step done;
+        vec dissipation = shell_point_update(p, s, sig, &eps_p, &T, de, &done);
+        if (p->failure)
+        {
+          done.increment = vselect(dead, VZERO, done.increment);
+          const vec D_new = vmax(D, accumulate_damage(p, state, stride, &b,
+                                                      p->damage_slot + pt, &done, T));
+          const ivec gone = D_new >= 1.0;
+          /* a point failing now gives up its elastic energy as dissipation */
+          const vec held = 0.5 * compliance_product(s, sig[0], sig[1], sig[2]);
+          dissipation = vselect(dead, VZERO, dissipation + vselect(gone, held, VZERO));
+          for (int i = 0; i < 3; ++i)
+            sig[i] = vselect(gone, VZERO, sig[i]);
+          failed_points += vselect(gone, VZERO + 1.0, VZERO);
+        }
+        for (int i = 0; i < 3; ++i)
+        {
+          store_slot(state, stride, &b, base + i, sig[i]);
+          N[i] += wt * sig[i];
+          M[i] += (wt * z) * sig[i];
+        }
+        store_slot(state, stride, &b, base + 3, eps_p);
+        store_slot(state, stride, &b, base + 4, T);
+        if (!s->omit_energy)
+          elastic += (0.5 * wt) * compliance_product(s, sig[0], sig[1], sig[2]);
+        dissipated += wt * dissipation;
+      }
+      if (p->failure)
+        damage = vselect(failed_points >= s->fail_fraction * npt - 1e-9, VZERO + 1.0, VZERO);
+    }
+    if (!s->omit_energy)
+      elastic += (Q[0] * Q[0] + Q[1] * Q[1]) * (0.5 / ks) / t;
+    quad_frame(x, &g);
+    quad_resultant_forces(&g, warping, N, M, Q, fe);
+    elastic *= g.area;
+    const vec plastic_work = dissipated * mid_area;
+    const ivec inverted = ~(g.area > 0.0);
+    vec dte = VZERO + INFINITY;
+    if (p->estimate)
+      dte = (p->calibration / s->bar_speed) * quad_length(&g);
+    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
+                                      &hourglass, du, fe, 8, energy, step);
+    stored_total += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    hourglass_total += lane_sum(hourglass, b.nb);
+    plastic_total += lane_sum(plastic_work, b.nb);
+    scatter_add(cells, 4, &b, fe, f);
+    scatter_add(cells, 4, &b, fe + 12, m);
+    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 4, step);
+  }
+  energy[0] += stored_total;
+  energy[1] += hourglass_total;
+  energy[2] += plastic_total;
+}
+
+/* f += internal forces (N), m += internal moments (N m) of the quadrilaterals `cells` (n x 4,
+ * counter-clockwise), nodes at X + u (m), velocities v (m/s) and angular velocities w
+ * (rad/s, global); the state rows as the header says; energies and steps as above. */
+void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                        const double *v, const double *w, const element_params *p,
+                        const shell_params *s, double *state, int64_t stride, double *f,
+                        double *m, double *energy, double *step)
+{
+  shell_quad(0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+}
+
+void shell_quad_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                        const double *v, const double *w, const element_params *p,
+                        const shell_params *s, double *state, int64_t stride, double *f,
+                        double *m, double *energy, double *step)
+{
+  shell_quad(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+}
+
+/* The projected area (m^2) and characteristic length (m) of each quadrilateral at x. */
+void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
+                      double *length)
+{
+  vec xe[12];
+  for (int64_t k0 = 0; k0 < n; k0 += LANES)
+  {
+    const batch_t b = batch_at(NULL, k0, n);
+    gather(cells, 4, &b, x, xe);
+    quad_frame_t g;
+    quad_frame(xe, &g);
+    const vec l = quad_length(&g);
+    for (int k = 0; k < b.nb; ++k)
+    {
+      area[k0 + k] = g.area[k];
+      length[k0 + k] = l[k];
+    }
+  }
+}
+
+/* The plane-stress point update of shell.h at one point (for tests and material drivers):
+ * stress (xx, yy, xy; Pa), plastic strain and temperature in place from the strain increment
+ * de (xx, yy, gamma_xy); returns the plastic dissipation density (J/m^3). */
+double shell_point(const element_params *p, const shell_params *s, double sigma[3],
+                   double *eps_p, double *T, const double de[3])
+{
+  vec sig[3], e = VZERO + *eps_p, temperature = VZERO + *T, d[3];
+  for (int i = 0; i < 3; ++i)
+  {
+    sig[i] = VZERO + sigma[i];
+    d[i] = VZERO + de[i];
+  }
+  point_step done;
+  const vec dissipation = shell_point_update(p, s, sig, &e, &temperature, d, &done);
+  for (int i = 0; i < 3; ++i)
+    sigma[i] = sig[i][0];
+  *eps_p = e[0];
+  *T = temperature[0];
+  return dissipation[0];
+}
