@@ -172,6 +172,10 @@ def _cells(mesh) -> float:
     """Cells of the built-in body ``mesh`` (a MeshSpec): section cells x layers."""
     h = mesh.element_size
     refine = mesh.refine_size is not None
+    if mesh.shape == "tube":  # shells: the perimeter's segments x the layers along it
+        side = mesh.width if mesh.section == "square" else math.pi * mesh.width / 4
+        quads = 4 * math.ceil(side / h - 1e-9) * math.ceil(mesh.length / h - 1e-9)
+        return quads * (2.0 if mesh.cell == "triangle" else 1.0)
     if mesh.shape == "round_bar":
         length = mesh.length
     else:

@@ -38,6 +38,7 @@ __all__ = [
     "read_mesh",
     "rotation_to",
     "round_bar_mesh",
+    "tube_mesh",
 ]
 
 
@@ -103,6 +104,10 @@ def body_mesh(comm: MPI.Comm, spec, max_cells: float | None = None) -> BodyMesh:
         return bar_mesh(comm, spec.origin, spec.size, **common)
     if spec.shape == "round_bar":
         return round_bar_mesh(comm, spec.origin, spec.radius, spec.length, **common)
+    if spec.shape == "tube":
+        trigger = (spec.trigger_amplitude, spec.trigger_wavelength)
+        return tube_mesh(comm, spec.origin, spec.width, spec.length, spec.element_size,
+                         spec.cell, spec.section, spec.axis, trigger, max_cells)  # fmt: skip
     if spec.shape == "plate" and spec.cell in SURFACE_CELLS:
         return plate_surface_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell,
                                   spec.axis, max_cells)  # fmt: skip
@@ -222,6 +227,68 @@ def plate_surface_mesh(
     x = body.msh.geometry.x
     x[:] = (x - origin) @ rotation_to(axis).T + origin
     return body
+
+
+def tube_mesh(
+    comm: MPI.Comm,
+    origin,
+    width: float,
+    length: float,
+    element_size: float,
+    cell: str,
+    section: str = "square",
+    axis=(0.0, 0.0, 1.0),
+    trigger: tuple[float, float] = (0.0, 0.0),
+    max_cells: float | None = None,
+) -> BodyMesh:
+    """Thin-walled tube as a mid-surface, for shells (``meshes/tube.geo``): a ``section``
+    "square" of side ``width`` or "circle" of diameter ``width`` (m), along its own z over
+    ``length`` (m) from ``origin`` (the centre of its bottom end), turned about ``origin``
+    onto ``axis``; ``cell`` "quadrilateral" or "triangle". Region "body"; ends "bottom" and
+    "top".
+
+    ``trigger`` = (amplitude, wavelength) (m; 0: none) dents the last wavelength before the
+    top end, where a crush should start to fold: the wall moves along its normal by
+    amplitude x sin(2 pi zeta) (zeta from 0 to 1 over that wavelength: one lobe in, one
+    out), on a square's faces also x sin(pi xi) across the face (0 at the corners, which
+    stay) with the sign alternating from face to face (the progressive folding mode of
+    square tubes); a circle's whole ring moves (the concertina mode)."""
+    params = {"width": width, "length": length, "section": int(section == "circle")}
+    params |= {"quadrangles": int(cell == "quadrilateral"), "h": element_size}
+    origin = np.asarray(origin, dtype=float)
+    params |= dict(zip(("x0", "y0", "z0"), origin, strict=True))
+    with importlib.resources.as_file(
+        importlib.resources.files("rwall_fem.meshes") / "tube.geo"
+    ) as path:
+        body = read_mesh(comm, path, params, max_cells)
+    x = body.msh.geometry.x
+    amplitude, wavelength = trigger
+    if amplitude > 0.0:
+        x[:] = origin + _dented(x - origin, width, length, section, amplitude, wavelength)
+    x[:] = (x - origin) @ rotation_to(axis).T + origin
+    return body
+
+
+def _dented(x: np.ndarray, width, length, section, amplitude, wavelength) -> np.ndarray:
+    """The points ``x`` (m, the tube's own frame about its origin) with the trigger dents
+    of :func:`tube_mesh`."""
+    zeta = (x[:, 2] - (length - wavelength)) / wavelength
+    wave = np.where((zeta > 0.0) & (zeta < 1.0), np.sin(2.0 * np.pi * zeta), 0.0)
+    moved = x.copy()
+    if section == "circle":
+        radial = x[:, :2] / np.linalg.norm(x[:, :2], axis=1, keepdims=True)
+        moved[:, :2] += (amplitude * wave)[:, None] * radial
+        return moved
+    a = 0.5 * width
+    on_x = np.abs(np.abs(x[:, 0]) - a) <= np.abs(np.abs(x[:, 1]) - a)  # a face x = +-a
+    across = np.where(on_x, x[:, 1], x[:, 0])  # from -a to a along the face
+    # Faces x = +-a go out, faces y = +-a in (a lobe of one face beside the other's).
+    sign = np.where(on_x, 1.0, -1.0)
+    offset = sign * amplitude * wave * np.sin(np.pi * (across + a) / width)
+    normal = np.where(on_x, 0, 1)
+    rows = np.arange(len(x))
+    moved[rows, normal] += offset * np.sign(x[rows, normal])
+    return moved
 
 
 def plate_with_hole_mesh(

@@ -120,6 +120,10 @@ MESH_SHAPES = {
         "bottom_layer",
         "top_layer",
     ),
+    "tube": (
+        "origin", "section", "width", "length", "axis", "element_size", "cell",
+        "trigger_amplitude", "trigger_wavelength",
+    ),
 }  # fmt: skip
 # The regions (gmsh physical volumes) of each built-in shape: always "body"; the others
 # when their key is above 0 (meshes/sweep.geo).
@@ -128,6 +132,7 @@ SHAPE_REGIONS = {
     "round_bar": {"front": "front_length"},
     "plate": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
     "plate_with_hole": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
+    "tube": {},
 }
 _REFINE_KEYS = ("refine_point", "refine_size", "refine_radius")
 
@@ -316,7 +321,32 @@ class MeshSpec:
     )
     radius: float | None = key(Real(low=0.0), None, required=True, unit="m", doc="of the bar")
     length: float | None = key(
-        Real(low=0.0), None, required=True, unit="m", doc="of the bar, along its own z"
+        Real(low=0.0), None, required=True, unit="m", doc="of the bar or tube, along its own z"
+    )
+    section: str = key(
+        Choice(("square", "circle")), "square", doc="the tube's cross-section (mid-surface)"
+    )
+    width: float | None = key(
+        Real(low=0.0),
+        None,
+        required=True,
+        unit="m",
+        doc="the tube's side (square) or diameter (circle), of its mid-surface",
+    )
+    trigger_amplitude: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="m",
+        doc="tubes: dents of this depth over the last trigger_wavelength before the top end, "
+        "where a crush should start to fold (a square's faces alternately in and out)",
+        default_doc="0: none",
+    )
+    trigger_wavelength: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="tubes: the length of one dent in and one out, at the top end",
+        default_doc="required with trigger_amplitude > 0",
     )
     hole_radius: float | None = key(
         Real(low=0.0), None, required=True, unit="m", doc="of the through-hole"
@@ -430,12 +460,25 @@ def _refinement_comes_whole(v, raw, fail):
 
 @rule(MeshSpec)
 def _surface_cells_are_a_plate(v, raw, fail):
-    """Shells (cell quadrilateral or triangle) are the built-in plate's mid-surface: no
-    layers, bottom_layer, top_layer or refinement."""
+    """Shells (cell quadrilateral or triangle) are the mid-surface of a plate or a tube
+    (a tube is only shells: quadrilateral by default); no layers, bottom_layer, top_layer
+    or refinement. A tube's trigger has a wavelength within its length."""
+    if v["shape"] == "tube":
+        if "cell" not in raw:
+            v["cell"] = "quadrilateral"
+        if v["cell"] not in SURFACE_CELLS:
+            fail("cell", f"a tube is a mid-surface of shells: 'quadrilateral' or 'triangle', "
+                 f"got {v['cell']!r}")  # fmt: skip
+        wavelength = v["trigger_wavelength"]
+        if v["trigger_amplitude"] > 0.0 and wavelength is None:
+            fail("trigger_wavelength", "missing: the dents of trigger_amplitude need it")
+        if wavelength is not None and wavelength > v["length"]:
+            fail("trigger_wavelength", f"{wavelength:g} m is longer than the tube "
+                 f"({v['length']:g} m)")  # fmt: skip
     if v["shape"] is None or v["cell"] not in SURFACE_CELLS:
         return
-    if v["shape"] != "plate":
-        fail("cell", f"{v['cell']!r} (shells) is for the shape 'plate' only; "
+    if v["shape"] not in ("plate", "tube"):
+        fail("cell", f"{v['cell']!r} (shells) is for the shapes 'plate' and 'tube'; "
              f"a {v['shape']} is hexahedron or tetrahedron")  # fmt: skip
     for name in ("layers", "bottom_layer", "top_layer", *_REFINE_KEYS):
         if name in raw:

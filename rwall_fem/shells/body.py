@@ -15,7 +15,7 @@ are never summed into a rotation vector.
 Its energies are those of a force without a stored energy: the work of the forces and
 moments at mid-step velocities (the internal energy: that work less the hourglass
 energy the kernels report), and the rotations' shadow kinetic energy
-``"rotational_kinetic"`` (docs/theory.md, "Shells").
+``"rotational_kinetic"`` (``docs/theory.md``, "Shell bodies").
 """
 
 from __future__ import annotations
@@ -223,6 +223,23 @@ class ShellBody:
                               force.hourglass_energy)  # fmt: skip
             ]
         )
+
+    def part_momenta(self, state) -> np.ndarray:
+        """(parts, 3): this rank's share of each part's momentum (kg m/s) at v^{n+1/2}, by
+        the parts' shares of the nodes' masses."""
+        return (self.part_masses / state.mass[:, None]).T @ (state.mass[:, None] * state.v)
+
+    def plastic_strains(self) -> np.ndarray:
+        """The equivalent plastic strain of every point of the elasto-plastic parts."""
+        return np.concatenate(
+            [f.kernel.plastic_strains().ravel() for f in self.elements if f.plastic]
+            or [np.zeros(0)]
+        )
+
+    @property
+    def plastic_work(self) -> float:
+        """Plastic dissipation (J) of this rank's cells so far."""
+        return sum(force.plastic_work for force in self.elements)
 
     def step_change_work(self) -> float:
         return 0.0

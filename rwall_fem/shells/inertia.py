@@ -4,7 +4,7 @@ A cell of area A, thickness t and density rho gives each of its n nodes (4 for a
 quadrilateral, 3 for a triangle) the mass rho t A / n, and the rotational inertia of that
 mass by Radioss's rule, m (A / 9 + t^2 / 12) with m = rho t A / n: the t^2 / 12 of a thin
 lamina about its mid-surface, and A / 9 that scales the rotations' inertia up so that
-they never set the stable step (``docs/theory.md``, "Shells: inertia and step"). One
+they never set the stable step (``docs/theory.md``, "Shell bodies"). One
 inertia about every axis: the nodes' rotations are integrated in the global frame, where
 an inertia tensor would need turning with the shell every step.
 

@@ -124,6 +124,20 @@ BEYOND = {
     "91_front_length_of_the_whole_bar",
     "94_part_without_cells",
     "95_part_density_1e-300",
+    # Shells: which cells a key fits ties [mesh] to [element] and the parts' (and a mesh
+    # file's cells are known once it is read); a tube's trigger ties its keys together.
+    "282_shell_triangle_formulation_on_quadrilaterals",
+    "283_shell_quadrilateral_formulation_on_triangles",
+    "286_shell_thickness_on_hexahedra",
+    "287_solid_integration_on_shells",
+    "288_shell_cell_on_a_bar",
+    "289_shell_plate_with_layers",
+    "290_shell_thickness_on_a_volume_mesh_file",
+    "291_shell_mesh_file_without_thickness",
+    "292_shell_mass_scaling",
+    "293_tube_of_hexahedra",
+    "294_tube_trigger_without_wavelength",
+    "295_tube_trigger_longer_than_the_tube",
 }
 
 

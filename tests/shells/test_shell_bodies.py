@@ -8,6 +8,7 @@ book the moment's work as the rotations' kinetic energy gained, to round-off. Ev
 figure is a global sum: the same on any number of ranks.
 """
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -133,3 +134,38 @@ def test_rotations_advance_by_central_differences():
     # latest step, is what the rotations' shadow kinetic energy lost.
     work = body.work - 0.5 * dt * np.sum(body.moments * body.w.owned)
     assert abs(body.rotational_kinetic - kinetic0 + work) <= 1e-13 * kinetic0
+
+
+@pytest.mark.parametrize("section", ["square", "circle"])
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_tube_mid_surface_and_its_trigger(section, cell):
+    """A tube of width 40 mm and length 0.1 m along (1, 1, 0): its area (4 w L, or the
+    inscribed polygon of 4 ns chords of the circle), its ends, and the trigger dents: the
+    last 20 mm moved by at most the amplitude, the rest and (square) the corners not."""
+    from rwall_fem.meshing import rotation_to, tube_mesh
+
+    w, length, h, amplitude, wavelength = 0.04, 0.1, 0.005, 5e-4, 0.02
+    axis = (1.0, 1.0, 0.0)
+    plain = tube_mesh(comm, (0, 0, 0), w, length, h, cell, section, axis)
+    dented = tube_mesh(comm, (0, 0, 0), w, length, h, cell, section, axis,
+                       trigger=(amplitude, wavelength))  # fmt: skip
+    msh = plain.msh
+    assert (msh.topology.dim, msh.geometry.dim) == (2, 3)
+    assert msh.topology.cell_type.name == cell
+    if section == "square":
+        expected = 4 * w * length
+    else:
+        segments = 4 * math.ceil(math.pi * w / 4 / h - 1e-9)
+        expected = segments * w * math.sin(math.pi / segments) * length
+    assert area(msh) == pytest.approx(expected, rel=1e-12)
+    assert set(plain.groups) == {"bottom", "top"}
+    own = dented.msh.geometry.x @ rotation_to(axis)  # back in the tube's own frame
+    rest = plain.msh.geometry.x @ rotation_to(axis)
+    assert np.allclose(own[:, 2], rest[:, 2], atol=1e-15)  # dents move across the axis only
+    moved = np.linalg.norm(own - rest, axis=1)
+    largest = comm.allreduce(float(moved.max(initial=0.0)), op=MPI.MAX)
+    assert 0.5 * amplitude < largest <= amplitude * (1 + 1e-12)
+    assert np.all(moved[rest[:, 2] < length - wavelength - 1e-12] <= 1e-15)
+    if section == "square":
+        corners = np.isclose(np.abs(rest[:, 0]), w / 2) & np.isclose(np.abs(rest[:, 1]), w / 2)
+        assert np.all(moved[corners] <= 1e-15)
