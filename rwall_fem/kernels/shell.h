@@ -61,11 +61,44 @@ INLINE vec compliance_product(const shell_params *s, vec sxx, vec syy, vec sxy)
                       + (2.0 * (1.0 + nu)) * sxy * sxy);
 }
 
-/* The capped flow stress and its slope (0 where the cap holds). */
-INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, vec e, vec rate,
-                              vec T, vec *slope)
+/* The factor of the flow stress that does not depend on the plastic strain: Johnson-Cook's
+ * rate and temperature factors (plasticity.h), 1 for the other laws; constant over a return. */
+INLINE vec flow_factor(const element_params *p, vec rate, vec T)
 {
-  const vec y = flow_stress(p, e, rate, T, slope);
+  if (p->hardening != JOHNSON_COOK)
+    return VZERO + 1.0;
+  vec factor = 1.0 + p->rate_coefficient
+                         * vlog(vmax(rate * (1.0 / p->reference_rate), VZERO + 1.0));
+  if (p->thermal)
+  {
+    const vec star = vmin(vmax((T - p->room_temperature)
+                                   * (1.0 / (p->melting_temperature - p->room_temperature)),
+                               VZERO),
+                          VZERO + 1.0);
+    factor *= 1.0 - vpow(star, p->thermal_exponent);
+  }
+  return factor;
+}
+
+/* The flow stress (Pa) of plasticity.h at plastic strain e times `factor` (flow_factor), capped
+ * at s->max_flow_stress, and its slope (0 where the cap holds).  The power laws' e^n is taken
+ * as exp(n log e) on all lanes at once (batch.h), and its slope as n e^n / e. */
+INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, vec e, vec factor,
+                              vec *slope)
+{
+  vec y;
+  if (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
+  {
+    const double B = p->hardening_coefficient, n = p->hardening_exponent;
+    const ivec positive = e > 0.0;
+    const vec safe = vselect(positive, e, VZERO + 1.0);
+    const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
+    y = (p->yield_stress + B * power) * factor;
+    /* at e = 0 the slope of n < 1 is infinite: the Newton steps stay in their bracket */
+    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300) * factor;
+  }
+  else
+    y = flow_stress(p, e, VZERO, VZERO, slope);
   const ivec capped = y > s->max_flow_stress;
   *slope = vselect(capped, VZERO, *slope);
   return vselect(capped, VZERO + s->max_flow_stress, y);
@@ -73,26 +106,38 @@ INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, ve
 
 /* The exact plane-stress J2 return of the trial stress sig[3] (xx, yy, xy; Pa, in/out) at
  * plastic strain eps_p, strain rate `rate` (1/s) and temperature T (K): returns the plastic
- * strain increment (0 in elastic lanes); *flow = the flow stress after the step. */
+ * strain increment (0 in elastic lanes); *flow = the flow stress after the step (the von
+ * Mises stress of the returned stress, equal to it to 1e-11). */
 INLINE vec plane_stress_return(const element_params *p, const shell_params *s, vec sig[3],
                                vec eps_p, vec rate, vec T, vec *flow)
 {
+  const vec factor = flow_factor(p, rate, T);
   const double E = s->young, nu = s->poisson;
   const double k1 = E / (3.0 * (1.0 - nu)), g2 = E / (1.0 + nu);
   const vec pp = sig[0] + sig[1], dd = sig[1] - sig[0], xy = sig[2];
   const vec P1 = 0.25 * pp * pp, P2 = 0.75 * dd * dd + 3.0 * xy * xy;
   const vec q_trial = vsqrt(P1 + P2);
   vec slope;
-  const vec y0 = capped_flow_stress(p, s, eps_p, rate, T, &slope);
+  const vec y0 = capped_flow_stress(p, s, eps_p, factor, &slope);
   const ivec plastic = q_trial > y0;
   *flow = y0;
   if (!any_lane(plastic))
     return VZERO;
-  /* F(0) = q_tr - y0 > 0; first guess from the linearisation at g = 0 */
+  /* F(0) = q_tr - y0 > 0; first guess from the linearisation at g = 0 with the secant
+   * slope of the flow stress over the perfectly plastic increment (q_tr - y0) / 3G (the
+   * tangent of a power law is infinite at eps_p = 0) */
   const vec safe_q = vselect(plastic, q_trial, VZERO + 1.0);
   vec lo = VZERO, hi = (safe_q / vmax(y0, VZERO + 1e-300) - 1.0) * (1.0 / k1);
+  vec start = slope;
+  if (any_lane(plastic & (eps_p <= 0.0)))
+  {
+    const vec d0 = vmax((safe_q - y0) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
+    vec unused;
+    const vec secant = (capped_flow_stress(p, s, eps_p + d0, factor, &unused) - y0) / d0;
+    start = vselect(eps_p <= 0.0, secant, slope);
+  }
   vec g = (safe_q - y0)
-          / ((P1 * k1 + P2 * g2) / safe_q + (2.0 / 3.0) * vmax(slope, VZERO) * safe_q);
+          / ((P1 * k1 + P2 * g2) / safe_q + (2.0 / 3.0) * vmax(start, VZERO) * safe_q);
   g = vselect(plastic, vmin(vmax(g, VZERO), hi), VZERO);
   vec q = safe_q;
   for (int iteration = 0; iteration < 50; ++iteration)
@@ -102,7 +147,7 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
     const vec dq = -(P1 * k1 * a * a * a + P2 * g2 * b * b * b) / q;
     const vec e = eps_p + (2.0 / 3.0) * g * q;
     vec h;
-    const vec F = q - capped_flow_stress(p, s, e, rate, T, &h);
+    const vec F = q - capped_flow_stress(p, s, e, factor, &h);
     lo = vselect(F > 0.0, g, lo);
     hi = vselect(F < 0.0, g, hi);
     const vec dF = dq - vmax(h, VZERO) * (2.0 / 3.0) * (q + g * dq);
@@ -110,7 +155,8 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
     next = vselect((next <= lo) | (next >= hi), 0.5 * (lo + hi), next);
     const vec change = vabs(next - g);
     g = vselect(plastic, next, VZERO);
-    if (!any_lane(plastic & (change > 1e-15 * g + 1e-300)))
+    /* converged: the residual at g is round-off, or the step changes g by round-off */
+    if (!any_lane(plastic & (vabs(F) > 1e-11 * q) & (change > 1e-15 * g + 1e-300)))
       break;
   }
   const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
@@ -120,8 +166,7 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
   sig[1] = 0.5 * (p_new + d_new);
   sig[2] = xy * b;
   const vec d = vselect(plastic, (2.0 / 3.0) * g * q, VZERO);
-  vec unused;
-  *flow = capped_flow_stress(p, s, eps_p + d, rate, T, &unused);
+  *flow = vselect(plastic, q, y0); /* on the yield surface after the return */
   return d;
 }
 

@@ -322,11 +322,13 @@ class ShellKernel:
         def ptr(array, kind="double *"):
             return ffi.cast(kind, array.ctypes.data)
 
-        return functools.partial(
+        call = functools.partial(
             getattr(self.lib, self.name), computed, ptr(self.cells, "int32_t *"), ptr(X), ptr(u),
             ptr(v), ptr(w), self.params, self.shell, ptr(self.history), self.num_cells, ptr(f),
             ptr(m), ptr(energy), ptr(step),
         )  # fmt: skip
+        call.keep = (self, X, u, v, w, f, m, energy, step)  # what the pointers point into
+        return call
 
     def run(self, dt: float, X, u, v, w, f, m, energy=None, step=None, estimate=True):
         """One pass over all cells with the step just taken ``dt`` (s): adds into f, m;
