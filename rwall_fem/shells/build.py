@@ -89,8 +89,10 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             hourglass=element.hourglass_coefficients,
             shear_factor=element.shear_factor,
         )
-    except ValueError as err:
-        raise SceneError(f"{scene.source}: {where}: {err}") from None
+    except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
+        said = str(err)
+        said = where + said[len("element") :] if said.startswith("element.") else f"{where}: {said}"
+        raise SceneError(f"{scene.source}: {said}") from None
     return ShellSection(technology, formulation, thickness, element.points)
 
 

@@ -171,3 +171,75 @@ def test_a_resumed_shell_run_equals_an_uninterrupted_one(shared_dir, monkeypatch
     assert np.abs(whole.internal.w.owned).max() > 1.0  # the rotations did move
     if comm.rank == 0:
         assert (out / "energy.csv").read_text() == (root / "whole" / "energy.csv").read_text()
+
+
+def _shaken(shared_dir, rotary=None):
+    """A free 2 mm plate of 5 mm cells (the transverse shear at its stiffest against the
+    membrane), every node started at its own translational and angular velocity (a
+    pattern of its coordinates, the same on any number of ranks), 2,000 steps at
+    dt_scale 0.95; ``rotary`` (kg, m^2, m -> kg m^2) replaces the rotational inertia."""
+    from rwall_fem.mechanics import coordinate_pattern
+
+    raw = plate(size=(0.05, 0.05, 0.002), h=0.005, end_time=1.0)
+    raw["run"]["dt_scale"] = 0.95
+    raw["run"]["max_energy_error"] = 1e300  # the guard would stop a run that blows up
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, shared_dir)
+    body, s = sim.internal, sim.state
+    if rotary is not None:
+        body.inertia[:, 1] = rotary(body.inertia[:, 0], 0.005**2, 0.002)
+        body.inv_inertia[:] = 1.0 / body.inertia[:, 1]
+    pattern = coordinate_pattern(s.X)
+    s.v[:] = pattern[:, None] * np.array([0.1, -0.2, 1.0])
+    body.w.owned[:] = pattern[:, None] * np.array([50.0, 30.0, -20.0])
+    sim.history.balance.initial = _kinetic(sim)
+    sim.end_time = 1999.5 * s.dt
+    with np.errstate(all="ignore"):
+        sim.run()
+    fastest = comm.allreduce(float(np.abs(body.w.owned).max()), op=MPI.MAX)
+    return fastest, sim
+
+
+def test_the_rotational_inertia_keeps_rotations_from_setting_the_step(shared_dir, tmp_path_factory):
+    """Radioss's m (A/9 + t^2/12) is stable at the membrane's step (docs/theory.md, "Shell
+    bodies": omega_s / omega_m <= 0.81 at nu = 0.3); the lamina's own m t^2 / 12 is not
+    (omega_s 2.3 times omega_m for these cells): its angular velocities blow up."""
+    fastest, sim = _shaken(shared_dir)
+    assert sim.status == "done"
+    assert fastest <= 100.0  # started at up to 50 rad/s
+    assert sim.history.summary["energy"]["max_balance_error"] <= 1e-10
+    other = comm.bcast(tmp_path_factory.mktemp("lamina") if comm.rank == 0 else None, root=0)
+    fastest, _ = _shaken(other, rotary=lambda m, area, t: m * t * t / 12)
+    assert not fastest <= 1e6
+
+
+def test_parts_of_shells_per_physical_surface(shared_dir):
+    """two_panels.geo: the floor (1 mm steel) and the wall (2 mm aluminium) as two parts,
+    dropped at 5 m/s on a plane: each part's mass rho t A, bonded along their edge, the
+    balance closed to 1e-12 and the parts' kinetic energies adding up to the body's."""
+    from pathlib import Path
+
+    geo = Path(__file__).resolve().parents[1] / "bad_scenes" / "files" / "two_panels.geo"
+    aluminium = {"model": "linear_elastic", "density": 2700.0, "young": 70e9, "poisson": 0.33}
+    raw = {
+        "run": {"end_time": 2e-5},
+        "mesh": {"file": str(geo)},
+        "material": dict(STEEL),
+        "part": [
+            {"name": "floor", "element": {"thickness": 0.001}},
+            {"name": "wall", "material": aluminium, "element": {"thickness": 0.002}},
+        ],
+        "initial": {"velocity": [0.0, 0.0, -5.0]},
+        "wall": [{"kind": "plane", "point": [0.0, 0.0, -1e-6], "normal_point": [0, 0, 1]}],
+        "output": {"frames": 0, "plot": False},
+    }
+    sim = run(raw, shared_dir)
+    parts = {p["name"]: p for p in sim.history.summary["parts"]}
+    assert parts["floor"]["mass"] == pytest.approx(7800.0 * 0.001 * 1e-4, rel=1e-12)
+    assert parts["wall"]["mass"] == pytest.approx(2700.0 * 0.002 * 1e-4, rel=1e-12)
+    assert sim.history.summary["energy"]["max_balance_error"] <= 1e-12
+    latest = sim.history.balance.latest
+    assert sim.history.balance.latest["wall_work"] < 0.0  # the floor hit the plane
+    energy = sim.history.summary["energy"]
+    kinetic = parts["floor"]["energy"]["kinetic"] + parts["wall"]["energy"]["kinetic"]
+    assert kinetic == pytest.approx(energy["kinetic"], rel=1e-12)
+    assert latest["time"] > 0.0
