@@ -106,8 +106,9 @@ INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, ve
 
 /* The exact plane-stress J2 return of the trial stress sig[3] (xx, yy, xy; Pa, in/out) at
  * plastic strain eps_p, strain rate `rate` (1/s) and temperature T (K): returns the plastic
- * strain increment (0 in elastic lanes); *flow = the flow stress after the step (the von
- * Mises stress of the returned stress, equal to it to 1e-11). */
+ * strain increment (0 in elastic lanes); *flow = the flow stress after the step where it
+ * flowed (the von Mises stress of the returned stress, equal to it to about 1e-14; not set to the
+ * law's value in lanes that stay elastic). */
 INLINE vec plane_stress_return(const element_params *p, const shell_params *s, vec sig[3],
                                vec eps_p, vec rate, vec T, vec *flow)
 {
@@ -117,6 +118,17 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
   const vec pp = sig[0] + sig[1], dd = sig[1] - sig[0], xy = sig[2];
   const vec P1 = 0.25 * pp * pp, P2 = 0.75 * dd * dd + 3.0 * xy * xy;
   const vec q_trial = vsqrt(P1 + P2);
+  /* below A factor (and the cap) every lane is elastic for the laws whose flow stress never
+   * falls below it (linear and power hardening, Johnson-Cook): no evaluation of the law */
+  if (p->hardening != HARDENING_TABLE)
+  {
+    const vec floor = vmin(p->yield_stress * factor, VZERO + s->max_flow_stress);
+    if (!any_lane(q_trial > floor))
+    {
+      *flow = VZERO;
+      return VZERO;
+    }
+  }
   vec slope;
   const vec y0 = capped_flow_stress(p, s, eps_p, factor, &slope);
   const ivec plastic = q_trial > y0;
@@ -155,8 +167,9 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
     next = vselect((next <= lo) | (next >= hi), 0.5 * (lo + hi), next);
     const vec change = vabs(next - g);
     g = vselect(plastic, next, VZERO);
-    /* converged: the residual at g is round-off, or the step changes g by round-off */
-    if (!any_lane(plastic & (vabs(F) > 1e-11 * q) & (change > 1e-15 * g + 1e-300)))
+    /* converged: the residual at the previous g was below 1e-7 q, so that the Newton step
+     * just taken (quadratic convergence) leaves one of order 1e-14 q; or g moves by round-off */
+    if (!any_lane(plastic & (vabs(F) > 1e-7 * q) & (change > 1e-15 * g + 1e-300)))
       break;
   }
   const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
