@@ -206,4 +206,112 @@ INLINE vec shell_point_update(const element_params *p, const shell_params *s, ve
   return dissipation;
 }
 
+/* The update of a batch's stress resultants over a step: from the membrane strain rates d,
+ * curvature rates k (both (xx, yy, 2 xy)) and transverse shear rates gs (xz, yz), times
+ * p->dt here, of cells of thickness t; the state rows as shell_quad.c says (elastic:
+ * resultants; plastic: shear resultants and the points through the thickness).  Out: the
+ * resultants N (N/m), M (N), Q (N/m) in the local frame, the stored elastic energy per unit
+ * area (J/m^2; 0 when s->omit_energy), the plastic dissipation of the step per unit area
+ * (J/m^2, with the elastic energy of points failing now), and 1 in the lanes whose share
+ * of failed points has reached s->fail_fraction. */
+INLINE void shell_update(int plastic, const element_params *p, const shell_params *s,
+                         const batch_t *bp, double *restrict state, int64_t stride, vec t,
+                         vec d[3], vec k[3], const vec gs[2], vec N[3], vec M[3], vec Q[2],
+                         vec *elastic_out, vec *dissipated_out, vec *damage_out)
+{
+  const batch_t b = *bp;
+  const double dt = p->dt, ks = s->shear_factor * 0.5 * s->young / (1.0 + s->poisson);
+  const int npt = s->points;
+  for (int i = 0; i < 3; ++i)
+  {
+    d[i] *= dt;
+    k[i] *= dt;
+  }
+  for (int i = 0; i < 3; ++i)
+    N[i] = M[i] = VZERO;
+  vec elastic = VZERO, dissipated = VZERO, damage = VZERO;
+  if (!plastic)
+  {
+    for (int i = 0; i < 3; ++i)
+    {
+      N[i] = load_slot(state, stride, &b, i);
+      M[i] = load_slot(state, stride, &b, 3 + i);
+    }
+    Q[0] = load_slot(state, stride, &b, 6);
+    Q[1] = load_slot(state, stride, &b, 7);
+    hooke_add(s, t, d, N);
+    hooke_add(s, (1.0 / 12.0) * t * t * t, k, M);
+    for (int i = 0; i < 3; ++i)
+    {
+      store_slot(state, stride, &b, i, N[i]);
+      store_slot(state, stride, &b, 3 + i, M[i]);
+    }
+    Q[0] += (ks * dt) * t * gs[0];
+    Q[1] += (ks * dt) * t * gs[1];
+    store_slot(state, stride, &b, 6, Q[0]);
+    store_slot(state, stride, &b, 7, Q[1]);
+    if (!s->omit_energy)
+      elastic = compliance_product(s, N[0], N[1], N[2]) * (0.5 / t)
+                + compliance_product(s, M[0], M[1], M[2]) * (6.0 / (t * t * t));
+  }
+  else
+  {
+    Q[0] = load_slot(state, stride, &b, 0) + (ks * dt) * t * gs[0];
+    Q[1] = load_slot(state, stride, &b, 1) + (ks * dt) * t * gs[1];
+    store_slot(state, stride, &b, 0, Q[0]);
+    store_slot(state, stride, &b, 1, Q[1]);
+    vec failed_points = VZERO;
+    for (int pt = 0; pt < npt; ++pt)
+    {
+      const int base = 2 + SHELL_POINT_SLOTS * pt;
+      const vec z = s->zeta[pt] * t, wt = s->weight[pt] * t;
+      vec sig[3], eps_p, T, de[3];
+      for (int i = 0; i < 3; ++i)
+      {
+        sig[i] = load_slot(state, stride, &b, base + i);
+        de[i] = d[i] + z * k[i];
+      }
+      eps_p = load_slot(state, stride, &b, base + 3);
+      T = load_slot(state, stride, &b, base + 4);
+      vec D = VZERO;
+      if (p->failure)
+        D = load_slot(state, stride, &b, p->damage_slot + pt);
+      const ivec dead = D >= 1.0;
+      point_step done;
+      vec dissipation = shell_point_update(p, s, sig, &eps_p, &T, de, &done);
+      if (p->failure)
+      {
+        done.increment = vselect(dead, VZERO, done.increment);
+        const vec D_new = vmax(D, accumulate_damage(p, state, stride, &b,
+                                                    p->damage_slot + pt, &done, T));
+        const ivec gone = D_new >= 1.0;
+        /* a point failing now gives up its elastic energy as dissipation */
+        const vec held = 0.5 * compliance_product(s, sig[0], sig[1], sig[2]);
+        dissipation = vselect(dead, VZERO, dissipation + vselect(gone, held, VZERO));
+        for (int i = 0; i < 3; ++i)
+          sig[i] = vselect(gone, VZERO, sig[i]);
+        failed_points += vselect(gone, VZERO + 1.0, VZERO);
+      }
+      for (int i = 0; i < 3; ++i)
+      {
+        store_slot(state, stride, &b, base + i, sig[i]);
+        N[i] += wt * sig[i];
+        M[i] += (wt * z) * sig[i];
+      }
+      store_slot(state, stride, &b, base + 3, eps_p);
+      store_slot(state, stride, &b, base + 4, T);
+      if (!s->omit_energy)
+        elastic += (0.5 * wt) * compliance_product(s, sig[0], sig[1], sig[2]);
+      dissipated += wt * dissipation;
+    }
+    if (p->failure)
+      damage = vselect(failed_points >= s->fail_fraction * npt - 1e-9, VZERO + 1.0, VZERO);
+  }
+  if (!s->omit_energy)
+    elastic += (Q[0] * Q[0] + Q[1] * Q[1]) * (0.5 / ks) / t;
+  *elastic_out = elastic;
+  *dissipated_out = dissipated;
+  *damage_out = damage;
+}
+
 #endif

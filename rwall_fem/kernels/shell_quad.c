@@ -275,8 +275,8 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
                        int64_t stride, double *restrict f, double *restrict m,
                        double *restrict energy, double *restrict step)
 {
-  const double dt = p->dt, ks = s->shear_factor * 0.5 * s->young / (1.0 + s->poisson);
-  const int warping = s->warping, npt = s->points;
+  const double dt = p->dt;
+  const int warping = s->warping;
   double stored_total = 0.0, hourglass_total = 0.0, plastic_total = 0.0;
   for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
@@ -308,92 +308,9 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0)
       hourglass = dt * quad_hourglass(&g, s, p->density, t, warping, vl, wl, fe);
     const vec mid_area = g.area;
-    for (int i = 0; i < 3; ++i)
-    {
-      d[i] *= dt;
-      k[i] *= dt;
-    }
-    vec N[3] = {VZERO, VZERO, VZERO}, M[3] = {VZERO, VZERO, VZERO}, Q[2];
-    vec elastic = VZERO, dissipated = VZERO, damage = VZERO;
-    if (!plastic)
-    {
-      for (int i = 0; i < 3; ++i)
-      {
-        N[i] = load_slot(state, stride, &b, i);
-        M[i] = load_slot(state, stride, &b, 3 + i);
-      }
-      Q[0] = load_slot(state, stride, &b, 6);
-      Q[1] = load_slot(state, stride, &b, 7);
-      hooke_add(s, t, d, N);
-      hooke_add(s, (1.0 / 12.0) * t * t * t, k, M);
-      for (int i = 0; i < 3; ++i)
-      {
-        store_slot(state, stride, &b, i, N[i]);
-        store_slot(state, stride, &b, 3 + i, M[i]);
-      }
-      Q[0] += (ks * dt) * t * gs[0];
-      Q[1] += (ks * dt) * t * gs[1];
-      store_slot(state, stride, &b, 6, Q[0]);
-      store_slot(state, stride, &b, 7, Q[1]);
-      if (!s->omit_energy)
-        elastic = compliance_product(s, N[0], N[1], N[2]) * (0.5 / t)
-                  + compliance_product(s, M[0], M[1], M[2]) * (6.0 / (t * t * t));
-    }
-    else
-    {
-      Q[0] = load_slot(state, stride, &b, 0) + (ks * dt) * t * gs[0];
-      Q[1] = load_slot(state, stride, &b, 1) + (ks * dt) * t * gs[1];
-      store_slot(state, stride, &b, 0, Q[0]);
-      store_slot(state, stride, &b, 1, Q[1]);
-      vec failed_points = VZERO;
-      for (int pt = 0; pt < npt; ++pt)
-      {
-        const int base = 2 + SHELL_POINT_SLOTS * pt;
-        const vec z = s->zeta[pt] * t, wt = s->weight[pt] * t;
-        vec sig[3], eps_p, T, de[3];
-        for (int i = 0; i < 3; ++i)
-        {
-          sig[i] = load_slot(state, stride, &b, base + i);
-          de[i] = d[i] + z * k[i];
-        }
-        eps_p = load_slot(state, stride, &b, base + 3);
-        T = load_slot(state, stride, &b, base + 4);
-        vec D = VZERO;
-        if (p->failure)
-          D = load_slot(state, stride, &b, p->damage_slot + pt);
-        const ivec dead = D >= 1.0;
-        point_step done;
-        vec dissipation = shell_point_update(p, s, sig, &eps_p, &T, de, &done);
-        if (p->failure)
-        {
-          done.increment = vselect(dead, VZERO, done.increment);
-          const vec D_new = vmax(D, accumulate_damage(p, state, stride, &b,
-                                                      p->damage_slot + pt, &done, T));
-          const ivec gone = D_new >= 1.0;
-          /* a point failing now gives up its elastic energy as dissipation */
-          const vec held = 0.5 * compliance_product(s, sig[0], sig[1], sig[2]);
-          dissipation = vselect(dead, VZERO, dissipation + vselect(gone, held, VZERO));
-          for (int i = 0; i < 3; ++i)
-            sig[i] = vselect(gone, VZERO, sig[i]);
-          failed_points += vselect(gone, VZERO + 1.0, VZERO);
-        }
-        for (int i = 0; i < 3; ++i)
-        {
-          store_slot(state, stride, &b, base + i, sig[i]);
-          N[i] += wt * sig[i];
-          M[i] += (wt * z) * sig[i];
-        }
-        store_slot(state, stride, &b, base + 3, eps_p);
-        store_slot(state, stride, &b, base + 4, T);
-        if (!s->omit_energy)
-          elastic += (0.5 * wt) * compliance_product(s, sig[0], sig[1], sig[2]);
-        dissipated += wt * dissipation;
-      }
-      if (p->failure)
-        damage = vselect(failed_points >= s->fail_fraction * npt - 1e-9, VZERO + 1.0, VZERO);
-    }
-    if (!s->omit_energy)
-      elastic += (Q[0] * Q[0] + Q[1] * Q[1]) * (0.5 / ks) / t;
+    vec N[3], M[3], Q[2], elastic, dissipated, damage;
+    shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
+                 &damage);
     quad_frame(x, &g);
     quad_resultant_forces(&g, warping, N, M, Q, fe);
     elastic *= g.area;
