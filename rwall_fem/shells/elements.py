@@ -3,7 +3,8 @@ compiled code.
 
 The kernels are ``rwall_fem/kernels/shell_quad.c`` (the Belytschko-Lin-Tsay quadrilateral,
 with the Belytschko-Wong-Chiang warping correction by rigid-body projection unless the
-formulation is plain ``"bt"``) and ``shell.h`` (the plane-stress J2 return and the rule
+formulation is plain ``"bt"``), ``shell_tria.c`` (the C0 triangle of Belytschko, Stolarski
+and Carpenter, its transverse shear tied along its sides) and ``shell.h`` (the plane-stress J2 return and the rule
 through the thickness); their formulas are in their header comments and in
 ``docs/theory.md`` ("Shells"). They are compiled through cffi into a module of their own,
 cached like :mod:`rwall_fem.kernels` (they include its ``batch.h``, ``plasticity.h``,
@@ -38,10 +39,11 @@ __all__ = ["ShellForce", "ShellKernel", "ShellTechnology", "load", "thickness_ru
 
 HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "shell.h",
-           "shell_quad.c")  # fmt: skip
+           "shell_quad.c", "shell_tria.c")  # fmt: skip
 POINT_SLOTS = 5  # per point through the thickness: sxx, syy, sxy, eps_p, temperature
 MAX_POINTS = 10
-FORMULATIONS = {"quadrilateral": ("bwc", "bt"), "triangle": ()}
+FORMULATIONS = {"quadrilateral": ("bwc", "bt"), "triangle": ("bsc",)}
+FAMILY = {"quadrilateral": "quad", "triangle": "tria"}
 # DOLFINx's quadrilateral vertices (0,0), (1,0), (0,1), (1,1): counter-clockwise order.
 _CCW = [0, 1, 3, 2]
 
@@ -60,14 +62,19 @@ typedef struct {
 } shell_params;
 """
     + "".join(
-        f"void shell_quad_{law}(int64_t n, const int32_t *cells, const double *X, const double *u,"
-        " const double *v, const double *w, const element_params *p, const shell_params *s,"
-        " double *state, int64_t stride, double *f, double *m, double *energy, double *step);\n"
+        f"void shell_{family}_{law}(int64_t n, const int32_t *cells, const double *X,"
+        " const double *u, const double *v, const double *w, const element_params *p,"
+        " const shell_params *s, double *state, int64_t stride, double *f, double *m,"
+        " double *energy, double *step);\n"
+        for family in ("quad", "tria")
         for law in ("elastic", "plastic")
     )
+    + "".join(
+        f"void shell_{family}_sizes(int64_t n, const int32_t *cells, const double *x,"
+        " double *area, double *length);\n"
+        for family in ("quad", "tria")
+    )
     + """
-void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
-                      double *length);
 double shell_point(const element_params *p, const shell_params *s, double sigma[3],
                    double *eps_p, double *T, const double de[3]);
 """
@@ -173,8 +180,9 @@ def thickness_rule(points: int) -> tuple[np.ndarray, np.ndarray]:
 class ShellTechnology:
     """How the shell elements of a body integrate their internal force."""
 
-    cell: str  # "quadrilateral" (or "triangle": not yet)
-    formulation: str = "bwc"  # "bwc": BLT with the warping correction; "bt": plain BLT
+    cell: str  # "quadrilateral" or "triangle"
+    formulation: str = "bwc"  # "bwc": BLT with the warping correction; "bt": plain BLT;
+    # "bsc": the Belytschko-Stolarski-Carpenter triangle
     points: int = 5  # through the thickness (elasto-plastic laws)
     hourglass: tuple[float, float, float] = (0.01, 0.01, 0.01)  # hm, hf, hr
     shear_factor: float = 5.0 / 6.0
@@ -185,13 +193,10 @@ class ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
-            raise ValueError(f"no shell element for {cell} cells; allowed: quadrilateral")
-        allowed = FORMULATIONS[cell]
-        if not allowed:
             raise ValueError(
-                "element.formulation: the shell triangle (bsc) is not built yet; mesh the "
-                "surface with quadrilaterals"
+                f"no shell element for {cell} cells; allowed: quadrilateral, triangle"
             )
+        allowed = FORMULATIONS[cell]
         formulation = formulation or allowed[0]
         if formulation not in allowed:
             raise ValueError(
@@ -206,7 +211,9 @@ class ShellTechnology:
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor))
 
     def describe(self) -> str:
-        """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the warping correction, 5 points'."""
+        """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
+        if self.cell == "triangle":
+            return "Belytschko-Stolarski-Carpenter C0 triangles"
         name = "Belytschko-Lin-Tsay quadrilaterals"
         warp = " with the BWC warping correction" if self.formulation == "bwc" else ""
         hm, hf, hr = self.hourglass
@@ -216,7 +223,8 @@ class ShellTechnology:
 class ShellKernel:
     """The compiled kernel of one material and shell technology on NumPy arrays.
 
-    ``cells``: (n, 4) int32 rows of node indices, counter-clockwise; ``thickness``: per cell
+    ``cells``: (n, 4) int32 rows of node indices, counter-clockwise, or (n, 3) for triangles
+    (the technology's cell); ``thickness``: per cell
     (m). :attr:`history` is the state (rows of ``shell_quad.c``, columns of cells);
     :meth:`run` adds the internal forces and moments of the cells into ``f`` and ``m``.
     ``material`` needs ``young``, ``poisson``, ``density`` and, elasto-plastic (``plastic``),
@@ -266,7 +274,9 @@ class ShellKernel:
         else:
             s.points = 0
             self.history = np.zeros((8, n))
-        self.name = "shell_quad_plastic" if self.plastic else "shell_quad_elastic"
+        self.family = FAMILY[technology.cell]
+        law = "plastic" if self.plastic else "elastic"
+        self.name = f"shell_{self.family}_{law}"
 
     @property
     def points(self) -> int:
@@ -344,11 +354,11 @@ class ShellKernel:
         return energy, step
 
     def sizes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The projected area (m^2) and characteristic length (m) of every cell at ``x``."""
+        """The (projected) area (m^2) and characteristic length (m) of every cell at ``x``."""
         area, length = np.empty(self.num_cells), np.empty(self.num_cells)
         x = np.ascontiguousarray(x, dtype=np.float64)
         ffi = self.ffi
-        self.lib.shell_quad_sizes(
+        getattr(self.lib, f"shell_{self.family}_sizes")(
             self.num_cells, ffi.cast("int32_t *", self.cells.ctypes.data),
             ffi.cast("double *", x.ctypes.data), ffi.cast("double *", area.ctypes.data),
             ffi.cast("double *", length.ctypes.data),
@@ -431,12 +441,14 @@ class ShellForce:
         self.cell_ids = np.arange(owned, dtype=np.int32) if cells is None else np.asarray(cells)
         self.X = np.ascontiguousarray(V.tabulate_dof_coordinates(), dtype=np.float64)
         nodes = np.asarray(_compat.cell_nodes(V)[:owned][self.cell_ids], dtype=np.int32)
-        if nodes.shape[1] != 4:
-            raise ValueError("element.formulation: the shell triangle is not built yet; "
-                             "mesh the surface with quadrilaterals")  # fmt: skip
+        if nodes.shape[1] != {"quadrilateral": 4, "triangle": 3}[technology.cell]:
+            raise ValueError(f"element.formulation: {technology.formulation!r} is not for "
+                             f"cells of {nodes.shape[1]} nodes")  # fmt: skip
+        if nodes.shape[1] == 4:
+            nodes = nodes[:, _CCW]
         thickness = np.broadcast_to(np.asarray(thickness, dtype=np.float64), (owned,))
         thickness = thickness[self.cell_ids] if cells is not None else thickness
-        self.kernel = k = ShellKernel(material, technology, nodes[:, _CCW], thickness,
+        self.kernel = k = ShellKernel(material, technology, nodes, thickness,
                                       max_flow_stress=max_flow_stress, failed_share=failed_share)  # fmt: skip
         self.plastic, self.failure = k.plastic, k.failure
         self.params, self.ffi = k.params, k.ffi
@@ -453,7 +465,8 @@ class ShellForce:
     @property
     def energy_names(self) -> tuple[str, ...]:
         names = ("internal",)
-        if any(c > 0.0 for c in self.technology.hourglass):
+        t = self.technology
+        if t.cell == "quadrilateral" and any(c > 0.0 for c in t.hourglass):
             names += ("hourglass",)
         return names + (("eroded_internal",) if self.erosion is not None else ())
 

@@ -1,5 +1,5 @@
-"""ShellForce on a DOLFINx surface mesh (serial and 2 ranks): the cells are handed to the
-kernel counter-clockwise, ghosts and owners add up, a rigid motion of a tilted plate gives
+"""ShellForce on a DOLFINx surface mesh of quadrilaterals or triangles (serial and 2 ranks):
+quadrilaterals are handed to the kernel counter-clockwise, ghosts and owners add up, a rigid motion of a tilted plate gives
 no force, and a linear in-plane velocity gives every cell the membrane resultant t C eps
 with no force on the interior nodes (the membrane patch test through the mesh)."""
 
@@ -20,12 +20,12 @@ ELASTIC = SimpleNamespace(model="linear_elastic", plastic=False, young=E, poisso
 AXIS = np.array([1.0, 1.0, 1.0]) / math.sqrt(3.0)
 
 
-def tilted_plate():
-    body = plate_surface_mesh(MPI.COMM_WORLD, (0.1, 0.2, 0.3), (1.0, 0.5, T), 0.125,
-                              "quadrilateral", axis=AXIS)  # fmt: skip
+def tilted_plate(cell):
+    body = plate_surface_mesh(MPI.COMM_WORLD, (0.1, 0.2, 0.3), (1.0, 0.5, T), 0.125, cell,
+                              axis=AXIS)  # fmt: skip
     V = _compat.vector_space(body.msh)
     fields = [GhostedField(V) for _ in range(3)]
-    force = ShellForce(V, ELASTIC, ShellTechnology.choose("quadrilateral"), *fields, thickness=T)
+    force = ShellForce(V, ELASTIC, ShellTechnology.choose(cell), *fields, thickness=T)
     return V, force, fields
 
 
@@ -40,8 +40,9 @@ def run(force, u, v, w, dt):
     return force.f.owned, force.m.owned
 
 
-def test_rigid_motion_of_a_tilted_plate():
-    V, force, (u, v, w) = tilted_plate()
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_rigid_motion_of_a_tilted_plate(cell):
+    V, force, (u, v, w) = tilted_plate(cell)
     X = force.X
     dt, omega, speed = 1e-5, np.array([40.0, -70.0, 20.0]), np.array([1.0, 2.0, -3.0])
     v.array[:] = speed + np.cross(omega, X - 0.3)
@@ -55,8 +56,9 @@ def test_rigid_motion_of_a_tilted_plate():
     assert abs(comm.allreduce(force.hourglass_energy)) <= 1e-12 * 0.5 * E * 1e-6 * T
 
 
-def test_membrane_patch_through_the_mesh():
-    V, force, (u, v, w) = tilted_plate()
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_membrane_patch_through_the_mesh(cell):
+    V, force, (u, v, w) = tilted_plate(cell)
     X = force.X
     R = rotation_to(AXIS)  # the plate's own x, y, z turned: z along AXIS
     a, b = R @ [1.0, 0.0, 0.0], R @ [0.0, 1.0, 0.0]
