@@ -41,17 +41,20 @@ def best(call, repeats=7):
     return min(times)
 
 
-def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=300e6):
-    n = int(round(math.sqrt(cells_wanted)))
+def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=300e6,
+               cell="quadrilateral"):
+    n = int(round(math.sqrt(cells_wanted / (2 if cell == "triangle" else 1))))
     h = 2.5e-3
     s = np.arange(n + 1) * h
     X = np.array([[x, y, 0.0] for y in s for x in s])
     cells = np.array([[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
                        (j + 1) * (n + 1) + i] for j in range(n) for i in range(n)], np.int32)  # fmt: skip
+    if cell == "triangle":  # each square halved
+        cells = np.ascontiguousarray(np.concatenate([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]]))
     rng = np.random.default_rng(0)
     material = SimpleNamespace(**(J2 | {"yield_stress": yield_stress})) if plastic else SimpleNamespace(
         model="linear_elastic", plastic=False, young=E, poisson=NU, density=RHO)  # fmt: skip
-    k = ShellKernel(material, ShellTechnology.choose("quadrilateral", points=points), cells, 1e-3)
+    k = ShellKernel(material, ShellTechnology.choose(cell, points=points), cells, 1e-3)
     u = rng.normal(size=X.shape) * 1e-6
     v, w = rng.normal(size=X.shape), rng.normal(size=X.shape) * 100
     f, m = np.zeros_like(X), np.zeros_like(X)
@@ -113,7 +116,10 @@ def main(sizes):
         for name, case in (("shell quad elastic", lambda: shell_case(size, False)),
                            ("shell quad J2, 5 points", lambda: shell_case(size, True)),
                            ("shell quad J2, 3 points", lambda: shell_case(size, True, 3)),
-                           ("shell quad J2, 5 points, elastic", lambda: shell_case(size, True, 5, 1e12))):  # fmt: skip
+                           ("shell quad J2, 5 points, elastic", lambda: shell_case(size, True, 5, 1e12)),
+                           ("shell triangle elastic", lambda: shell_case(size, False, cell="triangle")),
+                           ("shell triangle J2, 5 points",
+                            lambda: shell_case(size, True, cell="triangle"))):  # fmt: skip
             cells, call = case()
             rows.append((name, cells, best(call) / cells * 1e9))
         cells, call, _keep = hex_case(size)
