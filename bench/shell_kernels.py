@@ -4,7 +4,8 @@
 
 Each kernel runs over a structured grid of the given number of cells (default 10,000 and
 100,000) with small random velocities, as in a step of a run, on one core; the best of
-several repeats (processor time: the machine may be shared) is reported. The J2 cases (power-law hardening) flow plastically at every
+several repeats (processor time: the machine may be shared) is reported. The J2 cases
+(power-law hardening) flow plastically at every
 point once the first steps have brought the stresses to the yield surface (a steady
 plastic flow, increments of about 4e-5 per step), hexahedra alike; "elastic" is the same
 law below its yield stress.
@@ -47,13 +48,17 @@ def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=3
     h = 2.5e-3
     s = np.arange(n + 1) * h
     X = np.array([[x, y, 0.0] for y in s for x in s])
-    cells = np.array([[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
-                       (j + 1) * (n + 1) + i] for j in range(n) for i in range(n)], np.int32)  # fmt: skip
+    row = n + 1
+    cells = np.array([[j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i]
+                      for j in range(n) for i in range(n)], np.int32)  # fmt: skip
     if cell == "triangle":  # each square halved
         cells = np.ascontiguousarray(np.concatenate([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]]))
     rng = np.random.default_rng(0)
-    material = SimpleNamespace(**(J2 | {"yield_stress": yield_stress})) if plastic else SimpleNamespace(
-        model="linear_elastic", plastic=False, young=E, poisson=NU, density=RHO)  # fmt: skip
+    if plastic:
+        material = SimpleNamespace(**(J2 | {"yield_stress": yield_stress}))
+    else:
+        material = SimpleNamespace(model="linear_elastic", plastic=False, young=E, poisson=NU,
+                                   density=RHO)  # fmt: skip
     k = ShellKernel(material, ShellTechnology.choose(cell, points=points), cells, 1e-3)
     u = rng.normal(size=X.shape) * 1e-6
     v, w = rng.normal(size=X.shape), rng.normal(size=X.shape) * 100
@@ -90,7 +95,8 @@ def hex_case(cells_wanted: int):
     p.lmbda, p.mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
     p.density, p.wave_speed = RHO, math.sqrt((p.lmbda + 2 * p.mu) / RHO)
     p.hourglass_coefficient, p.calibration, p.dt, p.estimate = 0.1, 1.0, 1e-7, 1
-    p.hardening, p.yield_stress, p.hardening_coefficient, p.hardening_exponent = 1, 300e6, 500e6, 0.3
+    p.hardening, p.yield_stress = 1, 300e6
+    p.hardening_coefficient, p.hardening_exponent = 500e6, 0.3
     volume0 = np.full(len(cells), h**3)
     p.volume0 = ffi.cast("double *", volume0.ctypes.data)
     state = np.zeros((8 + 12, len(cells)))
@@ -99,8 +105,9 @@ def hex_case(cells_wanted: int):
         return ffi.cast(kind, a.ctypes.data)
 
     def call():
-        lib.hex8r_plastic_viscous(len(cells), ptr(cells, "int32_t *"), ptr(X), ptr(u), ptr(v), p,
-                                  ptr(state), len(cells), ptr(f), ptr(energy), ptr(step))  # fmt: skip
+        lib.hex8r_plastic_viscous(len(cells), ptr(cells, "int32_t *"), ptr(X), ptr(u), ptr(v),
+                                  p, ptr(state), len(cells), ptr(f), ptr(energy),
+                                  ptr(step))  # fmt: skip
 
     for _ in range(WARM_UP):
         call()
@@ -113,13 +120,15 @@ def main(sizes):
     print(f"{'kernel':34s} {'cells':>8s} {'ns/element-step':>16s}")
     for size in sizes:
         rows = []
-        for name, case in (("shell quad elastic", lambda: shell_case(size, False)),
-                           ("shell quad J2, 5 points", lambda: shell_case(size, True)),
-                           ("shell quad J2, 3 points", lambda: shell_case(size, True, 3)),
-                           ("shell quad J2, 5 points, elastic", lambda: shell_case(size, True, 5, 1e12)),
-                           ("shell triangle elastic", lambda: shell_case(size, False, cell="triangle")),
-                           ("shell triangle J2, 5 points",
-                            lambda: shell_case(size, True, cell="triangle"))):  # fmt: skip
+        cases = (
+            ("shell quad elastic", lambda: shell_case(size, False)),
+            ("shell quad J2, 5 points", lambda: shell_case(size, True)),
+            ("shell quad J2, 3 points", lambda: shell_case(size, True, 3)),
+            ("shell quad J2, 5 points, elastic", lambda: shell_case(size, True, 5, 1e12)),
+            ("shell triangle elastic", lambda: shell_case(size, False, cell="triangle")),
+            ("shell triangle J2, 5 points", lambda: shell_case(size, True, cell="triangle")),
+        )
+        for name, case in cases:
             cells, call = case()
             rows.append((name, cells, best(call) / cells * 1e9))
         cells, call, _keep = hex_case(size)

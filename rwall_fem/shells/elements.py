@@ -4,11 +4,11 @@ compiled code.
 The kernels are ``rwall_fem/kernels/shell_quad.c`` (the Belytschko-Lin-Tsay quadrilateral,
 with the Belytschko-Wong-Chiang warping correction by rigid-body projection unless the
 formulation is plain ``"bt"``), ``shell_tria.c`` (the C0 triangle of Belytschko, Stolarski
-and Carpenter, its transverse shear tied along its sides) and ``shell.h`` (the plane-stress J2 return and the rule
-through the thickness); their formulas are in their header comments and in
-``docs/theory.md`` ("Shells"). They are compiled through cffi into a module of their own,
-cached like :mod:`rwall_fem.kernels` (they include its ``batch.h``, ``plasticity.h``,
-``step.h`` and ``failure.h``).
+and Carpenter, its transverse shear tied along its sides) and ``shell.h`` (the
+plane-stress J2 return and the rule through the thickness); their formulas are in their
+header comments. They are compiled through cffi into a module of their own, cached like
+:mod:`rwall_fem.kernels` (they include its ``batch.h``, ``plasticity.h``, ``step.h`` and
+``failure.h``).
 
 :class:`ShellKernel` is the compiled kernel of one material and technology on NumPy arrays
 (what the element tests drive); :class:`ShellForce` is the internal force of the cells of a
@@ -233,8 +233,16 @@ class ShellKernel:
     for the cell to fail (1: all).
     """
 
-    def __init__(self, material, technology: ShellTechnology, cells: np.ndarray,
-                 thickness, *, max_flow_stress: float = math.inf, failed_share: float = 1.0):  # fmt: skip
+    def __init__(
+        self,
+        material,
+        technology: ShellTechnology,
+        cells: np.ndarray,
+        thickness,
+        *,
+        max_flow_stress: float = math.inf,
+        failed_share: float = 1.0,
+    ):
         if not material.plastic and material.model != "linear_elastic":
             raise ValueError(
                 f"material.model: {material.model!r} has no shell kernel; shells take "
@@ -448,8 +456,10 @@ class ShellForce:
             nodes = nodes[:, _CCW]
         thickness = np.broadcast_to(np.asarray(thickness, dtype=np.float64), (owned,))
         thickness = thickness[self.cell_ids] if cells is not None else thickness
-        self.kernel = k = ShellKernel(material, technology, nodes, thickness,
-                                      max_flow_stress=max_flow_stress, failed_share=failed_share)  # fmt: skip
+        self.kernel = k = ShellKernel(
+            material, technology, nodes, thickness, max_flow_stress=max_flow_stress,
+            failed_share=failed_share,
+        )  # fmt: skip
         self.plastic, self.failure = k.plastic, k.failure
         self.params, self.ffi = k.params, k.ffi
         self.cells, self.num_cells = k.cells, k.num_cells

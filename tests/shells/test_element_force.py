@@ -1,7 +1,8 @@
 """ShellForce on a DOLFINx surface mesh of quadrilaterals or triangles (serial and 2 ranks):
-quadrilaterals are handed to the kernel counter-clockwise, ghosts and owners add up, a rigid motion of a tilted plate gives
-no force, and a linear in-plane velocity gives every cell the membrane resultant t C eps
-with no force on the interior nodes (the membrane patch test through the mesh)."""
+quadrilaterals are handed to the kernel counter-clockwise, ghosts and owners add up, a
+rigid motion of a tilted plate gives no force, and a linear in-plane velocity gives every
+cell the membrane resultant t C eps with no force on the interior nodes (the membrane patch
+test through the mesh)."""
 
 import math
 from types import SimpleNamespace

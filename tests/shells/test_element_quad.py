@@ -38,7 +38,8 @@ def patch(n=3, warp=0.1, seed=1):
     inner = (X[:, 0] > 0) & (X[:, 0] < 1) & (X[:, 1] > 0) & (X[:, 1] < 1)
     X[inner, :2] += rng.uniform(-0.2, 0.2, (inner.sum(), 2)) / n
     X[:, 2] = warp * rng.uniform(-1, 1, len(X)) / n
-    cells = [[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i]
+    row = n + 1
+    cells = [[j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i]
              for j in range(n) for i in range(n)]  # fmt: skip
     return X, np.array(cells, dtype=np.int32)
 

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from test_element_quad import ELASTIC, J2, E, NU, T, rigid_run, rotation  # noqa: F401
+from test_element_quad import ELASTIC, J2, E, NU, T, rigid_run
 
 from rwall_fem.shells.elements import ShellKernel, ShellTechnology
 
