@@ -1,5 +1,5 @@
 /* What the shell kernels share: their constants, the plane-stress J2 return and the
- * through-thickness rule (docs/theory.md, "Shells").
+ * through-thickness rule (docs/theory.md, "Shell elements").
  *
  * Plane stress (sigma_zz = 0) in the cell's local frame; in-plane stresses and strains are
  * (xx, yy, xy) with the engineering shear strain gamma_xy = 2 eps_xy.  Hooke's law is

@@ -1,7 +1,7 @@
 /* Internal force of the Belytschko-Lin-Tsay quadrilateral shell (one in-plane point,
  * co-rotational frame, viscous hourglass control), batched over cells like the solids'.
  *
- * Notation (docs/theory.md, "Shells"): nodes I = 0..3 counter-clockwise (the caller
+ * Notation (docs/theory.md, "Shell elements"): nodes I = 0..3 counter-clockwise (the caller
  * reorders DOLFINx's (0, 1, 3, 2)).  Each cycle the cell gets a local frame: e3 along
  * d02 x d13 (the diagonals), e1 along the projected xi direction x1 + x2 - x0 - x3,
  * e2 = e3 x e1.  The local coordinates (x_I, y_I, z_I) of the nodes about the centroid
