@@ -529,6 +529,13 @@ def _boundary(scene: Scene, i: int, solid: _Solid) -> VelocityBoundary:
             f"the mesh has: {known}"
         )
     nodes = _owned(group_nodes(solid.V, solid.body, spec.group), solid.owned)
+    if spec.rotations is not None:
+        if not solid.shells:
+            raise SceneError(
+                f"{scene.source}: boundary[{i}].rotations: is for shells (nodes with "
+                f"rotations); the mesh has {solid.body.msh.topology.cell_type.name} cells"
+            )
+        solid.elastic.hold_rotations(nodes, spec.rotations)
     return VelocityBoundary(f"boundary[{i}]", nodes, spec.velocity, spec.components)
 
 

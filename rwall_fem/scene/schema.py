@@ -869,6 +869,13 @@ class BoundarySpec:
     components: str = key(
         Letters(), "xyz", doc="the global components prescribed; the others stay free"
     )
+    rotations: str | None = key(
+        Letters(),
+        None,
+        doc="shells: the global components of the nodes' rotations held fixed (with "
+        "components = 'xyz', rotations = 'xyz' clamps an edge)",
+        default_doc="none: the rotations stay free (a simply supported edge)",
+    )
 
 
 # --- [[wall]] ------------------------------------------------------------------------

@@ -126,6 +126,7 @@ class ShellBody:
         self.energy_names = ("rotational_kinetic", "internal", "hourglass")
         self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
         self._nodes = np.asarray(_compat.cell_nodes(V))  # each local cell's nodes
+        self._free = None  # (owned nodes, 3): 0 where a rotation is held, else 1
         self._acceleration = None
 
     # --- the step ----------------------------------------------------------------------
@@ -158,6 +159,18 @@ class ShellBody:
             )  # fmt: skip
         for pass_ in self._acceleration:
             pass_()
+        if self._free is not None:
+            self.alpha *= self._free
+
+    def hold_rotations(self, nodes: np.ndarray, axes: str) -> None:
+        """Hold the rotations of the owned ``nodes`` about the global ``axes`` (some of
+        "xyz") fixed: their angular velocity stays 0, the reaction moment does no work (a
+        clamped edge with the translations held by a boundary condition)."""
+        if self._free is None:
+            self._free = np.ones_like(self.alpha)
+        columns = ["xyz".index(c) for c in axes]
+        self._free[np.ix_(nodes, columns)] = 0.0
+        self.w.owned[np.ix_(nodes, columns)] = 0.0
 
     def _combine_steps(self) -> None:
         """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index

@@ -138,6 +138,7 @@ BEYOND = {
     "293_tube_of_hexahedra",
     "294_tube_trigger_without_wavelength",
     "295_tube_trigger_longer_than_the_tube",
+    "296_rotations_held_on_a_solid",
 }
 
 
