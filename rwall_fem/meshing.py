@@ -475,6 +475,8 @@ def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int], int]:
         if d == dim
     }
     _regions_are_disjoint(volumes, dim)
+    if dim == 3:
+        _surfaces_lie_on_the_volumes(groups)
     types = gmsh.model.mesh.getElementTypes(dim)
     kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in types]
     if len(kinds) > 1:
@@ -484,6 +486,24 @@ def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int], int]:
             f" (a shape of meshes/: try another element_size or {hint})"
         )
     return groups, volumes, dim
+
+
+def _surfaces_lie_on_the_volumes(groups: dict[str, int]) -> None:
+    """Every physical surface of a body of volumes lies on its volume cells (a face group):
+    a surface apart from them would be shells, and a body is shells or solids."""
+    import gmsh
+
+    _, cell_nodes = gmsh.model.mesh.getElements(3)[1:]
+    solid = np.unique(np.concatenate([np.asarray(n) for n in cell_nodes]))
+    for name, tag in groups.items():
+        nodes = np.asarray(gmsh.model.mesh.getNodesForPhysicalGroup(2, tag)[0])
+        apart = np.setdiff1d(nodes, solid)
+        if len(apart):
+            raise _GmshError(
+                f"the physical surface '{name}' has {len(apart)} nodes on no volume cell: "
+                "it is shells beside the solids, and a scene mixes no shells and solids in "
+                "one mesh"
+            )
 
 
 def _regions_are_disjoint(volumes: dict[str, int], dim: int = 3) -> None:

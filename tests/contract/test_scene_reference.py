@@ -139,6 +139,7 @@ BEYOND = {
     "294_tube_trigger_without_wavelength",
     "295_tube_trigger_longer_than_the_tube",
     "296_rotations_held_on_a_solid",
+    "297_shells_beside_solids_in_one_mesh_file",
 }
 
 
