@@ -35,9 +35,10 @@ def kernel(mat=None, **options):
                        **options)  # fmt: skip
 
 
-def uniaxial(k, strains):
+def uniaxial(k, strains, dt=0.0):
     """Drive one point along eps_xx = strains with sigma_yy = sigma_xy = 0 (the lateral
-    strain increment found by the secant method); returns sigma_xx and eps_p."""
+    strain increment found by the secant method), each increment over dt (s); returns
+    sigma_xx and eps_p."""
     sigma, eps_p, T, previous = np.zeros(3), 0.0, 0.0, 0.0
     out = []
     for strain in strains:
@@ -45,14 +46,14 @@ def uniaxial(k, strains):
         lateral = [-NU * dx, -0.5 * dx]
         residual = []
         for guess in lateral:
-            residual.append(k.point(sigma, eps_p, T, (dx, guess, 0.0))[0][1])
+            residual.append(k.point(sigma, eps_p, T, (dx, guess, 0.0), dt)[0][1])
         for _ in range(30):
             if abs(residual[-1]) <= 1e-9 * A:
                 break
             slope = (residual[-1] - residual[-2]) / (lateral[-1] - lateral[-2])
             lateral.append(lateral[-1] - residual[-1] / slope)
-            residual.append(k.point(sigma, eps_p, T, (dx, lateral[-1], 0.0))[0][1])
-        sigma, eps_p, T, _ = k.point(sigma, eps_p, T, (dx, lateral[-1], 0.0))
+            residual.append(k.point(sigma, eps_p, T, (dx, lateral[-1], 0.0), dt)[0][1])
+        sigma, eps_p, T, _ = k.point(sigma, eps_p, T, (dx, lateral[-1], 0.0), dt)
         out.append((sigma[0], eps_p))
         previous = strain
     return np.array(out)
@@ -241,3 +242,15 @@ def test_plastic_moment_through_the_thickness(points, ratio):
     assert rule == pytest.approx(ratio, abs=1e-4)
     assert M[0] / (A * t * t / 4) == pytest.approx(rule, rel=2e-3)
     assert abs(M[1]) <= 1e-6 * A * t * t
+
+
+def test_johnson_cook_rate_factor():
+    """Johnson-Cook's flow stress at a constant strain rate of 1000 /s in uniaxial stress:
+    sigma = (A + B eps_p^n)(1 + C ln(rate / rate_0)) within 0.5 % (the rate of the step is
+    the equivalent deviatoric one with the thickness strain of incompressible flow)."""
+    mat = material(model="johnson_cook", strain_rate_coefficient=0.02, reference_strain_rate=1.0)
+    rate, strains = 1000.0, np.linspace(0.0, 0.1, 401)[1:]
+    result = uniaxial(kernel(mat), strains, dt=(strains[1] - strains[0]) / rate)
+    factor = 1 + 0.02 * math.log(rate)
+    late = result[len(result) // 2 :]
+    np.testing.assert_allclose(late[:, 0], (A + B * late[:, 1] ** N) * factor, rtol=5e-3)
