@@ -96,6 +96,18 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
     return ShellSection(technology, formulation, thickness, element.points)
 
 
+# The sides of DOLFINx's triangle and quadrilateral, by local node index.
+_SIDES = {3: [(0, 1), (1, 2), (2, 0)], 4: [(0, 1), (1, 3), (3, 2), (2, 0)]}
+
+
+def _shortest_side(V, nodes: np.ndarray, comm: MPI.Comm) -> float:
+    """The shortest side (m) of the surface's cells (collective)."""
+    x = V.tabulate_dof_coordinates()
+    sides = np.array(_SIDES[nodes.shape[1]])
+    length = np.linalg.norm(x[nodes[:, sides[:, 1]]] - x[nodes[:, sides[:, 0]]], axis=2)
+    return comm.allreduce(float(length.min(initial=np.inf)), op=MPI.MIN)
+
+
 def shell_solid(scene, comm: MPI.Comm, body):
     """The :class:`~rwall_fem.build._Solid` of the scene's body of shells on the surface
     mesh ``body`` (a :class:`~rwall_fem.meshing.BodyMesh`): parts (physical surfaces) with
@@ -114,12 +126,15 @@ def shell_solid(scene, comm: MPI.Comm, body):
         raise SceneError(f"{scene.source}: {err}") from None
     parts = [ShellPart(p.name, p.cells, p.material, p.technology, p.velocity) for p in found]
     V = _compat.vector_space(body.msh)
+    nodes = np.asarray(_compat.cell_nodes(V))
     if scene.mesh is not None and scene.mesh.noise is not None:
+        from rwall_fem.build import _noise_is_small
         from rwall_fem.meshing import perturb
 
+        if scene.mesh.file is not None:  # a built-in shape's noise was checked with the scene
+            _noise_is_small(scene, _shortest_side(V, nodes, comm))
         perturb(body, *scene.mesh.noise)
     X = V.tabulate_dof_coordinates()[: V.dofmap.index_map.size_local].copy()
-    nodes = np.asarray(_compat.cell_nodes(V))
     inertias = [
         lumped_inertia(V, nodes[part.cells], part.material.density, part.technology.thickness)
         for part in parts
