@@ -529,6 +529,11 @@ class ShellForce:
     def detach_nodes(self) -> None:
         self.erosion.detach()
 
+    def plastic_strains(self) -> np.ndarray:
+        """The equivalent plastic strain of every point through the thickness (rows, bottom
+        to top) of its cells (columns); elasto-plastic forces only."""
+        return self.kernel.plastic_strains()
+
     @property
     def stored_energy(self) -> float:
         return float(self._energy[0])
