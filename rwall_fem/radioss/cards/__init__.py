@@ -35,6 +35,7 @@ from rwall_fem.radioss.cards import (
     nodes,
     parts,
     run,
+    shells,
     solids,
     walls,
 )
@@ -43,8 +44,8 @@ from rwall_fem.radioss.cards.base import keyword
 __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supported", "table"]
 
 STARTER_FAMILIES = (
-    begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
-    control,
+    begin, nodes, solids, shells, parts, materials, failures, groups, functions, conditions,
+    walls, control,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 

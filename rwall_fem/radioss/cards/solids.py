@@ -68,7 +68,8 @@ def _property(deck: Deck, card: Card) -> None:
 
 @catch_all
 def _other_property(deck: Deck, card: Card) -> None:
-    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14)")
+    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14), /PROP/SHELL "
+              "(/PROP/TYPE1)")  # fmt: skip
 
 
 def finish(deck: Deck) -> None:
