@@ -42,6 +42,8 @@ typedef struct
   double fail_fraction;    /* a cell fails when this share of its points has failed */
   int warping;             /* 1: project out the rigid motion (warped cells), 0: plain BT */
   int omit_energy;         /* 1: skip the stored-energy sum (0 by default) */
+  double hk;               /* elastic hourglass stiffness coefficient (0: viscous only) */
+  int hourglass_slot;      /* the state's first row of the 5 elastic hourglass forces */
 } shell_params;
 
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */

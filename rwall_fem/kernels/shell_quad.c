@@ -34,7 +34,12 @@
  * qw = gamma.vz, qr = gamma.theta; generalized forces C q with C = 4 rho c t sqrt(A) times
  * hm (membrane), hf (out of plane) and hr t^2 / 12 (rotations), c the bar speed.  hm = 0.01
  * is 1 % of the damping that is critical for a mode of frequency 2 c / sqrt(A) of a square
- * cell; their dissipation dt C q.q is the hourglass energy.
+ * cell; their dissipation dt C q.q is the hourglass energy.  With s->hk > 0 elastic
+ * hourglass forces are added, incremental in the cell's frame (state rows from
+ * s->hourglass_slot): Q += k dt q with k = hk (2/3) E' t A |b|^2 (membrane; for a square,
+ * hk (4/3) E' t, the normal-strain part of the fully integrated cell's in-plane bending),
+ * 4 hk D A |b|^4 (out of plane) and hk (2/3) D A |b|^2 (rotations), E' = E / (1 - nu^2),
+ * D = E' t^3 / 12, |b|^2 = sum b1^2 + b2^2; their work joins the hourglass energy.
  *
  * Rate form over the step dt = p->dt: the strain increments are dt times the velocity
  * strains of v, theta (v^{n-1/2}) in the mid-step configuration x - dt v / 2 (a rigid
@@ -211,8 +216,9 @@ INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec 
 /* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
  * velocities vl (projected when warping) and angular velocities wl; returns their power, W. */
 INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double density,
-                          vec thickness, int warping, const vec vl[4][3], const vec wl[4][3],
-                          vec *restrict fe)
+                          double dt, vec thickness, int warping, const vec vl[4][3],
+                          const vec wl[4][3], double *restrict state, int64_t stride,
+                          const batch_t *b, vec *restrict fe)
 {
   vec gx = VZERO, gy = VZERO;
   for (int I = 0; I < 4; ++I)
@@ -231,7 +237,31 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   }
   const vec C = (4.0 * density * s->bar_speed) * thickness * vsqrt(g->area);
   const vec Cm = s->hm * C, Cf = s->hf * C, Cr = (s->hr / 12.0) * C * thickness * thickness;
-  const vec Q[5] = {Cm * q[0], Cm * q[1], Cf * q[2], Cr * q[3], Cr * q[4]};
+  vec Q[5] = {Cm * q[0], Cm * q[1], Cf * q[2], Cr * q[3], Cr * q[4]};
+  vec work = VZERO;
+  for (int k = 0; k < 5; ++k)
+    work += dt * Q[k] * q[k];
+  if (s->hk > 0.0)
+  {
+    /* elastic hourglass forces, incremental in the cell's frame: dQ = k dt q */
+    vec bb = VZERO;
+    for (int I = 0; I < 4; ++I)
+      bb += g->b1[I] * g->b1[I] + g->b2[I] * g->b2[I];
+    const double Ep = s->young / (1.0 - s->poisson * s->poisson);
+    const vec bending = (Ep / 12.0) * thickness * thickness * thickness;
+    const vec km = (s->hk * 2.0 / 3.0 * Ep) * thickness * g->area * bb;
+    const vec kw = (4.0 * s->hk) * bending * g->area * bb * bb;
+    const vec kr = (s->hk * 2.0 / 3.0) * bending * g->area * bb;
+    const vec k[5] = {km, km, kw, kr, kr};
+    for (int m = 0; m < 5; ++m)
+    {
+      const vec old = load_slot(state, stride, b, s->hourglass_slot + m);
+      const vec dq = dt * q[m], dQ = k[m] * dq;
+      store_slot(state, stride, b, s->hourglass_slot + m, old + dQ);
+      work += (old + 0.5 * dQ) * dq;
+      Q[m] += old + dQ;
+    }
+  }
   vec fl[4][3], ml[4][2];
   for (int I = 0; I < 4; ++I)
   {
@@ -243,10 +273,7 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   if (warping)
     project_rigid_forces(g, fl);
   add_global(g, fl, ml, fe);
-  vec power = VZERO;
-  for (int k = 0; k < 5; ++k)
-    power += Q[k] * q[k];
-  return power;
+  return work;
 }
 
 /* Radioss's characteristic length (m) of the cells of frame g. */
@@ -305,8 +332,8 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
       project_rigid(&g, vl);
     quad_strain_rates(&g, vl, wl, d, k, gs);
     vec hourglass = VZERO;
-    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0)
-      hourglass = dt * quad_hourglass(&g, s, p->density, t, warping, vl, wl, fe);
+    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
+      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, vl, wl, state, stride, &b, fe);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,

@@ -175,7 +175,9 @@ INLINE void shell_tria(int plastic, int64_t num_cells, const int32_t *restrict c
   for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
     const batch_t b = batch_at(p->live, k0, num_cells);
-    vec Xe[9], ue[9], ve[9], we[9], x[9], xm[9], fe[18], du[18];
+    /* initialised: gather fills them lane by lane */
+    vec Xe[9] = {VZERO}, ue[9] = {VZERO}, ve[9] = {VZERO}, we[9] = {VZERO}, x[9], xm[9], fe[18],
+        du[18];
     gather(cells, 3, &b, X, Xe);
     gather(cells, 3, &b, u, ue);
     gather(cells, 3, &b, v, ve);
@@ -244,7 +246,7 @@ void shell_tria_plastic(int64_t n, const int32_t *cells, const double *X, const 
 void shell_tria_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
                       double *length)
 {
-  vec xe[9];
+  vec xe[9] = {VZERO};
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
   {
     const batch_t b = batch_at(NULL, k0, n);

@@ -59,6 +59,8 @@ typedef struct {
   double hm, hf, hr;
   double max_flow_stress, fail_fraction;
   int warping, omit_energy;
+  double hk;
+  int hourglass_slot;
 } shell_params;
 """
     + "".join(
@@ -186,10 +188,13 @@ class ShellTechnology:
     points: int = 5  # through the thickness (elasto-plastic laws)
     hourglass: tuple[float, float, float] = (0.01, 0.01, 0.01)  # hm, hf, hr
     shear_factor: float = 5.0 / 6.0
+    # elastic hourglass stiffness (quadrilaterals; 0: viscous only, shell_quad.c)
+    hourglass_stiffness: float = 0.0
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
-               hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0) -> ShellTechnology:
+               hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
+               hourglass_stiffness: float = 0.0) -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -208,7 +213,12 @@ class ShellTechnology:
             raise ValueError("element.hourglass_coefficients: must be >= 0")
         if not 0.0 < shear_factor <= 1.0:
             raise ValueError(f"element.shear_factor: must be in (0, 1], got {shear_factor}")
-        return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor))
+        if not hourglass_stiffness >= 0.0:
+            raise ValueError(
+                f"element.hourglass_stiffness: must be >= 0, got {hourglass_stiffness}"
+            )
+        return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
+                   float(hourglass_stiffness) if cell == "quadrilateral" else 0.0)  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -282,6 +292,10 @@ class ShellKernel:
         else:
             s.points = 0
             self.history = np.zeros((8, n))
+        s.hk = technology.hourglass_stiffness
+        if s.hk > 0.0:  # the elastic hourglass forces, in rows after the others
+            s.hourglass_slot = len(self.history)
+            self.history = np.concatenate([self.history, np.zeros((5, n))])
         self.family = FAMILY[technology.cell]
         law = "plastic" if self.plastic else "elastic"
         self.name = f"shell_{self.family}_{law}"

@@ -65,13 +65,15 @@ def rigid_run(kernel, X, steps=60, angle=3.0, dt=1e-4):
     return worst, energy
 
 
+@pytest.mark.parametrize("stiffness", [0.0, 0.1], ids=["viscous", "elastic-hourglass"])
 @pytest.mark.parametrize("material", [ELASTIC, J2], ids=["elastic", "j2"])
 @pytest.mark.parametrize("n", [1, 3])
-def test_rigid_motion_strains_nothing(material, n):
+def test_rigid_motion_strains_nothing(material, n, stiffness):
     """A cell (n = 1, warped) and an irregular warped patch translated and turned through
     3 rad: no force, no moment, no energy (relative to those of a strain of 1e-3)."""
     X, cells = (WARPED, np.array([[0, 1, 2, 3]], np.int32)) if n == 1 else patch(n)
-    kernel = ShellKernel(material, ShellTechnology.choose("quadrilateral"), cells, T)
+    technology = ShellTechnology.choose("quadrilateral", hourglass_stiffness=stiffness)
+    kernel = ShellKernel(material, technology, cells, T)
     worst, energy = rigid_run(kernel, X)
     force_scale = E * T * 1e-3 * 1.0  # N: a membrane strain of 1e-3 over a 1 m edge
     energy_scale = 0.5 * E * 1e-6 * T * 1.0
