@@ -21,13 +21,15 @@
  * Warping (s->warping, Belytschko-Wong-Chiang's correction by the rigid-body projection of
  * Belytschko and Leviathan): a rigid rotation (Ox, Oy) about the in-plane axes gives the
  * nodes of a warped cell the in-plane velocities (Oy z_I, -Ox z_I), which plain BT takes for
- * an hourglass motion (and whose forces are not in moment equilibrium).  The rigid rotation
- * of the cell is Ox = b2.vz, Oy = -b1.vz; its part is removed from the in-plane velocities,
- *     vx'_I = vx_I - z_I Oy,  vy'_I = vy_I + z_I Ox,
- * before the strains and hourglass rates are taken, and the forces come back through the
- * transpose (fz_J += b1_J sum_I z_I fx_I + b2_J sum_I z_I fy_I): any rigid motion then gives
- * exactly zero strain rates, and the nodal forces and moments of any stress are in
- * equilibrium.
+ * an hourglass motion (and whose forces are not in moment equilibrium).  The cell's rigid
+ * rotation is the least-squares fit of all its nodal velocities about the centroid,
+ *     Omega = J^-1 sum_I r_I x (v_I - mean v),  J = sum_I (|r_I|^2 I - r_I r_I^T),
+ * and its part Omega x r_I is removed from the in-plane velocities before the strains and
+ * hourglass rates are taken (the orthogonal projection: an in-plane hourglass motion is
+ * not mistaken for a rotation, as it would be by a fit to vz alone); the in-plane forces
+ * come back through the transpose, f_I -= mu x r_I with mu = J^-1 sum_I r_I x (fx, fy, 0)_I.
+ * Any rigid motion then gives exactly zero strain rates, and the nodal forces and moments
+ * of any stress are in equilibrium.
  *
  * Hourglass (viscous, Belytschko-Tsay): gamma_I = (G_I - (G.x) b1_I - (G.y) b2_I) / 4 with
  * G = (1, -1, 1, -1), orthogonal to every linear field; rates qm = gamma.v' (in-plane),
@@ -124,33 +126,76 @@ INLINE void to_local(const quad_frame_t *g, const vec *restrict a, vec out[4][3]
       out[I][k] = g->e[k][0] * a[3 * I] + g->e[k][1] * a[3 * I + 1] + g->e[k][2] * a[3 * I + 2];
 }
 
-/* Remove the rigid rotation about the in-plane axes from the in-plane velocities (in place). */
-INLINE void project_rigid(const quad_frame_t *g, vec vl[4][3])
+/* The inverse of the nodes' inertia tensor J = sum_I (|r_I|^2 I - r_I r_I^T) about the
+ * centroid (local frame), row-major. */
+INLINE void rigid_inverse(const quad_frame_t *g, vec Ji[9])
 {
-  vec ox = VZERO, oy = VZERO;
+  vec J[9] = {VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO};
   for (int I = 0; I < 4; ++I)
   {
-    ox += g->b2[I] * vl[I][2];
-    oy -= g->b1[I] * vl[I][2];
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    const vec rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        J[3 * i + j] += (i == j ? rr : VZERO) - r[i] * r[j];
   }
+  const vec c0 = J[4] * J[8] - J[5] * J[7], c1 = J[5] * J[6] - J[3] * J[8];
+  const vec c2 = J[3] * J[7] - J[4] * J[6];
+  const vec inv = 1.0 / (J[0] * c0 + J[1] * c1 + J[2] * c2);
+  Ji[0] = c0 * inv, Ji[3] = c1 * inv, Ji[6] = c2 * inv;
+  Ji[1] = (J[2] * J[7] - J[1] * J[8]) * inv, Ji[4] = (J[0] * J[8] - J[2] * J[6]) * inv;
+  Ji[7] = (J[1] * J[6] - J[0] * J[7]) * inv;
+  Ji[2] = (J[1] * J[5] - J[2] * J[4]) * inv, Ji[5] = (J[2] * J[3] - J[0] * J[5]) * inv;
+  Ji[8] = (J[0] * J[4] - J[1] * J[3]) * inv;
+}
+
+/* Remove the cell's rigid rotation, the least-squares fit Omega = J^-1 sum r_I x (v_I - mean v)
+ * of all its nodal velocities, from the in-plane velocities (in place). */
+INLINE void project_rigid(const quad_frame_t *g, const vec Ji[9], vec vl[4][3])
+{
+  vec mean[3], a[3] = {VZERO, VZERO, VZERO}, o[3];
+  for (int i = 0; i < 3; ++i)
+    mean[i] = 0.25 * (vl[0][i] + vl[1][i] + vl[2][i] + vl[3][i]);
   for (int I = 0; I < 4; ++I)
   {
-    vl[I][0] -= g->z[I] * oy;
-    vl[I][1] += g->z[I] * ox;
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    const vec d[3] = {vl[I][0] - mean[0], vl[I][1] - mean[1], vl[I][2] - mean[2]};
+    vec c[3];
+    cross(r, d, c);
+    for (int i = 0; i < 3; ++i)
+      a[i] += c[i];
+  }
+  for (int i = 0; i < 3; ++i)
+    o[i] = Ji[3 * i] * a[0] + Ji[3 * i + 1] * a[1] + Ji[3 * i + 2] * a[2];
+  for (int I = 0; I < 4; ++I)
+  {
+    vl[I][0] -= o[1] * g->z[I] - o[2] * g->y[I];
+    vl[I][1] -= o[2] * g->x[I] - o[0] * g->z[I];
   }
 }
 
-/* The transpose of project_rigid on local nodal forces fl (in place). */
-INLINE void project_rigid_forces(const quad_frame_t *g, vec fl[4][3])
+/* The transpose of project_rigid on local nodal forces fl whose in-plane parts act on the
+ * projected velocities (in place): fl_I -= mu x r_I, mu = J^-1 sum r_I x (fx_I, fy_I, 0). */
+INLINE void project_rigid_forces(const quad_frame_t *g, const vec Ji[9], vec fl[4][3])
 {
-  vec sx = VZERO, sy = VZERO;
+  vec M[3] = {VZERO, VZERO, VZERO}, mu[3];
   for (int I = 0; I < 4; ++I)
   {
-    sx += g->z[I] * fl[I][0];
-    sy += g->z[I] * fl[I][1];
+    /* r x (fx, fy, 0) */
+    M[0] -= g->z[I] * fl[I][1];
+    M[1] += g->z[I] * fl[I][0];
+    M[2] += g->x[I] * fl[I][1] - g->y[I] * fl[I][0];
   }
+  for (int i = 0; i < 3; ++i)
+    mu[i] = Ji[3 * i] * M[0] + Ji[3 * i + 1] * M[1] + Ji[3 * i + 2] * M[2];
   for (int I = 0; I < 4; ++I)
-    fl[I][2] += g->b1[I] * sx + g->b2[I] * sy;
+  {
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    vec c[3];
+    cross(mu, r, c);
+    for (int i = 0; i < 3; ++i)
+      fl[I][i] -= c[i];
+  }
 }
 
 /* Membrane (xx, yy, gamma_xy), curvature and transverse shear velocity strains. */
@@ -194,8 +239,9 @@ INLINE void add_global(const quad_frame_t *g, const vec fl[4][3], const vec ml[4
 
 /* The nodal forces and moments of the resultants N, M, Q on the cells of frame g, added
  * to fe (global). */
-INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec N[3],
-                                  const vec M[3], const vec Q[2], vec *restrict fe)
+INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec Ji[9],
+                                  const vec N[3], const vec M[3], const vec Q[2],
+                                  vec *restrict fe)
 {
   vec fl[4][3], ml[4][2];
   const vec A = g->area;
@@ -209,14 +255,15 @@ INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec 
     ml[I][1] = b1 * M[0] + b2 * M[2] + (0.25 * A) * Q[0];
   }
   if (warping)
-    project_rigid_forces(g, fl);
+    project_rigid_forces(g, Ji, fl);
   add_global(g, fl, ml, fe);
 }
 
 /* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
  * velocities vl (projected when warping) and angular velocities wl; returns their power, W. */
 INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double density,
-                          double dt, vec thickness, int warping, const vec vl[4][3],
+                          double dt, vec thickness, int warping, const vec Ji[9],
+                          const vec vl[4][3],
                           const vec wl[4][3], double *restrict state, int64_t stride,
                           const batch_t *b, vec *restrict fe)
 {
@@ -271,7 +318,7 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
     ml[I][1] = gamma[I] * Q[4];
   }
   if (warping)
-    project_rigid_forces(g, fl);
+    project_rigid_forces(g, Ji, fl);
   add_global(g, fl, ml, fe);
   return work;
 }
@@ -328,18 +375,25 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
     to_local(&g, ve, vl);
     to_local(&g, we, wl);
+    vec Ji[9];
     if (warping)
-      project_rigid(&g, vl);
+    {
+      rigid_inverse(&g, Ji);
+      project_rigid(&g, Ji, vl);
+    }
     quad_strain_rates(&g, vl, wl, d, k, gs);
     vec hourglass = VZERO;
     if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
-      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, vl, wl, state, stride, &b, fe);
+      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, Ji, vl, wl, state, stride,
+                                 &b, fe);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
                  &damage);
     quad_frame(x, &g);
-    quad_resultant_forces(&g, warping, N, M, Q, fe);
+    if (warping)
+      rigid_inverse(&g, Ji);
+    quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
     elastic *= g.area;
     const vec plastic_work = dissipated * mid_area;
     const ivec inverted = ~(g.area > 0.0);
