@@ -816,20 +816,25 @@ class Element:
         "Belytschko-Stolarski-Carpenter triangle",
         default_doc="bwc on quadrilaterals, bsc on triangles",
     )
-    points: int = key(
+    points: int | None = key(
         Integer(1, 10, why="Radioss's N"),
-        5,
+        None,
         doc="shells: integration points through the thickness (equally spaced, both surfaces "
         "included)",
+        default_doc="5",
     )
-    hourglass_coefficients: tuple[float, float, float] = key(
+    hourglass_coefficients: tuple[float, float, float] | None = key(
         Vector(kind="non_negative"),
-        (0.01, 0.01, 0.01),
+        None,
         doc="shells: the viscous hourglass coefficients of the membrane, bending and "
         "rotation modes (Radioss's hm, hf, hr)",
+        default_doc="[0.01, 0.01, 0.01]",
     )
-    shear_factor: float = key(
-        Real(low=0.0, high=1.0), 5.0 / 6.0, doc="shells: the transverse shear factor"
+    shear_factor: float | None = key(
+        Real(low=0.0, high=1.0),
+        None,
+        doc="shells: the transverse shear factor",
+        default_doc="5/6",
     )
 
 

@@ -23,6 +23,8 @@ from rwall_fem.shells.inertia import lumped_inertia
 
 __all__ = ["shell_solid", "solid_keys_on_shells"]
 
+# The defaults of the shells' [element] keys: Radioss's N, hm, hf, hr and Ashear.
+POINTS, HOURGLASS, SHEAR_FACTOR = 5, (0.01, 0.01, 0.01), 5.0 / 6.0
 # The scene's [element] keys that only solids have, as the Element dataclass holds them
 # (None: not given).
 _SOLID_VALUES = ("integration", "hourglass", "hourglass_coefficient")
@@ -81,19 +83,20 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
     from rwall_fem.shells.elements import ShellTechnology
 
     formulation = element.formulation or ("bsc" if cell == "triangle" else "bwc")
+    points = element.points or POINTS
     try:
         technology = ShellTechnology.choose(
             cell,
             formulation,
-            points=element.points,
-            hourglass=element.hourglass_coefficients,
-            shear_factor=element.shear_factor,
+            points=points,
+            hourglass=element.hourglass_coefficients or HOURGLASS,
+            shear_factor=element.shear_factor or SHEAR_FACTOR,
         )
     except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
         said = str(err)
         said = where + said[len("element") :] if said.startswith("element.") else f"{where}: {said}"
         raise SceneError(f"{scene.source}: {said}") from None
-    return ShellSection(technology, formulation, thickness, element.points)
+    return ShellSection(technology, formulation, thickness, points)
 
 
 # The sides of DOLFINx's triangle and quadrilateral, by local node index.
