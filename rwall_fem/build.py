@@ -217,6 +217,7 @@ class _Solid:
     elastic: Body
     dt_stable: float
     size: float
+    shells: bool = False  # a body of shells (rwall_fem.shells): elastic is its ShellBody
 
     @property
     def owned(self) -> int:
@@ -245,6 +246,14 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
             where = "mesh.file" if spec.file is not None else "mesh"
             raise SceneError(f"{scene.source}: {where}: {err}") from None
     cell = body.msh.topology.cell_type.name
+    if body.msh.topology.dim == 2:
+        from rwall_fem.shells.build import shell_solid
+
+        return shell_solid(scene, comm, body)
+    if spec is not None and spec.file is not None:
+        from rwall_fem.shells.build import solid_keys_on_shells
+
+        solid_keys_on_shells(scene, cell)
     if cell not in ("tetrahedron", "hexahedron"):
         raise SceneError(
             f"{scene.source}: mesh: {cell} cells; allowed: tetrahedra or hexahedra (a volume)"
@@ -348,8 +357,9 @@ def _step_fact(sim: Simulation) -> str:
         if step.mode == "adaptive"
         else "fixed"
     )
+    source = "L_c / c" if info["cell"] in ("quadrilateral", "triangle") else "eigenvalue"
     return (
-        f"time step {how}; at rest: stable {info['dt_stable']:.4g} s (eigenvalue), smallest "
+        f"time step {how}; at rest: stable {info['dt_stable']:.4g} s ({source}), smallest "
         f"L/c of a cell {info['dt_element_estimate']:.4g} s; dt = {sim.state.dt:.4g} s"
     )
 
@@ -359,7 +369,8 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     they act."""
     comm = solid.comm
     internal = solid.elastic
-    if any(part.material.model != "linear_elastic" for part in solid.parts):
+    nonlinear = any(part.material.model != "linear_elastic" for part in solid.parts)
+    if nonlinear and not solid.shells:
         internal = Body(solid.V, solid.parts, solid.u, solid.v, explicit=bool(scene.parts))
     internal.part_masses = solid.part_masses.copy()
     if reason := shared_velocities(internal, comm):
@@ -386,7 +397,13 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     boundaries = [_boundary(scene, i, solid) for i in range(len(scene.boundaries))]
     rigid = _rigid_bodies(scene, solid, state, walls, boundaries)
     inactive = deactivate_rigid_cells(internal, rigid, solid.V, comm) if rigid else 0
+    update = None
+    if solid.shells:
+        from rwall_fem.shells.update import ShellUpdate
+
+        update = ShellUpdate(state, internal)
     return Simulation(
+        update=update,
         state=state,
         end_time=scene.run.end_time,
         internal=internal,
@@ -636,6 +653,13 @@ def _boundary(scene: Scene, i: int, solid: _Solid) -> VelocityBoundary:
             f"the mesh has: {known}"
         )
     nodes = _owned(group_nodes(solid.V, solid.body, spec.group), solid.owned)
+    if spec.rotations is not None:
+        if not solid.shells:
+            raise SceneError(
+                f"{scene.source}: boundary[{i}].rotations: is for shells (nodes with "
+                f"rotations); the mesh has {solid.body.msh.topology.cell_type.name} cells"
+            )
+        solid.elastic.hold_rotations(nodes, spec.rotations)
     return VelocityBoundary(f"boundary[{i}]", nodes, spec.velocity, spec.components)
 
 
@@ -657,7 +681,7 @@ def _secondary_nodes(
                 )
     selected = np.zeros(owned, dtype=bool)
     if sec.search_distance is None and not sec.add and not sec.parts:
-        if erodes:  # erosion bares the inside: every node may meet the wall
+        if erodes or solid.shells:  # erosion bares the inside; a shell's nodes are all on it
             selected[:] = True
         else:
             selected[_owned(boundary_nodes(V), owned)] = True

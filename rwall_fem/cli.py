@@ -356,10 +356,11 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
             if adaptive
             else f"{sim.planned_steps} steps to {scene.run.end_time:.4g} s"
         )
+        shells = info["cell"] in ("quadrilateral", "triangle")  # no eigenvalue: the L_c / c
+        stable = "" if shells else f"{info['dt_stable']:.4g} s from the eigenvalue, "
         print(
             f"  time step: {sim.step_size.mode}, {sim.state.dt:.4g} s at rest (stable "
-            f"{info['dt_stable']:.4g} s from the eigenvalue, {info['dt_element_estimate']:.4g} "
-            f"s from the smallest cell L/c); {steps}"
+            f"{stable}{info['dt_element_estimate']:.4g} s from the smallest cell L/c); {steps}"
         )
         print(f"  effects: {', '.join(sim.effects)}")
         cards = deck_report.walls if deck_report is not None else [""] * len(walls)

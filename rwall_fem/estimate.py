@@ -42,8 +42,10 @@ __all__ = [
 LIFT_HINT = "or pass --lift-limits to rwall-fem"
 
 _RANK_BYTES = 150e6  # resident size of a rank before the mesh, bytes
-_CELL_BYTES = {"hexahedron": 1.7e3, "tetrahedron": 0.8e3}  # per cell, bytes
-_STEP_FACTOR = {"hexahedron": 1.0, "tetrahedron": 0.6}  # dt ~ k h_min / c_p
+_CELL_BYTES = {"hexahedron": 1.7e3, "tetrahedron": 0.8e3,
+               "quadrilateral": 1.2e3, "triangle": 1.0e3}  # per cell, bytes  # fmt: skip
+# dt ~ k h_min / c_p (shells: a square's L_c is its side, a halved square's h / sqrt 2)
+_STEP_FACTOR = {"hexahedron": 1.0, "tetrahedron": 0.6, "quadrilateral": 1.0, "triangle": 0.7}
 _FREE_QUADS = 1.3  # quadrangles per h^2 of a section gmsh meshes freely
 _TETRAHEDRA_PER_QUAD = 6.0
 
@@ -170,6 +172,10 @@ def _cells(mesh) -> float:
     """Cells of the built-in body ``mesh`` (a MeshSpec): section cells x layers."""
     h = mesh.element_size
     refine = mesh.refine_size is not None
+    if mesh.shape == "tube":  # shells: the perimeter's segments x the layers along it
+        side = mesh.width if mesh.section == "square" else math.pi * mesh.width / 4
+        quads = 4 * math.ceil(side / h - 1e-9) * math.ceil(mesh.length / h - 1e-9)
+        return quads * (2.0 if mesh.cell == "triangle" else 1.0)
     if mesh.shape == "round_bar":
         length = mesh.length
     else:
@@ -179,6 +185,8 @@ def _cells(mesh) -> float:
         quads = float(nx * ny)
     else:
         quads = _FREE_QUADS * _section_integral(mesh)
+    if mesh.cell in ("quadrilateral", "triangle"):  # shells: the mid-surface
+        return quads * (2.0 if mesh.cell == "triangle" else 1.0)
     if mesh.shape in ("plate", "plate_with_hole"):
         layers = mesh.layers or math.ceil(length / h - 1e-9)
     elif refine:

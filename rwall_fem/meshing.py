@@ -22,6 +22,7 @@ from mpi4py import MPI
 from rwall_fem import _compat, interrupts
 
 __all__ = [
+    "SURFACE_CELLS",
     "BodyMesh",
     "MeshTooLarge",
     "Refinement",
@@ -32,11 +33,17 @@ __all__ = [
     "group_nodes",
     "perturb",
     "plate_mesh",
+    "plate_surface_mesh",
     "plate_with_hole_mesh",
     "read_mesh",
     "rotation_to",
     "round_bar_mesh",
+    "tube_mesh",
 ]
+
+
+# The cells of a surface mesh (topological dimension 2 in 3-D): a body of shells.
+SURFACE_CELLS = ("quadrilateral", "triangle")
 
 
 @dataclass
@@ -97,6 +104,13 @@ def body_mesh(comm: MPI.Comm, spec, max_cells: float | None = None) -> BodyMesh:
         return bar_mesh(comm, spec.origin, spec.size, **common)
     if spec.shape == "round_bar":
         return round_bar_mesh(comm, spec.origin, spec.radius, spec.length, **common)
+    if spec.shape == "tube":
+        trigger = (spec.trigger_amplitude, spec.trigger_wavelength)
+        return tube_mesh(comm, spec.origin, spec.width, spec.length, spec.element_size,
+                         spec.cell, spec.section, spec.axis, trigger, max_cells)  # fmt: skip
+    if spec.shape == "plate" and spec.cell in SURFACE_CELLS:
+        return plate_surface_mesh(comm, spec.origin, spec.size, spec.element_size, spec.cell,
+                                  spec.axis, max_cells)  # fmt: skip
     if spec.shape == "plate":
         return plate_mesh(comm, spec.origin, spec.size, layers=spec.layers, **common)
     if spec.shape == "plate_with_hole":
@@ -185,6 +199,96 @@ def plate_mesh(
     return _swept_body(
         comm, "plate.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
+
+
+def plate_surface_mesh(
+    comm: MPI.Comm,
+    origin,
+    size,
+    element_size: float,
+    cell: str,
+    axis=(0.0, 0.0, 1.0),
+    max_cells: float | None = None,
+) -> BodyMesh:
+    """The mid-surface of the plate of :func:`plate_mesh`, for shells
+    (``meshes/plate_surface.geo``): the rectangle ``size[0]`` x ``size[1]`` (m) at half the
+    thickness ``size[2]`` above ``origin``, turned about ``origin`` so that its own z points
+    along ``axis``; ``cell`` "quadrilateral" (squares of side at most ``element_size``) or
+    "triangle" (each square halved). Region "body"; edges "side_x0", "side_x1", "side_y0",
+    "side_y1"."""
+    params = dict(zip(("lx", "ly", "thickness"), size, strict=True))
+    params |= {"quadrangles": int(cell == "quadrilateral")}
+    origin = np.asarray(origin, dtype=float)
+    params |= dict(zip(("x0", "y0", "z0"), origin, strict=True)) | {"h": element_size}
+    with importlib.resources.as_file(
+        importlib.resources.files("rwall_fem.meshes") / "plate_surface.geo"
+    ) as path:
+        body = read_mesh(comm, path, params, max_cells)
+    x = body.msh.geometry.x
+    x[:] = (x - origin) @ rotation_to(axis).T + origin
+    return body
+
+
+def tube_mesh(
+    comm: MPI.Comm,
+    origin,
+    width: float,
+    length: float,
+    element_size: float,
+    cell: str,
+    section: str = "square",
+    axis=(0.0, 0.0, 1.0),
+    trigger: tuple[float, float] = (0.0, 0.0),
+    max_cells: float | None = None,
+) -> BodyMesh:
+    """Thin-walled tube as a mid-surface, for shells (``meshes/tube.geo``): a ``section``
+    "square" of side ``width`` or "circle" of diameter ``width`` (m), along its own z over
+    ``length`` (m) from ``origin`` (the centre of its bottom end), turned about ``origin``
+    onto ``axis``; ``cell`` "quadrilateral" or "triangle". Region "body"; ends "bottom" and
+    "top".
+
+    ``trigger`` = (amplitude, wavelength) (m; 0: none) dents the last wavelength before the
+    top end, where a crush should start to fold: the wall moves along its normal by
+    amplitude x sin(2 pi zeta) (zeta from 0 to 1 over that wavelength: one lobe in, one
+    out), on a square's faces also x sin(pi xi) across the face (0 at the corners, which
+    stay) with the sign alternating from face to face (the progressive folding mode of
+    square tubes); a circle's whole ring moves (the concertina mode)."""
+    params = {"width": width, "length": length, "section": int(section == "circle")}
+    params |= {"quadrangles": int(cell == "quadrilateral"), "h": element_size}
+    origin = np.asarray(origin, dtype=float)
+    params |= dict(zip(("x0", "y0", "z0"), origin, strict=True))
+    with importlib.resources.as_file(
+        importlib.resources.files("rwall_fem.meshes") / "tube.geo"
+    ) as path:
+        body = read_mesh(comm, path, params, max_cells)
+    x = body.msh.geometry.x
+    amplitude, wavelength = trigger
+    if amplitude > 0.0:
+        x[:] = origin + _dented(x - origin, width, length, section, amplitude, wavelength)
+    x[:] = (x - origin) @ rotation_to(axis).T + origin
+    return body
+
+
+def _dented(x: np.ndarray, width, length, section, amplitude, wavelength) -> np.ndarray:
+    """The points ``x`` (m, the tube's own frame about its origin) with the trigger dents
+    of :func:`tube_mesh`."""
+    zeta = (x[:, 2] - (length - wavelength)) / wavelength
+    wave = np.where((zeta > 0.0) & (zeta < 1.0), np.sin(2.0 * np.pi * zeta), 0.0)
+    moved = x.copy()
+    if section == "circle":
+        radial = x[:, :2] / np.linalg.norm(x[:, :2], axis=1, keepdims=True)
+        moved[:, :2] += (amplitude * wave)[:, None] * radial
+        return moved
+    a = 0.5 * width
+    on_x = np.abs(np.abs(x[:, 0]) - a) <= np.abs(np.abs(x[:, 1]) - a)  # a face x = +-a
+    across = np.where(on_x, x[:, 1], x[:, 0])  # from -a to a along the face
+    # Faces x = +-a go out, faces y = +-a in (a lobe of one face beside the other's).
+    sign = np.where(on_x, 1.0, -1.0)
+    offset = sign * amplitude * wave * np.sin(np.pi * (across + a) / width)
+    normal = np.where(on_x, 0, 1)
+    rows = np.arange(len(x))
+    moved[rows, normal] += offset * np.sign(x[rows, normal])
+    return moved
 
 
 def plate_with_hole_mesh(
@@ -303,8 +407,8 @@ def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
         gmsh.initialize(argv, readConfigFiles=False)
         keep()
         try:
-            groups, volumes = _gmsh_model(Path(path))
-            cells = sum(len(tags) for tags in gmsh.model.mesh.getElements(3)[1])
+            groups, volumes, dim = _gmsh_model(Path(path))
+            cells = sum(len(tags) for tags in gmsh.model.mesh.getElements(dim)[1])
         except _GmshError as err:
             error = f"{Path(path).name}: {err}"
         except UnicodeDecodeError:  # gmsh's own message quotes the file's bytes
@@ -329,10 +433,15 @@ class _GmshError(Exception):
     """What is wrong with the model gmsh read, in one line."""
 
 
-def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int]]:
+def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int], int]:
     """Open ``path`` in the current gmsh session, mesh it in 3-D if it holds no volume
-    cells, and return its named surface groups and volumes (name -> tag; one volume "body"
-    when it names none); raises on anything DOLFINx cannot take."""
+    cells, and return its named facet groups and regions (name -> tag; one region "body"
+    when it names none) and the dimension of its cells; raises on anything DOLFINx cannot
+    take.
+
+    A body of volumes has physical surfaces as facet groups and physical volumes as
+    regions; a body of surfaces (shells: a file without volumes, with surface cells or
+    surfaces to mesh), physical curves and physical surfaces."""
     import gmsh
 
     _looks_like_gmsh(path)
@@ -345,44 +454,70 @@ def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int]]:
     gmsh.onelab.clear()
     gmsh.open(str(path))
     if len(gmsh.model.mesh.getElements(3)[0]) == 0:
-        gmsh.model.mesh.generate(3)
+        if gmsh.model.getEntities(3) or not len(gmsh.model.mesh.getElements(2)[0]):
+            gmsh.model.mesh.generate(3)  # of surfaces alone, their surface mesh
     if not any(len(gmsh.model.mesh.getElements(dim)[0]) for dim in (2, 3)):
         raise _GmshError("no cells: the file holds no mesh, and no geometry to mesh")
+    # Without volume cells the body is its surfaces (shells).
+    dim = 3 if len(gmsh.model.mesh.getElements(3)[0]) else 2
     groups = {
-        gmsh.model.getPhysicalName(dim, tag) or f"{dim}:{tag}": tag
-        for dim, tag in gmsh.model.getPhysicalGroups()
-        if dim == 2
+        gmsh.model.getPhysicalName(d, tag) or f"{d}:{tag}": tag
+        for d, tag in gmsh.model.getPhysicalGroups()
+        if d == dim - 1
     }
-    if not any(dim == 3 for dim, _ in gmsh.model.getPhysicalGroups()):
+    if not any(d == dim for d, _ in gmsh.model.getPhysicalGroups()):
         # DOLFINx reads only cells that belong to a physical group.
-        tag = gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)])
-        gmsh.model.setPhysicalName(3, tag, "body")
+        tag = gmsh.model.addPhysicalGroup(dim, [t for _, t in gmsh.model.getEntities(dim)])
+        gmsh.model.setPhysicalName(dim, tag, "body")
     volumes = {
-        gmsh.model.getPhysicalName(3, tag) or f"3:{tag}": tag
-        for dim, tag in gmsh.model.getPhysicalGroups()
-        if dim == 3
+        gmsh.model.getPhysicalName(d, tag) or f"{d}:{tag}": tag
+        for d, tag in gmsh.model.getPhysicalGroups()
+        if d == dim
     }
-    _regions_are_disjoint(volumes)
-    kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in gmsh.model.mesh.getElementTypes(3)]
+    _regions_are_disjoint(volumes, dim)
+    if dim == 3:
+        _surfaces_lie_on_the_volumes(groups)
+    types = gmsh.model.mesh.getElementTypes(dim)
+    kinds = [gmsh.model.mesh.getElementProperties(k)[0] for k in types]
     if len(kinds) > 1:
+        hint = "cell = 'tetrahedron'" if dim == 3 else "one of quadrangles or triangles"
         raise _GmshError(
             f"mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
-            " (a shape of meshes/: try another element_size or cell = 'tetrahedron')"
+            f" (a shape of meshes/: try another element_size or {hint})"
         )
-    return groups, volumes
+    return groups, volumes, dim
 
 
-def _regions_are_disjoint(volumes: dict[str, int]) -> None:
-    """Every volume entity is in at most one physical volume: DOLFINx reads each physical
-    volume's cells, so a cell in two would be two cells."""
+def _surfaces_lie_on_the_volumes(groups: dict[str, int]) -> None:
+    """Every physical surface of a body of volumes lies on its volume cells (a face group):
+    a surface apart from them would be shells, and a body is shells or solids."""
     import gmsh
 
+    _, cell_nodes = gmsh.model.mesh.getElements(3)[1:]
+    solid = np.unique(np.concatenate([np.asarray(n) for n in cell_nodes]))
+    for name, tag in groups.items():
+        nodes = np.asarray(gmsh.model.mesh.getNodesForPhysicalGroup(2, tag)[0])
+        apart = np.setdiff1d(nodes, solid)
+        if len(apart):
+            raise _GmshError(
+                f"the physical surface '{name}' has {len(apart)} nodes on no volume cell: "
+                "it is shells beside the solids, and a scene mixes no shells and solids in "
+                "one mesh"
+            )
+
+
+def _regions_are_disjoint(volumes: dict[str, int], dim: int = 3) -> None:
+    """Every volume (``dim`` 3) or surface (2) entity is in at most one physical group of
+    its dimension: DOLFINx reads each group's cells, so a cell in two would be two cells."""
+    import gmsh
+
+    kind = {3: "volume", 2: "surface"}[dim]
     owner: dict[int, str] = {}
     for name, tag in volumes.items():
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(3, tag):
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
             if int(entity) in owner:
                 raise _GmshError(
-                    f"the physical volumes '{owner[int(entity)]}' and '{name}' share volume "
+                    f"the physical {kind}s '{owner[int(entity)]}' and '{name}' share {kind} "
                     f"{int(entity)}: a cell can be in one region only"
                 )
             owner[int(entity)] = name

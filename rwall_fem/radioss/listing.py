@@ -5,7 +5,8 @@ smallest element time steps and where they are, worked out from the deck alone.
 A cell's step is its stable estimate ``L / c`` at rest, the one the run starts from
 (``docs/theory.md``): ``L`` its volume over its largest face area (a tetrahedron: three
 times that), ``c`` the dilatational wave speed of its material,
-``sqrt(E (1 - nu) / (rho (1 + nu) (1 - 2 nu)))``. The volume of a hexahedron is the
+``sqrt(E (1 - nu) / (rho (1 + nu) (1 - 2 nu)))``; a shell's ``L`` is Radioss's L_c and
+``c`` the plate's in-plane speed ``sqrt(E / (rho (1 - nu^2)))``, its mass rho t A. The volume of a hexahedron is the
 2 x 2 x 2 Gauss integral of its Jacobian, exact for the trilinear map.
 """
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from rwall_fem.radioss.model import Deck
 
-__all__ = ["SMALLEST", "cell_geometry", "starter_listing"]
+__all__ = ["SMALLEST", "cell_geometry", "shell_geometry", "starter_listing"]
 
 SMALLEST = 5  # the smallest steps listed, as Radioss lists its ten smallest
 
@@ -47,6 +48,23 @@ def cell_geometry(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return volume, volume / area.max(axis=1)
 
 
+def shell_geometry(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Areas (m^2) and characteristic lengths (m) of shells at ``x`` (n, 4 or 3, 3; nodes
+    in Radioss's order, around the cell): half the norm of the cross product of the
+    diagonals (of the sides of a triangle), and Radioss's L_c, a quadrilateral's
+    max(A / longest diagonal, shortest side or diagonal), a triangle's 2 A / longest side."""
+    count = x.shape[1]
+    sides = np.linalg.norm(x - np.roll(x, -1, axis=1), axis=2)
+    if count == 3:
+        area = np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1) / 2
+        return area, 2 * area / sides.max(axis=1)
+    d1, d2 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
+    area = np.linalg.norm(np.cross(d1, d2), axis=1) / 2
+    diagonals = np.column_stack([np.linalg.norm(d1, axis=1), np.linalg.norm(d2, axis=1)])
+    shortest = np.minimum(sides.min(axis=1), diagonals.min(axis=1))
+    return area, np.maximum(area / diagonals.max(axis=1), shortest)
+
+
 def _wave_speed(m: dict) -> float:
     E, nu, rho = m["young"], m["poisson"], m["density"]
     return float(np.sqrt(E * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu))))
@@ -69,7 +87,13 @@ def starter_listing(deck: Deck, dt_scale: float) -> list[str]:
         for body in bodies:
             rows = deck.node_positions(body.nodes.ravel())
             x = deck.coordinates[rows].reshape(*body.nodes.shape, 3)
-            volume, length = cell_geometry(x)
+            if body.cell in ("quadrilateral", "triangle"):  # the plate's in-plane speed
+                area, length = shell_geometry(x)
+                volume = area * deck.properties[part.prop]["element"]["thickness"]
+                E, nu, rho = material["young"], material["poisson"], material["density"]
+                speed = float(np.sqrt(E / (rho * (1 - nu * nu))))
+            else:
+                volume, length = cell_geometry(x)
             name = body.card.key(0)
             counts[name] = counts.get(name, 0) + len(body.ids)
             mass += material["density"] * float(volume.sum())

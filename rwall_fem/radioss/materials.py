@@ -87,6 +87,16 @@ def element_table(deck: Deck, pid: int, cell: str, material: dict, cells) -> tup
     """The [element] table of /PROP/SOLID ``pid`` for ``cells`` (node IDs) of type ``cell``
     in ``material`` (a [material] table), and the line saying what it became."""
     p = deck.properties[pid]
+    shells = cell in ("quadrilateral", "triangle")
+    if shells != (p.get("kind") == "shell"):
+        elements = "/SHELL, /SH3N" if shells else "/BRICK, /TETRA4"
+        card = "/PROP/SOLID or /PROP/TYPE14" if not shells else "/PROP/SHELL or /PROP/TYPE1"
+        raise DeckError(f"{p['where']}: property {pid} is not a property of {elements} "
+                        f"elements: give them a {card}")  # fmt: skip
+    if shells:
+        from rwall_fem.radioss.cards.shells import shell_element
+
+        return shell_element(deck, pid, cell)
     head = f"property: /PROP/SOLID/{pid} Isolid {p['isolid']} ({p['where']})"
     if cell == "tetrahedron":
         if p["itetra4"]:  # the column is Irot of bricks before version 12

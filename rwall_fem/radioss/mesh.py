@@ -1,5 +1,6 @@
 """The mesh of a deck as a gmsh file: its elements, in regions (the parts: gmsh physical
-volumes), and its node groups as face groups.
+volumes, or physical surfaces of shells), and its node groups as face groups (of shells:
+groups of their sides).
 
 rwall_fem refers to node sets by the name of a gmsh physical surface group (a facet
 tag of the DOLFINx mesh): a set is the nodes of its faces. A /GRNOD becomes the faces
@@ -27,7 +28,7 @@ __all__ = ["WRITER", "FaceGroups", "face_groups", "write_msh"]
 
 # What the files of write_msh are: part of the name of a deck's mesh in the cache, so that
 # a change of the writer writes the meshes anew.
-WRITER = "MSH 2.2; a physical volume per region; node tags 1..N"
+WRITER = "MSH 2.2; a physical volume (shells: surface) per region; node tags 1..N"
 
 # The faces of gmsh's (and Radioss's) hexahedron and tetrahedron, by local node index.
 _FACES = {
@@ -35,8 +36,14 @@ _FACES = {
         [[0, 3, 2, 1], [0, 1, 5, 4], [0, 4, 7, 3], [1, 2, 6, 5], [2, 3, 7, 6], [4, 5, 6, 7]]
     ),
     "tetrahedron": np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]),
+    # Shells: the facets are the sides (a node set of a shell body is a union of sides).
+    "quadrilateral": np.array([[0, 1], [1, 2], [2, 3], [3, 0]]),
+    "triangle": np.array([[0, 1], [1, 2], [2, 0]]),
 }
-_GMSH_TYPE = {"hexahedron": 5, "tetrahedron": 4, 4: 3, 3: 2}  # volume cells; quads, triangles
+# gmsh's element types: cells; facets by their node count (quadrangles, triangles, lines)
+_GMSH_TYPE = {"hexahedron": 5, "tetrahedron": 4, "quadrilateral": 3, "triangle": 2,
+              4: 3, 3: 2, 2: 1}  # fmt: skip
+_DIMENSION = {"hexahedron": 3, "tetrahedron": 3, "quadrilateral": 2, "triangle": 2}
 
 
 @dataclass
@@ -98,10 +105,11 @@ def write_msh(path: Path, node_ids: np.ndarray, coordinates: np.ndarray, cell: s
     with open(partial, "w", encoding="ascii") as out:
         out.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n")
         out.write(f"{len(names) + len(regions)}\n")
+        dim = _DIMENSION[cell]
         for tag, name in enumerate(regions, start=1):
-            out.write(f'3 {tag} "{name}"\n')
+            out.write(f'{dim} {tag} "{name}"\n')
         for tag, name in enumerate(names, start=1):
-            out.write(f'2 {tag} "{name}"\n')
+            out.write(f'{dim - 1} {tag} "{name}"\n')
         out.write(f"$EndPhysicalNames\n$Nodes\n{len(used)}\n")
         table = np.column_stack([np.arange(1.0, len(used) + 1), coordinates[rows]])
         np.savetxt(out, table, fmt=["%d", "%.17g", "%.17g", "%.17g"])

@@ -190,6 +190,8 @@ class Deck:
     functions: dict[int, Function] = field(default_factory=dict)
     initial: list[tuple[np.ndarray, int, str]] = field(default_factory=list)  # v, group
     clamps: list[tuple[str, int, str]] = field(default_factory=list)  # components, group
+    # /BCS rotation codes by the file:line of their /BCS: the global axes held ("xyz")
+    held_rotations: dict[str, str] = field(default_factory=dict)
     velocities: list[Prescribed] = field(default_factory=list)  # /IMPVEL
     gravity: list[Prescribed] = field(default_factory=list)  # /GRAV
     loads: list[Prescribed] = field(default_factory=list)  # /CLOAD (y_scale in N)

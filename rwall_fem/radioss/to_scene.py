@@ -68,9 +68,11 @@ def scene_of(deck: Deck) -> SceneParts:
         deck.warnings.append(slip)
     cells_by_kind = {b.cell for b in deck.bodies}
     if len(cells_by_kind) > 1:
+        surfaces = cells_by_kind & {"quadrilateral", "triangle"}
+        why = ("a scene mixes no shells and solids in one mesh"
+               if surfaces and surfaces != cells_by_kind else "DOLFINx holds one cell type per mesh")  # fmt: skip
         raise DeckError(
-            f"{deck.starter}: both /BRICK and /TETRA4 elements: DOLFINx holds one cell type "
-            "per mesh"
+            f"{deck.starter}: elements of {' and '.join(sorted(cells_by_kind))} cells: {why}"
         )
     cell = cells_by_kind.pop()
     cells = np.concatenate([b.nodes for b in deck.bodies])
@@ -143,9 +145,11 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["gravity"] = {"acceleration": list(gravity)}
         facts.append(f"gravity: {_vec(gravity)} m/s^2")
     boundaries, wall_velocity = _boundaries(deck, atoms, mains)
+    _held_rotations(deck, boundaries, cell)
     if boundaries:
         raw["boundary"] = boundaries
         facts += [f"boundary on {b['group']}: components {b.get('components', 'xyz')}"
+                  + (f", rotations {b['rotations']}" if "rotations" in b else "")
                   for b in boundaries]  # fmt: skip
     tables, lines = load_tables(deck, cell, cells, atoms, body_nodes)
     raw |= tables
@@ -186,7 +190,7 @@ def _check_references(deck: Deck) -> None:
                 f"{part.where}: /PART/{part.id}: prop_ID {part.prop} refers to no /PROP"
             )
     if not deck.bodies:
-        raise DeckError(f"{deck.starter}: no elements (/BRICK or /TETRA4)")
+        raise DeckError(f"{deck.starter}: no elements (/BRICK, /TETRA4, /SHELL or /SH3N)")
     for body in deck.bodies:
         if body.part not in deck.parts:
             body.card.fail(f"part_ID {body.part} refers to no /PART")
@@ -383,7 +387,9 @@ def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
         if set(g.nodes.tolist()) & mains:
             raise DeckError(f"{where}: /BCS: group {gid} holds the main node of a /RWALL: fix "
                             "a wall by giving it no node_ID")  # fmt: skip
-        out += [{"group": a, "components": components} for a in atoms.of[gid]]
+        rotations = deck.held_rotations.get(where)
+        held = {"rotations": rotations, "where": where} if rotations else {}
+        out += [{"group": a, "components": components} | held for a in atoms.of[gid]]
     on_walls: dict[int, list[Prescribed]] = {}
     by_group: dict[int, list[Prescribed]] = {}
     for p in deck.velocities:
@@ -401,6 +407,21 @@ def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
         rows, components = _table(deck, items)
         out += [{"group": a, "velocity": rows, "components": components} for a in atoms.of[gid]]
     return out, on_walls
+
+
+def _held_rotations(deck: Deck, boundaries: list[dict], cell: str) -> None:
+    """Keep the rotation codes of /BCS on shells (``rotations``); on solids say once per
+    card that they are not used (their nodes have none)."""
+    said = set()
+    for b in boundaries:
+        where = b.pop("where", None)
+        if where is None or cell in ("quadrilateral", "triangle"):
+            continue
+        del b["rotations"]
+        if where not in said:
+            said.add(where)
+            deck.warnings.append(f"{where}: /BCS: rotation codes are not used (solid nodes "
+                                 "have no rotations)")  # fmt: skip
 
 
 def _wall(deck: Deck, w: Wall, atoms: FaceGroups, by_parts: dict[int, list[str]],

@@ -388,15 +388,20 @@ class Vector(ValueType):
             raise Invalid(f"must be {self.size} finite numbers [{names}], got {show(value)}")
         elif self.kind == "direction" and not any(value):
             raise Invalid(f"must be a non-zero direction [{names}], got {show(value)}")
+        elif self.kind == "non_negative" and min(value) < 0:
+            raise Invalid(f"must be {self.size} numbers >= 0 [{names}], got {show(value)}")
         return tuple(float(c) for c in value)
 
     def allowed_text(self):
-        return {"finite": "finite", "positive": "each > 0", "direction": "not all 0"}[self.kind]
+        return {"finite": "finite", "positive": "each > 0", "direction": "not all 0",
+                "non_negative": "each >= 0"}[self.kind]  # fmt: skip
 
     def json(self):
         item: dict = {"type": "number"}
         if self.kind == "positive":
             item["exclusiveMinimum"] = 0
+        if self.kind == "non_negative":
+            item["minimum"] = 0
         out = {"type": "array", "items": item, "minItems": self.size, "maxItems": self.size}
         if self.kind == "direction":
             out["not"] = {"items": {"const": 0}}

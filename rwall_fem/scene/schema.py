@@ -60,6 +60,8 @@ __all__ = [
     "Output",
     "PartSpec",
     "RunSettings",
+    "SHELL_KEYS",
+    "SURFACE_CELLS",
     "Scene",
     "Secondary",
     "WallSpec",
@@ -124,6 +126,10 @@ MESH_SHAPES = {
         "bottom_layer",
         "top_layer",
     ),
+    "tube": (
+        "origin", "section", "width", "length", "axis", "element_size", "cell",
+        "trigger_amplitude", "trigger_wavelength",
+    ),
 }  # fmt: skip
 # The regions (gmsh physical volumes) of each built-in shape: always "body"; the others
 # when their key is above 0 (meshes/sweep.geo).
@@ -132,6 +138,7 @@ SHAPE_REGIONS = {
     "round_bar": {"front": "front_length"},
     "plate": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
     "plate_with_hole": {"bottom_layer": "bottom_layer", "top_layer": "top_layer"},
+    "tube": {},
 }
 _REFINE_KEYS = ("refine_point", "refine_size", "refine_radius")
 
@@ -320,7 +327,32 @@ class MeshSpec:
     )
     radius: float | None = key(Real(low=0.0), None, required=True, unit="m", doc="of the bar")
     length: float | None = key(
-        Real(low=0.0), None, required=True, unit="m", doc="of the bar, along its own z"
+        Real(low=0.0), None, required=True, unit="m", doc="of the bar or tube, along its own z"
+    )
+    section: str = key(
+        Choice(("square", "circle")), "square", doc="the tube's cross-section (mid-surface)"
+    )
+    width: float | None = key(
+        Real(low=0.0),
+        None,
+        required=True,
+        unit="m",
+        doc="the tube's side (square) or diameter (circle), of its mid-surface",
+    )
+    trigger_amplitude: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="m",
+        doc="tubes: dents of this depth over the last trigger_wavelength before the top end, "
+        "where a crush should start to fold (a square's faces alternately in and out)",
+        default_doc="0: none",
+    )
+    trigger_wavelength: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="tubes: the length of one dent in and one out, at the top end",
+        default_doc="required with trigger_amplitude > 0",
     )
     hole_radius: float | None = key(
         Real(low=0.0), None, required=True, unit="m", doc="of the through-hole"
@@ -342,7 +374,12 @@ class MeshSpec:
     element_size: float | None = key(
         Real(low=0.0), None, required=True, unit="m", doc="target edge length"
     )
-    cell: str = key(Choice(("hexahedron", "tetrahedron")), "hexahedron", doc="the cell type")
+    cell: str = key(
+        Choice(("hexahedron", "tetrahedron", "quadrilateral", "triangle")),
+        "hexahedron",
+        doc="the cell type; quadrilateral, triangle: the plate's mid-surface in shells "
+        "(element.thickness, by default the plate's)",
+    )
     front_length: float = key(
         Real(low=0.0, low_open=False),
         0.0,
@@ -425,6 +462,34 @@ def _refinement_comes_whole(v, raw, fail):
             fail(name, f"missing ({' and '.join(given)} need it)")
     if v["refine_radius"] is None:
         v["refine_radius"] = 4 * v["element_size"]
+
+
+@rule(MeshSpec)
+def _surface_cells_are_a_plate(v, raw, fail):
+    """Shells (cell quadrilateral or triangle) are the mid-surface of a plate or a tube
+    (a tube is only shells: quadrilateral by default); no layers, bottom_layer, top_layer
+    or refinement. A tube's trigger has a wavelength within its length."""
+    if v["shape"] == "tube":
+        if "cell" not in raw:
+            v["cell"] = "quadrilateral"
+        if v["cell"] not in SURFACE_CELLS:
+            fail("cell", f"a tube is a mid-surface of shells: 'quadrilateral' or 'triangle', "
+                 f"got {v['cell']!r}")  # fmt: skip
+        wavelength = v["trigger_wavelength"]
+        if v["trigger_amplitude"] > 0.0 and wavelength is None:
+            fail("trigger_wavelength", "missing: the dents of trigger_amplitude need it")
+        if wavelength is not None and wavelength > v["length"]:
+            fail("trigger_wavelength", f"{wavelength:g} m is longer than the tube "
+                 f"({v['length']:g} m)")  # fmt: skip
+    if v["shape"] is None or v["cell"] not in SURFACE_CELLS:
+        return
+    if v["shape"] not in ("plate", "tube"):
+        fail("cell", f"{v['cell']!r} (shells) is for the shapes 'plate' and 'tube'; "
+             f"a {v['shape']} is hexahedron or tetrahedron")  # fmt: skip
+    for name in ("layers", "bottom_layer", "top_layer", *_REFINE_KEYS):
+        if name in raw:
+            fail(name, f"is for solid plates; a plate of {v['cell']} cells is one mid-surface "
+                 "of shells: leave it out")  # fmt: skip
 
 
 def _own_frame(axis) -> list[list[float]]:
@@ -709,6 +774,10 @@ def _damage_reference_rate(v, raw, fail):
 
 
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
+# The cells of a body of shells, and the keys of [element] for shells and for solids.
+SURFACE_CELLS = ("quadrilateral", "triangle")
+SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor")
+SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
 @table("Element technology (LS-DYNA *SECTION_SOLID + *HOURGLASS, Radioss /PROP/SOLID); optional.")
@@ -737,6 +806,41 @@ class Element:
         default_doc="physical: 1.0 (full integration on parallelepipeds) on elastic bodies, 0.1 "
         "on elasto-plastic ones (elastic hourglass stresses would stiffen the plastic flow); "
         "stiffness, viscous: 0.1 (LS-DYNA's QM)",
+    )
+    thickness: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="shells: the thickness (constant)",
+        default_doc="a built-in plate's size[2]; required for a mesh file of surfaces",
+    )
+    formulation: str | None = key(
+        Choice(("bwc", "bt", "bsc")),
+        None,
+        doc="shells: bwc, Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping "
+        "correction; bt, plain Belytschko-Lin-Tsay (quadrilaterals); bsc, the "
+        "Belytschko-Stolarski-Carpenter triangle",
+        default_doc="bwc on quadrilaterals, bsc on triangles",
+    )
+    points: int | None = key(
+        Integer(1, 10, why="Radioss's N"),
+        None,
+        doc="shells: integration points through the thickness (equally spaced, both surfaces "
+        "included)",
+        default_doc="5",
+    )
+    hourglass_coefficients: tuple[float, float, float] | None = key(
+        Vector(kind="non_negative"),
+        None,
+        doc="shells: the viscous hourglass coefficients of the membrane, bending and "
+        "rotation modes (Radioss's hm, hf, hr)",
+        default_doc="[0.01, 0.01, 0.01]",
+    )
+    shear_factor: float | None = key(
+        Real(low=0.0, high=1.0),
+        None,
+        doc="shells: the transverse shear factor",
+        default_doc="5/6",
     )
 
 
@@ -775,6 +879,13 @@ class BoundarySpec:
     )
     components: str = key(
         Letters(), "xyz", doc="the global components prescribed; the others stay free"
+    )
+    rotations: str | None = key(
+        Letters(),
+        None,
+        doc="shells: the global components of the nodes' rotations held fixed (with "
+        "components = 'xyz', rotations = 'xyz' clamps an edge)",
+        default_doc="none: the rotations stay free (a simply supported edge)",
     )
 
 
@@ -1247,6 +1358,47 @@ def _element_fits_the_cells(v, raw, fail):
                     "needs integration = 'reduced', and tetrahedra (mesh.cell) are integrated "
                     "'full'",
                 )
+
+
+def element_tables(v, raw) -> list[tuple[str, Element, dict]]:
+    """(where, the table, its raw keys) of [element] and of every part's own."""
+    tables = [("element", v["element"], raw.get("element", {}))]
+    for i, part in enumerate(v["parts"]):
+        if part.element is not None:
+            tables.append((f"part[{i}].element", part.element, raw["part"][i]["element"]))
+    return tables
+
+
+def element_fits_the_surface(where: str, given, cell: str) -> str | None:
+    """What is wrong, in one line naming the key, with an element table whose keys are
+    ``given`` for ``cell`` cells (a shell's or a solid's), or None."""
+    shells = cell in SURFACE_CELLS
+    for name in SOLID_KEYS if shells else SHELL_KEYS:
+        if name in given:
+            what = "solids (hexahedra, tetrahedra)" if shells else "shells (surface cells)"
+            return f"{where}.{name}: is for {what}, and the mesh has {cell} cells: leave it out"
+    formulation = given.get("formulation")
+    fits = {"quadrilateral": ("bt", "bwc"), "triangle": ("bsc",)}
+    if shells and formulation is not None and formulation not in fits[cell]:
+        return (f"{where}.formulation: {formulation!r} is not an element of {cell} cells; "
+                f"allowed: {', '.join(fits[cell])}")  # fmt: skip
+    return None
+
+
+@rule(Scene)
+def _element_fits_shells_or_solids(v, raw, fail):
+    """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor) for
+    surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
+    volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles. (For a
+    mesh file the cells are known when the body is built.)"""
+    mesh = v["mesh"]
+    if mesh is None or mesh.shape is None:
+        return
+    for where, _, given in element_tables(v, raw):
+        wrong = element_fits_the_surface(where, given, mesh.cell)
+        if wrong:
+            name, _, why = wrong.partition(": ")
+            fail(name, why)
 
 
 @rule(

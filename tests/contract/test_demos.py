@@ -22,6 +22,7 @@ COARSE = {  # scene -> overrides that keep it to a few seconds
     "taylor_johnson_cook": ["mesh.element_size=0.001", "run.end_time=1e-5"],
     "perforation_weldox": ["run.end_time=2e-5"],  # its mesh file's 2 mm: the first contact
     "copper_nosed_striker": ["mesh.element_size=0.001", "run.end_time=1e-5"],
+    "tube_crush": ["mesh.element_size=0.01", "run.end_time=3e-4"],
 }
 
 

@@ -267,7 +267,8 @@ def test_render_draws_a_results_folder_again(tmp_path):
 
 
 @pytest.mark.serial
-def test_a_surface_mesh_is_refused(tmp_path):
+def test_a_surface_mesh_without_a_thickness_is_refused(tmp_path):
+    """A mesh file of surfaces is a body of shells: without element.thickness, one line."""
     import gmsh
 
     gmsh.initialize()
@@ -285,7 +286,11 @@ def test_a_surface_mesh_is_refused(tmp_path):
     (tmp_path / "scene.toml").write_text(scene)
     result = _cli("run", "scene.toml", cwd=tmp_path)
     assert result.returncode == 2
-    assert "mesh: triangle cells; allowed: tetrahedra or hexahedra" in result.stderr
+    assert (
+        "element.thickness: missing: a mesh file of surfaces (shells) needs the shells' "
+        "thickness (m)" in result.stderr
+    )
+    assert len(result.stderr.strip().splitlines()) == 1
 
 
 def test_walls_given_as_shape_objects_equal_their_tables():

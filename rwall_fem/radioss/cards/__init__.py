@@ -37,6 +37,7 @@ from rwall_fem.radioss.cards import (
     parts,
     rigid_bodies,
     run,
+    shells,
     solids,
     walls,
 )
@@ -45,8 +46,8 @@ from rwall_fem.radioss.cards.base import keyword
 __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supported", "table"]
 
 STARTER_FAMILIES = (
-    begin, nodes, solids, parts, materials, failures, groups, functions, conditions, walls,
-    control, loads, rigid_bodies,
+    begin, nodes, solids, shells, parts, materials, failures, groups, functions, conditions,
+    walls, control, loads, rigid_bodies,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 

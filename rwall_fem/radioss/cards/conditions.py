@@ -49,11 +49,15 @@ def _clamp(deck: Deck, card: Card) -> None:
     if skew:
         card.fail("a skew (skew_ID) is not supported", line)
     components = "".join(axis for axis, c in zip("xyz", tra, strict=True) if c == "1")
+    rotations = "".join(axis for axis, c in zip("xyz", digits[3:6]) if c == "1")
     if not components:
+        if rotations:
+            card.fail("rotations held without the translations (Tra 000): a boundary holds "
+                      "translations, and rotations beside them", line)  # fmt: skip
         deck.warn(card, "no translation is fixed (Tra 000): nothing to do on solid nodes", line)
         return
-    if digits[3:].strip("0"):
-        deck.warn(card, "rotation codes are not used (solid nodes have no rotations)", line)
+    if rotations:  # shells hold them; the deck's solids have none (said when it is known)
+        deck.held_rotations[line.where] = rotations
     deck.clamps.append((components, group, line.where))
 
 

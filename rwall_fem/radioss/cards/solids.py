@@ -72,8 +72,8 @@ def _property(deck: Deck, card: Card) -> None:
 
 @catch_all
 def _other_property(deck: Deck, card: Card) -> None:
-    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14), /PROP/VOID "
-              "(/PROP/TYPE0)")
+    card.fail("unsupported property; supported: /PROP/SOLID (/PROP/TYPE14), /PROP/SHELL "
+              "(/PROP/TYPE1), /PROP/VOID (/PROP/TYPE0)")  # fmt: skip
 
 
 def _void_property(deck: Deck, card: Card) -> None:

@@ -1,0 +1,477 @@
+/* Internal force of the Belytschko-Lin-Tsay quadrilateral shell (one in-plane point,
+ * co-rotational frame, viscous hourglass control), batched over cells like the solids'.
+ *
+ * Notation (docs/theory.md, "Shell elements"): nodes I = 0..3 counter-clockwise (the caller
+ * reorders DOLFINx's (0, 1, 3, 2)).  Each cycle the cell gets a local frame: e3 along
+ * d02 x d13 (the diagonals), e1 along the projected xi direction x1 + x2 - x0 - x3,
+ * e2 = e3 x e1.  The local coordinates (x_I, y_I, z_I) of the nodes about the centroid
+ * have z_I = h (1, -1, 1, -1) (h = 0: a flat cell; h != 0: a warped one).  At the
+ * centre, with 2A = x20 y31 - x31 y20 (A the projected area),
+ *     b1 = (y13, y20, y31, y02) / 2A,  b2 = (x31, x02, x13, x20) / 2A   (dN_I/dx, dN_I/dy).
+ * Mindlin kinematics: a fibre at height z moves with v + z (theta_y, -theta_x, 0), so the
+ * velocity strains are, with v, theta the nodal velocities in the local frame,
+ *     membrane   d = (b1.vx, b2.vy, b2.vx + b1.vy),
+ *     curvature  k = (b1.ty, -b2.tx, b2.ty - b1.tx),
+ *     shear      g = (b1.vz + mean ty, b2.vz - mean tx),
+ * and the strain at height z is d + z k.  Stress resultants N (membrane), M (moments) and
+ * Q (transverse shear, shear factor 5/6, elastic) act back through the transposed relations
+ * (the power A (N.d + M.k + Q.g) equals f.v + m.theta).  The element has no drilling
+ * stiffness: its moment about e3 is zero.
+ *
+ * Warping (s->warping, Belytschko-Wong-Chiang's correction by the rigid-body projection of
+ * Belytschko and Leviathan): a rigid rotation (Ox, Oy) about the in-plane axes gives the
+ * nodes of a warped cell the in-plane velocities (Oy z_I, -Ox z_I), which plain BT takes for
+ * an hourglass motion (and whose forces are not in moment equilibrium).  The cell's rigid
+ * rotation is the least-squares fit of all its nodal velocities about the centroid,
+ *     Omega = J^-1 sum_I r_I x (v_I - mean v),  J = sum_I (|r_I|^2 I - r_I r_I^T),
+ * and its part Omega x r_I is removed from the in-plane velocities before the strains and
+ * hourglass rates are taken (the orthogonal projection: an in-plane hourglass motion is
+ * not mistaken for a rotation, as it would be by a fit to vz alone); the in-plane forces
+ * come back through the transpose, f_I -= mu x r_I with mu = J^-1 sum_I r_I x (fx, fy, 0)_I.
+ * Any rigid motion then gives exactly zero strain rates, and the nodal forces and moments
+ * of any stress are in equilibrium.
+ *
+ * Hourglass (viscous, Belytschko-Tsay): gamma_I = (G_I - (G.x) b1_I - (G.y) b2_I) / 4 with
+ * G = (1, -1, 1, -1), orthogonal to every linear field; rates qm = gamma.v' (in-plane),
+ * qw = gamma.vz, qr = gamma.theta; generalized forces C q with C = 4 rho c t sqrt(A) times
+ * hm (membrane), hf (out of plane) and hr t^2 / 12 (rotations), c the bar speed.  hm = 0.01
+ * is 1 % of the damping that is critical for a mode of frequency 2 c / sqrt(A) of a square
+ * cell; their dissipation dt C q.q is the hourglass energy.  With s->hk > 0 elastic
+ * hourglass forces are added, incremental in the cell's frame (state rows from
+ * s->hourglass_slot): Q += k dt q with k = hk (2/3) E' t A |b|^2 (membrane; for a square,
+ * hk (4/3) E' t, the normal-strain part of the fully integrated cell's in-plane bending),
+ * 4 hk D A |b|^4 (out of plane) and hk (2/3) D A |b|^2 (rotations), E' = E / (1 - nu^2),
+ * D = E' t^3 / 12, |b|^2 = sum b1^2 + b2^2; their work joins the hourglass energy.
+ *
+ * Rate form over the step dt = p->dt: the strain increments are dt times the velocity
+ * strains of v, theta (v^{n-1/2}) in the mid-step configuration x - dt v / 2 (a rigid
+ * motion gives none, whatever its rotation); the resultants, kept in the local frame, are
+ * updated; their forces are those of the current configuration x = X + u.  The hourglass
+ * rates and forces are those of the mid-step configuration, where a rigid motion has
+ * exactly none (in the current one it would have rates of order dt |omega|^2 L, and a
+ * spinning body would dissipate).
+ *
+ * Elastic cells keep the resultants (state rows 0..7: Nxx, Nyy, Nxy, Mxx, Myy, Mxy, Qx, Qy).
+ * Elasto-plastic cells keep Qx, Qy (rows 0, 1) and, at each of s->points points through the
+ * thickness (heights zeta_k t, weights w_k, shell.h), SHELL_POINT_SLOTS rows from
+ * 2 + SHELL_POINT_SLOTS k: the stress (plane, exact J2 return of shell.h), plastic strain and
+ * temperature; N = t sum w_k sigma_k, M = t^2 sum w_k zeta_k sigma_k; with a failure
+ * criterion the damage of point k at row p->damage_slot + k.  A point whose damage reaches 1
+ * carries no stress from then on (its elastic energy is booked as dissipated), and a cell
+ * fails when the share s->fail_fraction of its points has failed; erosion as failure.h
+ * (the nodal moments and rotations count in the energy the cell leaves with).
+ *
+ * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
+ * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable
+ * step is L_c / c with Radioss's L_c = max(A / longest diagonal, shortest side or diagonal)
+ * in the current configuration (times p->calibration), noted in `step` (step.h).
+ */
+#include "shell.h"
+
+static const double WARP_SIGN[4] = {1.0, -1.0, 1.0, -1.0};
+
+typedef struct
+{
+  vec e[3][3];                 /* e1, e2, e3: their global components */
+  vec x[4], y[4], z[4];        /* local coordinates of the nodes about the centroid, m */
+  vec area;                    /* projected area A, m^2 */
+  vec b1[4], b2[4];            /* dN_I/dx, dN_I/dy at the centre, 1/m */
+} quad_frame_t;
+
+/* The local frame and centre gradients of the cells at x[3 I + i]. */
+INLINE void quad_frame(const vec *restrict x, quad_frame_t *g)
+{
+  vec c[3], d1[3], d2[3], t[3];
+  for (int i = 0; i < 3; ++i)
+  {
+    c[i] = 0.25 * (x[i] + x[3 + i] + x[6 + i] + x[9 + i]);
+    d1[i] = x[6 + i] - x[i];
+    d2[i] = x[9 + i] - x[3 + i];
+    t[i] = x[3 + i] + x[6 + i] - x[i] - x[9 + i];
+  }
+  vec *e1 = g->e[0], *e2 = g->e[1], *e3 = g->e[2];
+  cross(d1, d2, e3);
+  const vec inv_n = 1.0 / vsqrt(dot3(e3, e3));
+  for (int i = 0; i < 3; ++i)
+    e3[i] *= inv_n;
+  const vec tn = dot3(t, e3);
+  for (int i = 0; i < 3; ++i)
+    t[i] -= tn * e3[i];
+  const vec inv_t = 1.0 / vsqrt(dot3(t, t));
+  for (int i = 0; i < 3; ++i)
+    e1[i] = t[i] * inv_t;
+  cross(e3, e1, e2);
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec r[3] = {x[3 * I] - c[0], x[3 * I + 1] - c[1], x[3 * I + 2] - c[2]};
+    g->x[I] = dot3(r, e1);
+    g->y[I] = dot3(r, e2);
+    g->z[I] = dot3(r, e3);
+  }
+  const vec *X = g->x, *Y = g->y;
+  const vec two_area = (X[2] - X[0]) * (Y[3] - Y[1]) - (X[3] - X[1]) * (Y[2] - Y[0]);
+  const vec inv = 1.0 / two_area;
+  g->area = 0.5 * two_area;
+  g->b1[0] = (Y[1] - Y[3]) * inv, g->b1[1] = (Y[2] - Y[0]) * inv;
+  g->b1[2] = (Y[3] - Y[1]) * inv, g->b1[3] = (Y[0] - Y[2]) * inv;
+  g->b2[0] = (X[3] - X[1]) * inv, g->b2[1] = (X[0] - X[2]) * inv;
+  g->b2[2] = (X[1] - X[3]) * inv, g->b2[3] = (X[2] - X[0]) * inv;
+}
+
+/* The local components out[I][k] of the nodal vectors a[3 I + i] (k < 3). */
+INLINE void to_local(const quad_frame_t *g, const vec *restrict a, vec out[4][3])
+{
+  for (int I = 0; I < 4; ++I)
+    for (int k = 0; k < 3; ++k)
+      out[I][k] = g->e[k][0] * a[3 * I] + g->e[k][1] * a[3 * I + 1] + g->e[k][2] * a[3 * I + 2];
+}
+
+/* The inverse of the nodes' inertia tensor J = sum_I (|r_I|^2 I - r_I r_I^T) about the
+ * centroid (local frame), row-major. */
+INLINE void rigid_inverse(const quad_frame_t *g, vec Ji[9])
+{
+  vec J[9] = {VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO, VZERO};
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    const vec rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        J[3 * i + j] += (i == j ? rr : VZERO) - r[i] * r[j];
+  }
+  const vec c0 = J[4] * J[8] - J[5] * J[7], c1 = J[5] * J[6] - J[3] * J[8];
+  const vec c2 = J[3] * J[7] - J[4] * J[6];
+  const vec inv = 1.0 / (J[0] * c0 + J[1] * c1 + J[2] * c2);
+  Ji[0] = c0 * inv, Ji[3] = c1 * inv, Ji[6] = c2 * inv;
+  Ji[1] = (J[2] * J[7] - J[1] * J[8]) * inv, Ji[4] = (J[0] * J[8] - J[2] * J[6]) * inv;
+  Ji[7] = (J[1] * J[6] - J[0] * J[7]) * inv;
+  Ji[2] = (J[1] * J[5] - J[2] * J[4]) * inv, Ji[5] = (J[2] * J[3] - J[0] * J[5]) * inv;
+  Ji[8] = (J[0] * J[4] - J[1] * J[3]) * inv;
+}
+
+/* Remove the cell's rigid rotation, the least-squares fit Omega = J^-1 sum r_I x (v_I - mean v)
+ * of all its nodal velocities, from the in-plane velocities (in place). */
+INLINE void project_rigid(const quad_frame_t *g, const vec Ji[9], vec vl[4][3])
+{
+  vec mean[3], a[3] = {VZERO, VZERO, VZERO}, o[3];
+  for (int i = 0; i < 3; ++i)
+    mean[i] = 0.25 * (vl[0][i] + vl[1][i] + vl[2][i] + vl[3][i]);
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    const vec d[3] = {vl[I][0] - mean[0], vl[I][1] - mean[1], vl[I][2] - mean[2]};
+    vec c[3];
+    cross(r, d, c);
+    for (int i = 0; i < 3; ++i)
+      a[i] += c[i];
+  }
+  for (int i = 0; i < 3; ++i)
+    o[i] = Ji[3 * i] * a[0] + Ji[3 * i + 1] * a[1] + Ji[3 * i + 2] * a[2];
+  for (int I = 0; I < 4; ++I)
+  {
+    vl[I][0] -= o[1] * g->z[I] - o[2] * g->y[I];
+    vl[I][1] -= o[2] * g->x[I] - o[0] * g->z[I];
+  }
+}
+
+/* The transpose of project_rigid on local nodal forces fl whose in-plane parts act on the
+ * projected velocities (in place): fl_I -= mu x r_I, mu = J^-1 sum r_I x (fx_I, fy_I, 0). */
+INLINE void project_rigid_forces(const quad_frame_t *g, const vec Ji[9], vec fl[4][3])
+{
+  vec M[3] = {VZERO, VZERO, VZERO}, mu[3];
+  for (int I = 0; I < 4; ++I)
+  {
+    /* r x (fx, fy, 0) */
+    M[0] -= g->z[I] * fl[I][1];
+    M[1] += g->z[I] * fl[I][0];
+    M[2] += g->x[I] * fl[I][1] - g->y[I] * fl[I][0];
+  }
+  for (int i = 0; i < 3; ++i)
+    mu[i] = Ji[3 * i] * M[0] + Ji[3 * i + 1] * M[1] + Ji[3 * i + 2] * M[2];
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec r[3] = {g->x[I], g->y[I], g->z[I]};
+    vec c[3];
+    cross(mu, r, c);
+    for (int i = 0; i < 3; ++i)
+      fl[I][i] -= c[i];
+  }
+}
+
+/* Membrane (xx, yy, gamma_xy), curvature and transverse shear velocity strains. */
+INLINE void quad_strain_rates(const quad_frame_t *g, const vec vl[4][3], const vec wl[4][3],
+                              vec d[3], vec k[3], vec gs[2])
+{
+  for (int i = 0; i < 3; ++i)
+    d[i] = k[i] = VZERO;
+  gs[0] = gs[1] = VZERO;
+  vec tx = VZERO, ty = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec b1 = g->b1[I], b2 = g->b2[I];
+    d[0] += b1 * vl[I][0];
+    d[1] += b2 * vl[I][1];
+    d[2] += b2 * vl[I][0] + b1 * vl[I][1];
+    k[0] += b1 * wl[I][1];
+    k[1] -= b2 * wl[I][0];
+    k[2] += b2 * wl[I][1] - b1 * wl[I][0];
+    gs[0] += b1 * vl[I][2];
+    gs[1] += b2 * vl[I][2];
+    tx += wl[I][0];
+    ty += wl[I][1];
+  }
+  gs[0] += 0.25 * ty;
+  gs[1] -= 0.25 * tx;
+}
+
+/* Add the local forces fl[I] and moments ml[I] (x, y) to the global fe[3 I + i] (forces)
+ * and fe[12 + 3 I + i] (moments). */
+INLINE void add_global(const quad_frame_t *g, const vec fl[4][3], const vec ml[4][2],
+                       vec *restrict fe)
+{
+  for (int I = 0; I < 4; ++I)
+    for (int i = 0; i < 3; ++i)
+    {
+      fe[3 * I + i] += fl[I][0] * g->e[0][i] + fl[I][1] * g->e[1][i] + fl[I][2] * g->e[2][i];
+      fe[12 + 3 * I + i] += ml[I][0] * g->e[0][i] + ml[I][1] * g->e[1][i];
+    }
+}
+
+/* The nodal forces and moments of the resultants N, M, Q on the cells of frame g, added
+ * to fe (global). */
+INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec Ji[9],
+                                  const vec N[3], const vec M[3], const vec Q[2],
+                                  vec *restrict fe)
+{
+  vec fl[4][3], ml[4][2];
+  const vec A = g->area;
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec b1 = A * g->b1[I], b2 = A * g->b2[I];
+    fl[I][0] = b1 * N[0] + b2 * N[2];
+    fl[I][1] = b2 * N[1] + b1 * N[2];
+    fl[I][2] = b1 * Q[0] + b2 * Q[1];
+    ml[I][0] = -b2 * M[1] - b1 * M[2] - (0.25 * A) * Q[1];
+    ml[I][1] = b1 * M[0] + b2 * M[2] + (0.25 * A) * Q[0];
+  }
+  if (warping)
+    project_rigid_forces(g, Ji, fl);
+  add_global(g, fl, ml, fe);
+}
+
+/* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
+ * velocities vl (projected when warping) and angular velocities wl; returns their power, W. */
+INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double density,
+                          double dt, vec thickness, int warping, const vec Ji[9],
+                          const vec vl[4][3],
+                          const vec wl[4][3], double *restrict state, int64_t stride,
+                          const batch_t *b, vec *restrict fe)
+{
+  vec gx = VZERO, gy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    gx += WARP_SIGN[I] * g->x[I];
+    gy += WARP_SIGN[I] * g->y[I];
+  }
+  vec gamma[4], q[5] = {VZERO, VZERO, VZERO, VZERO, VZERO};
+  for (int I = 0; I < 4; ++I)
+  {
+    gamma[I] = 0.25 * (WARP_SIGN[I] - gx * g->b1[I] - gy * g->b2[I]);
+    for (int k = 0; k < 3; ++k)
+      q[k] += gamma[I] * vl[I][k];
+    q[3] += gamma[I] * wl[I][0];
+    q[4] += gamma[I] * wl[I][1];
+  }
+  const vec C = (4.0 * density * s->bar_speed) * thickness * vsqrt(g->area);
+  const vec Cm = s->hm * C, Cf = s->hf * C, Cr = (s->hr / 12.0) * C * thickness * thickness;
+  vec Q[5] = {Cm * q[0], Cm * q[1], Cf * q[2], Cr * q[3], Cr * q[4]};
+  vec work = VZERO;
+  for (int k = 0; k < 5; ++k)
+    work += dt * Q[k] * q[k];
+  if (s->hk > 0.0)
+  {
+    /* elastic hourglass forces, incremental in the cell's frame: dQ = k dt q */
+    vec bb = VZERO;
+    for (int I = 0; I < 4; ++I)
+      bb += g->b1[I] * g->b1[I] + g->b2[I] * g->b2[I];
+    const double Ep = s->young / (1.0 - s->poisson * s->poisson);
+    const vec bending = (Ep / 12.0) * thickness * thickness * thickness;
+    const vec km = (s->hk * 2.0 / 3.0 * Ep) * thickness * g->area * bb;
+    const vec kw = (4.0 * s->hk) * bending * g->area * bb * bb;
+    const vec kr = (s->hk * 2.0 / 3.0) * bending * g->area * bb;
+    const vec k[5] = {km, km, kw, kr, kr};
+    for (int m = 0; m < 5; ++m)
+    {
+      const vec old = load_slot(state, stride, b, s->hourglass_slot + m);
+      const vec dq = dt * q[m], dQ = k[m] * dq;
+      store_slot(state, stride, b, s->hourglass_slot + m, old + dQ);
+      work += (old + 0.5 * dQ) * dq;
+      Q[m] += old + dQ;
+    }
+  }
+  vec fl[4][3], ml[4][2];
+  for (int I = 0; I < 4; ++I)
+  {
+    for (int k = 0; k < 3; ++k)
+      fl[I][k] = gamma[I] * Q[k];
+    ml[I][0] = gamma[I] * Q[3];
+    ml[I][1] = gamma[I] * Q[4];
+  }
+  if (warping)
+    project_rigid_forces(g, Ji, fl);
+  add_global(g, fl, ml, fe);
+  return work;
+}
+
+/* Radioss's characteristic length (m) of the cells of frame g. */
+INLINE vec quad_length(const quad_frame_t *g)
+{
+  vec l2[6];
+  static const int PAIRS[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
+  for (int e = 0; e < 6; ++e)
+  {
+    const vec dx = g->x[PAIRS[e][1]] - g->x[PAIRS[e][0]];
+    const vec dy = g->y[PAIRS[e][1]] - g->y[PAIRS[e][0]];
+    const vec dz = g->z[PAIRS[e][1]] - g->z[PAIRS[e][0]];
+    l2[e] = dx * dx + dy * dy + dz * dz;
+  }
+  vec shortest = l2[0];
+  for (int e = 1; e < 6; ++e)
+    shortest = vmin(shortest, l2[e]);
+  const vec dynamic = g->area * g->area / vmax(l2[4], l2[5]);
+  return vsqrt(vmax(dynamic, shortest));
+}
+
+INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict cells,
+                       const double *restrict X, const double *restrict u,
+                       const double *restrict v, const double *restrict w,
+                       const element_params *p, const shell_params *s, double *restrict state,
+                       int64_t stride, double *restrict f, double *restrict m,
+                       double *restrict energy, double *restrict step)
+{
+  const double dt = p->dt;
+  const int warping = s->warping;
+  double stored_total = 0.0, hourglass_total = 0.0, plastic_total = 0.0;
+  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
+  {
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
+    gather(cells, 4, &b, X, Xe);
+    gather(cells, 4, &b, u, ue);
+    gather(cells, 4, &b, v, ve);
+    gather(cells, 4, &b, w, we);
+    for (int i = 0; i < 12; ++i)
+    {
+      x[i] = Xe[i] + ue[i];
+      xm[i] = x[i] - (0.5 * dt) * ve[i];
+      du[i] = dt * ve[i];
+      du[12 + i] = dt * we[i];
+    }
+    for (int i = 0; i < 24; ++i)
+      fe[i] = VZERO;
+    const vec t = cell_values(s->thickness, &b);
+    quad_frame_t g;
+    quad_frame(xm, &g);
+    vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
+    to_local(&g, ve, vl);
+    to_local(&g, we, wl);
+    vec Ji[9];
+    if (warping)
+    {
+      rigid_inverse(&g, Ji);
+      project_rigid(&g, Ji, vl);
+    }
+    quad_strain_rates(&g, vl, wl, d, k, gs);
+    vec hourglass = VZERO;
+    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
+      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, Ji, vl, wl, state, stride,
+                                 &b, fe);
+    const vec mid_area = g.area;
+    vec N[3], M[3], Q[2], elastic, dissipated, damage;
+    shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
+                 &damage);
+    quad_frame(x, &g);
+    if (warping)
+      rigid_inverse(&g, Ji);
+    quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
+    elastic *= g.area;
+    const vec plastic_work = dissipated * mid_area;
+    const ivec inverted = ~(g.area > 0.0);
+    vec dte = VZERO + INFINITY;
+    if (p->estimate)
+      dte = (p->calibration / s->bar_speed) * quad_length(&g);
+    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
+                                      &hourglass, du, fe, 8, energy, step);
+    stored_total += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    hourglass_total += lane_sum(hourglass, b.nb);
+    plastic_total += lane_sum(plastic_work, b.nb);
+    scatter_add(cells, 4, &b, fe, f);
+    scatter_add(cells, 4, &b, fe + 12, m);
+    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
+    if (p->estimate)
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 4, step);
+  }
+  energy[0] += stored_total;
+  energy[1] += hourglass_total;
+  energy[2] += plastic_total;
+}
+
+/* f += internal forces (N), m += internal moments (N m) of the quadrilaterals `cells` (n x 4,
+ * counter-clockwise), nodes at X + u (m), velocities v (m/s) and angular velocities w
+ * (rad/s, global); the state rows as the header says; energies and steps as above. */
+void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                        const double *v, const double *w, const element_params *p,
+                        const shell_params *s, double *state, int64_t stride, double *f,
+                        double *m, double *energy, double *step)
+{
+  shell_quad(0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+}
+
+void shell_quad_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
+                        const double *v, const double *w, const element_params *p,
+                        const shell_params *s, double *state, int64_t stride, double *f,
+                        double *m, double *energy, double *step)
+{
+  shell_quad(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+}
+
+/* The projected area (m^2) and characteristic length (m) of each quadrilateral at x. */
+void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
+                      double *length)
+{
+  vec xe[12];
+  for (int64_t k0 = 0; k0 < n; k0 += LANES)
+  {
+    const batch_t b = batch_at(NULL, k0, n);
+    gather(cells, 4, &b, x, xe);
+    quad_frame_t g;
+    quad_frame(xe, &g);
+    const vec l = quad_length(&g);
+    for (int k = 0; k < b.nb; ++k)
+    {
+      area[k0 + k] = g.area[k];
+      length[k0 + k] = l[k];
+    }
+  }
+}
+
+/* The plane-stress point update of shell.h at one point (for tests and material drivers):
+ * stress (xx, yy, xy; Pa), plastic strain and temperature in place from the strain increment
+ * de (xx, yy, gamma_xy); returns the plastic dissipation density (J/m^3). */
+double shell_point(const element_params *p, const shell_params *s, double sigma[3],
+                   double *eps_p, double *T, const double de[3])
+{
+  vec sig[3], e = VZERO + *eps_p, temperature = VZERO + *T, d[3];
+  for (int i = 0; i < 3; ++i)
+  {
+    sig[i] = VZERO + sigma[i];
+    d[i] = VZERO + de[i];
+  }
+  point_step done;
+  const vec dissipation = shell_point_update(p, s, sig, &e, &temperature, d, &done);
+  for (int i = 0; i < 3; ++i)
+    sigma[i] = sig[i][0];
+  *eps_p = e[0];
+  *T = temperature[0];
+  return dissipation[0];
+}

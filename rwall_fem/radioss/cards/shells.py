@@ -1,0 +1,139 @@
+"""Shell elements and their property: /SHELL, /SH3N and /PROP/SHELL (/PROP/TYPE1), whose
+blank fields take /DEF_SHELL's values (read at the end, wherever the cards are).
+
+Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): 1, 2, 3 and 4
+(Belytschko-Tsay with viscous hourglass control) to ``"bt"``; 24 (QEPH, Belytschko-Leviathan's
+physical stabilisation) and 12 to ``"bwc"`` (Belytschko-Lin-Tsay with the
+Belytschko-Wong-Chiang warping correction and viscous hourglass control), with a warning
+that QEPH's physical stabilisation is not there. Ish3n 1 and 2 (the C0 triangle) to
+``"bsc"``. N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
+``thickness``, ``shear_factor`` and ``hourglass_coefficients`` (Radioss's defaults where
+blank: N 5, Ashear 5/6, hm hf hr 0.01).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rwall_fem.radioss.cards.base import card_units, ident
+from rwall_fem.radioss.model import Body, Deck
+from rwall_fem.radioss.reader import Card, fixed_table, read_fields
+
+__all__ = ["ISHELL", "STARTER", "finish", "shell_element"]
+
+# Ishell -> the scene's formulation of quadrilaterals.
+ISHELL = {1: "bt", 2: "bt", 3: "bt", 4: "bt", 12: "bwc", 24: "bwc"}
+_ISHELL_TEXT = "1, 2, 3, 4 (Belytschko-Tsay), 12 and 24 (read as Belytschko-Lin-Tsay with the " \
+    "warping correction)"  # fmt: skip
+
+
+def _elements(deck: Deck, card: Card) -> None:
+    part = ident(card, 1, "part_ID")
+    count = 4 if card.key(0) == "SHELL" else 3
+    layout = "i:elem_ID " + " ".join(f"i:node{k + 1}" for k in range(count))
+    columns = fixed_table(card, 0, layout)
+    ids = columns[0]
+    nodes = np.column_stack(columns[1:])
+    if not len(ids):
+        card.fail("no elements")
+    missing = np.flatnonzero((nodes <= 0).any(axis=1))
+    if len(missing):
+        k = missing[0]
+        card.fail(f"truncated line: element {ids[k]} needs {count} node IDs, got "
+                  f"{int((nodes[k] > 0).sum())}", card.lines[k])  # fmt: skip
+    repeated = np.flatnonzero((np.diff(np.sort(nodes, axis=1), axis=1) == 0).any(axis=1))
+    if len(repeated):
+        card.fail(f"element {ids[repeated[0]]} repeats a node (a degenerate element): give "
+                  "a triangle as /SH3N", card.lines[repeated[0]])  # fmt: skip
+    cell = "quadrilateral" if count == 4 else "triangle"
+    deck.bodies.append(Body(part, cell, ids, nodes, card))
+
+
+def _property(deck: Deck, card: Card) -> None:
+    pid = ident(card, 2, "prop_ID")
+    if pid in deck.properties:
+        card.fail(f"property {pid} is defined twice")
+    units = card_units(deck, card, 3)
+    first = card.line(1, "Ishell Ismstr Ish3n Idrill Ipinch P_thickfail")
+    ishell, ismstr, ish3n, idrill, _, _ = read_fields(
+        card, first, "i:Ishell i:Ismstr i:Ish3n i:Idrill i:Ipinch -:blank f:P_thickfail"
+    )
+    hm, hf, hr, _, _ = card.read(2, "f:hm f:hf f:hr f:dm f:dn", "hm hf hr dm dn")
+    third = card.line(3, "N Istrain Thick Ashear Ithick Iplas")
+    n, _, thick, ashear, ithick, iplas = read_fields(
+        card, third, "i:N i:Istrain f:Thick f:Ashear -:blank i:Ithick i:Iplas"
+    )
+    deck.properties[pid] = {
+        "unread": "shell", "card": card, "where": card.header.where, "first": first.where,
+        "third": third.where,
+        "given": {"ishell": ishell, "ismstr": ismstr, "ish3n": ish3n, "idrill": idrill,
+                  "ithick": ithick, "iplas": iplas},
+        "n": n, "thick": thick * units.length, "ashear": ashear, "hourglass": (hm, hf, hr),
+    }  # fmt: skip
+
+
+def finish(deck: Deck) -> None:
+    """Every /PROP/SHELL with /DEF_SHELL's values in its blank fields, checked."""
+    for pid, raw in deck.properties.items():
+        if raw.get("unread") == "shell":
+            deck.properties[pid] = _shell_property(deck, raw)
+
+
+def _shell_property(deck: Deck, raw: dict) -> dict:
+    """The facts of a /PROP/SHELL: its kind ("shell"), Ishell, Ish3n and the [element]
+    keys; refusals of what has no counterpart name its line."""
+    card: Card = raw["card"]
+    first = next(li for li in card.lines if li.where == raw["first"])
+    third = next(li for li in card.lines if li.where == raw["third"])
+    value = {k: v or deck.shell_defaults.get(k, 0) for k, v in raw["given"].items()}
+    ishell = value["ishell"] or 24  # Radioss's default (QEPH)
+    ish3n = value["ish3n"] or 2
+    if ishell not in ISHELL:
+        card.fail(f"Ishell = {ishell}: supported: {_ISHELL_TEXT}", first)
+    if ish3n not in (1, 2):
+        card.fail(f"Ish3n = {ish3n}: supported: 1 and 2 (the C0 triangle)", first)
+    if value["ismstr"] not in (0, 2, 4):
+        card.fail(f"Ismstr = {value['ismstr']}: small-strain formulations are not supported; "
+                  "leave it blank (full geometric non-linearity)", first)  # fmt: skip
+    if value["ithick"] not in (0, 2):
+        card.fail(f"Ithick = {value['ithick']}: the thickness is constant (Ithick 2 or "
+                  "blank)", third)  # fmt: skip
+    if raw["thick"] <= 0.0:
+        card.fail(f"Thick = {raw['thick']:g} m: a shell needs a thickness > 0", third)
+    points = raw["n"] or 5
+    if not 1 <= points <= 10:
+        card.fail(f"N = {points}: 1 to 10 points through the thickness", third)
+    if value["idrill"]:
+        deck.warn(card, f"Idrill = {value['idrill']}: no drilling stiffness (the rotation "
+                  "about a shell's normal is held by its inertia only)", first)  # fmt: skip
+    hourglass = [h if h else 0.01 for h in raw["hourglass"]]
+    element = {"thickness": raw["thick"], "points": points,
+               "hourglass_coefficients": hourglass}  # fmt: skip
+    if raw["ashear"]:
+        element["shear_factor"] = raw["ashear"]
+    if ishell in (12, 24):
+        deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
+                  "warping correction and viscous hourglass control hm, hf, hr (QEPH's "
+                  "physical stabilisation is not there)", first)  # fmt: skip
+    return {"kind": "shell", "ishell": ishell, "ish3n": ish3n, "where": card.header.where,
+            "line": first.where, "element": element}  # fmt: skip
+
+
+def shell_element(deck: Deck, pid: int, cell: str) -> tuple[dict, str]:
+    """The [element] table of /PROP/SHELL ``pid`` for ``cell`` cells, and the line saying
+    what it became."""
+    p = deck.properties[pid]
+    element = dict(p["element"])
+    element["formulation"] = "bsc" if cell == "triangle" else ISHELL[p["ishell"]]
+    head = (f"property: /PROP/SHELL/{pid} Ishell {p['ishell']} Ish3n {p['ish3n']} "
+            f"({p['where']})")  # fmt: skip
+    text = ", ".join(f"{k} {v}" for k, v in element.items())
+    return element, f"{head} -> {text}"
+
+
+STARTER = {
+    "SHELL": _elements,
+    "SH3N": _elements,
+    "PROP/SHELL": _property,
+    "PROP/TYPE1": _property,
+}

@@ -1,0 +1,357 @@
+"""A body of shells: its parts' element forces and moments, and its nodes' rotations.
+
+Each node has six degrees of freedom: the three translations of the body's
+:class:`~rwall_fem.solver.State` (walls, boundary conditions, gravity and the update act
+on them as on a solid's nodes), and three rotations, whose angular velocity ``w`` (rad/s,
+global axes) lives here, in a second P1 vector field on the same space. The elements take
+their frame from the current coordinates and their strain rates from ``v`` and ``w``
+(rate form), so the angular velocity is all of a node's rotations that a step needs: they
+are never summed into a rotation vector.
+
+:class:`ShellBody` is the internal force of the step pipeline: its :meth:`accelerate` sets
+``state.a = -f / m`` and the angular acceleration ``alpha = -M / I`` (kg, kg m^2:
+:mod:`rwall_fem.shells.inertia`); :class:`~rwall_fem.shells.update.ShellUpdate` advances
+``w`` with ``v`` and books the rotations' kinetic energy and the work of the moments.
+Its energies are those of a force without a stored energy: the work of the forces and
+moments at mid-step velocities (the internal energy: that work less the hourglass
+energy the kernels report), and the rotations' shadow kinetic energy
+``"rotational_kinetic"`` (``docs/theory.md``, "Shell bodies").
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+
+from rwall_fem import _compat
+from rwall_fem.elements import GhostedField
+from rwall_fem.kernels import STEP_SLOTS, load
+
+__all__ = ["FORMULATIONS", "ShellBody", "ShellPart", "ShellSection"]
+
+
+# The scene's names of the shell formulations.
+FORMULATIONS = {
+    "bwc": "Belytschko-Lin-Tsay quadrilateral shells with the Belytschko-Wong-Chiang "
+    "warping correction",
+    "bt": "Belytschko-Lin-Tsay quadrilateral shells",
+    "bsc": "Belytschko-Stolarski-Carpenter triangular shells",
+}
+
+
+@dataclass(frozen=True)
+class ShellSection:
+    """A part's shell section (Radioss /PROP/SHELL): the element ``technology`` of the
+    kernels (:class:`~rwall_fem.shells.elements.ShellTechnology`), the scene's
+    ``formulation``, the ``thickness`` (m) and the ``points`` through it."""
+
+    technology: object
+    formulation: str
+    thickness: float
+    points: int
+
+    def describe(self) -> str:
+        """E.g. 'Belytschko-Lin-Tsay quadrilateral shells, 5 points through 0.002 m'."""
+        return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
+                f"{self.thickness:g} m")  # fmt: skip
+
+
+@dataclass
+class ShellPart:
+    """A part of a shell body: its ``name``, the local indices of its owned ``cells``, its
+    ``material``, its :class:`ShellSection` ``technology`` and initial ``velocity``
+    (m/s)."""
+
+    name: str
+    cells: np.ndarray
+    material: object
+    technology: ShellSection
+    velocity: tuple[float, float, float]
+
+
+class ShellBody:
+    """The internal force and moments of the shell ``parts`` (:class:`ShellPart`) on the
+    vector space ``V``, with the displacement and velocity fields ``u`` and ``v`` (m, m/s)
+    of the state; ``inertia`` (owned nodes, 2) holds the nodes' masses (kg) and
+    rotational inertias (kg m^2). ``force_class`` is the shell element force (one per part;
+    ``ShellForce(V, material, technology, u, v, w, thickness=, cells=, f=, m=)``, filling
+    nodal forces ``f`` (N) and moments ``m`` (N m)). ``explicit``: the scene gave its parts.
+    """
+
+    conservative = False  # the kernels' stresses follow a path (rate form)
+    books_work = True
+    corrects = False
+    erosion = None
+    labels = None  # the update books the work of the body as a whole
+    controlling_part = 0
+
+    def __init__(self, V, parts, u: GhostedField, v: GhostedField, inertia: np.ndarray,
+                 *, explicit: bool = False):  # fmt: skip
+        from rwall_fem.shells.elements import ShellForce
+
+        self.V, self.u, self.v = V, u, v
+        self.w = GhostedField(V)  # angular velocity w^{n-1/2}, rad/s
+        self.f, self.m = GhostedField(V), GhostedField(V)  # N, N m
+        self.parts, self.explicit = parts, explicit
+        self.inertia = inertia
+        self.inv_inertia = 1.0 / inertia[:, 1]
+        self.alpha = np.zeros_like(self.w.owned)  # angular acceleration, rad/s^2
+        self.elements = [
+            ShellForce(V, part.material, part.technology.technology, u, v, self.w,
+                       thickness=part.technology.thickness, cells=part.cells, f=self.f,
+                       m=self.m)  # fmt: skip
+            for part in parts
+        ]
+        self.nodal_force = self.f.owned
+        self.moments = self.m.owned
+        self.X = np.ascontiguousarray(V.tabulate_dof_coordinates(), dtype=np.float64)
+        owned = V.mesh.topology.index_map(V.mesh.topology.dim).size_local
+        self._alone = len(parts) == 1 and len(parts[0].cells) == owned
+        self.step = self.elements[0].step if self._alone else np.zeros(STEP_SLOTS)
+        self.held = _held(V, parts)
+        self.part_masses = None  # (owned nodes, parts), kg: set by the builder
+        self.rotational_kinetic = 0.0  # the rotations' K^n of the latest update, J
+        self.rotational_sums = (0.0, 0.0)  # sum M . w^{n-1/2}, sum M . w^{n+1/2}, W
+        self._done = 0.0  # the work of the forces and moments over the finished halves, J
+        self._latest = 0.0  # ... up to step n (its first half), J
+        self.name = (
+            f"shells ({parts[0].material.model})"
+            if len(parts) == 1
+            else "shells: " + ", ".join(f"{p.name} {p.material.model}" for p in parts)
+        )
+        self.plastic = any(part.material.plastic for part in parts)
+        self.energy_names = ("rotational_kinetic", "internal", "hourglass")
+        self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
+        self._nodes = np.asarray(_compat.cell_nodes(V))  # each local cell's nodes
+        self._free = None  # (owned nodes, 3): 0 where a rotation is held, else 1
+        self._acceleration = None
+
+    # --- the step ----------------------------------------------------------------------
+
+    def accelerate(self, state) -> None:
+        """Set ``state.a = -f(u^n) / m`` and :attr:`alpha` ``= -M / I`` on the owned nodes,
+        every part's kernel adding its forces and moments; combine what they noted of the
+        stable steps."""
+        for field in (self.u, self.v, self.w):
+            field.scatter_forward()
+        self.f.array.fill(0.0)
+        self.m.array.fill(0.0)
+        for force in self.elements:
+            force.compute(state)
+        self.f.scatter_reverse_add()
+        self.m.scatter_reverse_add()
+        if not self._alone:
+            self._combine_steps()
+        if self._acceleration is None:
+            ffi, lib = load()
+
+            def ptr(array):
+                return ffi.cast("double *", array.ctypes.data)
+
+            self._acceleration = (
+                functools.partial(lib.internal_acceleration, len(state.inv_mass),
+                                  ptr(self.f.array), ptr(state.inv_mass), ptr(state.a)),
+                functools.partial(lib.internal_acceleration, len(self.inv_inertia),
+                                  ptr(self.m.array), ptr(self.inv_inertia), ptr(self.alpha)),
+            )  # fmt: skip
+        for pass_ in self._acceleration:
+            pass_()
+        if self._free is not None:
+            self.alpha *= self._free
+
+    def hold_rotations(self, nodes: np.ndarray, axes: str) -> None:
+        """Hold the rotations of the owned ``nodes`` about the global ``axes`` (some of
+        "xyz") fixed: their angular velocity stays 0, the reaction moment does no work (a
+        clamped edge with the translations held by a boundary condition)."""
+        if self._free is None:
+            self._free = np.ones_like(self.alpha)
+        columns = ["xyz".index(c) for c in axes]
+        self._free[np.ix_(nodes, columns)] = 0.0
+        self.w.owned[np.ix_(nodes, columns)] = 0.0
+
+    def _combine_steps(self) -> None:
+        """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index
+        among the owned cells) and place, the inverted cells."""
+        best = min(range(len(self.elements)), key=lambda k: self.elements[k].step[0])
+        self.controlling_part = best
+        step, mine = self.step, self.elements[best].step
+        step[:5] = mine[:5]
+        if mine[1] >= 0:
+            step[1] = self.parts[best].cells[int(mine[1])]
+        step[5], step[6], step[10], step[11] = 0.0, -1.0, 0.0, 0.0
+        for part, force in zip(self.parts, self.elements, strict=True):
+            if force.step[5] and not step[5]:
+                step[6] = part.cells[int(force.step[6])]
+                step[7:10] = force.step[7:10]
+            step[5] += force.step[5]
+
+    def book(self, state, first: float, second: float) -> None:
+        """After the update of step n: book the work of the forces and moments at mid-step
+        velocities, dt^n/2 (first + second), from sum f . v^{n-1/2} + M . w^{n-1/2}
+        (``first``, with :attr:`rotational_sums`) and the same at n + 1/2 (W); what is
+        booked up to step n holds its first half only."""
+        dt_v = state.dt_velocity
+        first += self.rotational_sums[0]
+        second += self.rotational_sums[1]
+        self._latest = self._done + 0.5 * dt_v * first
+        self._done += 0.5 * dt_v * (first + second)
+
+    # --- energies ----------------------------------------------------------------------
+
+    def energies(self, state) -> dict[str, float]:
+        """This rank's energies (J) at step n: the rotations' shadow kinetic energy, the
+        internal energy (the work of the forces and moments less the hourglass energy)
+        and the hourglass energy."""
+        hourglass = sum(force.hourglass_energy for force in self.elements)
+        energies = {
+            "rotational_kinetic": self.rotational_kinetic,
+            "internal": self._latest - hourglass,
+            "hourglass": hourglass,
+        }
+        if self.plastic:
+            energies["elastic"] = sum(force.stored_energy for force in self.elements)
+            energies["plastic_work"] = sum(force.plastic_work for force in self.elements)
+        return energies
+
+    def part_columns(self) -> tuple[str, ...]:
+        """The per-part columns of ``energy.csv``: ``<part>.kinetic`` (translations, by the
+        part's share of the nodes' masses), ``<part>.internal`` and ``<part>.hourglass``
+        (what its kernel booked of its cells: stored and plastic work; hourglass work)."""
+        return tuple(f"{p.name}.{n}" for p in self.parts for n in ("kinetic", "internal",
+                                                                    "hourglass"))  # fmt: skip
+
+    def part_values(self, state) -> np.ndarray:
+        """This rank's values (J) of :meth:`part_columns` at step n."""
+        v_old = state.v - state.dt_velocity * state.a
+        per_node = 0.5 * state.mass * np.einsum("ij,ij->i", v_old, state.v)
+        kinetic = per_node @ (self.part_masses / state.mass[:, None])
+        return np.array(
+            [
+                value
+                for k, force in enumerate(self.elements)
+                for value in (kinetic[k], force.stored_energy + force.plastic_work,
+                              force.hourglass_energy)  # fmt: skip
+            ]
+        )
+
+    def part_momenta(self, state) -> np.ndarray:
+        """(parts, 3): this rank's share of each part's momentum (kg m/s) at v^{n+1/2}, by
+        the parts' shares of the nodes' masses."""
+        return (self.part_masses / state.mass[:, None]).T @ (state.mass[:, None] * state.v)
+
+    def plastic_strains(self) -> np.ndarray:
+        """The equivalent plastic strain of every point of the elasto-plastic parts."""
+        return np.concatenate(
+            [f.kernel.plastic_strains().ravel() for f in self.elements if f.plastic]
+            or [np.zeros(0)]
+        )
+
+    @property
+    def plastic_work(self) -> float:
+        """Plastic dissipation (J) of this rank's cells so far."""
+        return sum(force.plastic_work for force in self.elements)
+
+    def step_change_work(self) -> float:
+        return 0.0
+
+    def cell_fields(self, state) -> dict[str, np.ndarray]:
+        """Values per owned cell for the outputs: the parts' cell fields (the plane stresses
+        of a surface as ``<name>_xx``, ``_yy``, ``_xy``) and, for a body of parts,
+        ``"part"``, the part's index."""
+        owned = self.V.mesh.topology.index_map(self.V.mesh.topology.dim).size_local
+        fields: dict[str, np.ndarray] = {}
+        for part, force in zip(self.parts, self.elements, strict=True):
+            for name, values in force.cell_fields(state).items():
+                if values.ndim == 2:  # the plane stresses of a surface, local frame: Pa
+                    for component, row in zip(("xx", "yy", "xy"), values, strict=True):
+                        fields.setdefault(f"{name}_{component}", np.zeros(owned))[
+                            part.cells] = row  # fmt: skip
+                else:
+                    fields.setdefault(name, np.zeros(owned))[part.cells] = values
+        if self.explicit:
+            index = np.zeros(owned)
+            for k, part in enumerate(self.parts):
+                index[part.cells] = k
+            fields["part"] = index
+        return fields
+
+    # --- the stable step ---------------------------------------------------------------
+
+    estimate_every_step = True  # the frame and the lengths follow the shell every cycle
+
+    def calibrate(self, dt_exact: float, cap: bool = True) -> float:
+        """Shells take the elements' estimates as they are (Radioss's L_c / c): the ratio of
+        ``dt_exact`` (s, their smallest at rest) to their smallest at rest, 1."""
+        smallest = self.V.mesh.comm.allreduce(
+            float(self.steps_at_rest().min(initial=np.inf)), op=MPI.MIN
+        )
+        return dt_exact / smallest
+
+    calibration = 1.0
+
+    def steps_at_rest(self) -> np.ndarray:
+        """Every owned cell's stable step estimate at rest (s), part after part."""
+        return np.concatenate([force.steps_at_rest() for force in self.elements])
+
+    def erode_below(self, floor: float) -> None:
+        raise NotImplementedError("shells do not erode")
+
+    def detach_nodes(self) -> None:
+        """Nothing to detach: shells do not erode."""
+
+    def cell_position(self, cell: int) -> np.ndarray:
+        """The centroid (m) of the owned ``cell`` (its local index) at X + u."""
+        nodes = self._nodes[cell]
+        return (self.X[nodes] + self.u.array[nodes]).mean(axis=0)
+
+    def describe_cell(self, cell: int) -> str:
+        """The owned ``cell``'s part in words."""
+        part, _ = self._locate(cell)
+        return f"of part {self.parts[part].name}" if self.explicit else "a shell"
+
+    def _locate(self, cell: int) -> tuple[int, int]:
+        for k, part in enumerate(self.parts):
+            where = np.flatnonzero(part.cells == cell)
+            if len(where):
+                return k, int(where[0])
+        raise KeyError(cell)
+
+    # --- checkpoints -------------------------------------------------------------------
+
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The angular velocity w^{n+1/2}, the books of the work, the rotations' latest
+        kinetic energy and each part's kernel state."""
+        arrays = {
+            "w": self.w.owned,
+            "books": np.array([self._done, self._latest, self.rotational_kinetic]),
+        }
+        for k, force in enumerate(self.elements):
+            arrays |= {f"part{k}_{name}": a for name, a in force.checkpoint_state().items()}
+        return arrays
+
+    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
+        self.w.owned[:] = arrays["w"]
+        self._done, self._latest, self.rotational_kinetic = arrays["books"].tolist()
+        for k, force in enumerate(self.elements):
+            prefix = f"part{k}_"
+            mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
+            force.restore_state(mine)
+
+
+def _held(V, parts) -> np.ndarray:
+    """(owned + ghost nodes, parts): how many cells of each part hold each node, on any
+    rank (collective)."""
+    from dolfinx import la
+
+    count = len(parts)
+    held = la.vector(V.dofmap.index_map, count)
+    rows = held.array.reshape(-1, count)
+    nodes = np.asarray(_compat.cell_nodes(V))
+    for k, part in enumerate(parts):
+        np.add.at(rows[:, k], nodes[part.cells].ravel(), 1.0)
+    _compat.scatter_reverse_add(held)
+    held.scatter_forward()
+    return rows.copy()
