@@ -77,7 +77,7 @@ class Picture:
             threshold = vtk.vtkThreshold()
             threshold.SetInputData(grid)
             threshold.SetInputArrayToProcess(0, 0, 0, 1, "live")  # 1: cell data
-            threshold.SetLowerThreshold(0.5)
+            threshold.SetUpperThreshold(0.5)  # UPPER keeps the values >= it
             threshold.SetThresholdFunction(vtk.vtkThreshold.THRESHOLD_UPPER)
             output = threshold.GetOutputPort()
             self._filters.append(threshold)

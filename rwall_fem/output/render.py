@@ -27,7 +27,7 @@ import numpy as np
 from rwall_fem import interrupts
 from rwall_fem.output.coloring import COLORS, coloring, fixed_range
 from rwall_fem.output.view import choose_view, up_direction, wall_surface
-from rwall_fem.output.view_spec import ViewSpec, parse_view_text, view_from_json
+from rwall_fem.scene.view import ViewSpec, parse_view_text, view_from_json
 from rwall_fem.scene.keys import SceneError
 from rwall_fem.walls.shapes import shape_from_parameters
 

@@ -28,7 +28,8 @@ from rwall_fem.scene.keys import (
     table,
 )
 
-__all__ = ["ViewSpec", "read_view", "view_from_json", "view_to_json"]
+__all__ = ["ViewSpec", "check_view", "parse_view_text", "read_view", "view_from_json",
+           "view_to_json"]
 
 AXES = ("x", "y", "z")
 SIZES = (64, 4096)  # pixels: the least and largest side of a picture
@@ -216,10 +217,35 @@ def parse_view_text(text: str) -> ViewSpec:
 
 
 def view_to_json(view: ViewSpec) -> dict:
-    """``view`` as JSON-able values (stored with the frame data)."""
-    return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(view).items()}
+    """``view`` as JSON-able values (stored with the frame data; keys left to the automatic
+    choice are left out, as in TOML)."""
+    return {k: v for k, v in asdict(view).items() if v is not None}
 
 
 def view_from_json(raw: dict, source: str) -> ViewSpec:
     """The view stored by :func:`view_to_json`."""
     return read_view(raw, source, "view")
+
+
+def check_view(view: ViewSpec, X, parts, source: str, comm) -> None:
+    """What ``view`` asks of the body: a focus part it has (``parts``, the names; empty
+    for a body without [[part]]), a cut plane that meets its box (``X``, the owned nodes'
+    reference coordinates on each rank of ``comm``, m). SceneError (one line) otherwise."""
+    import numpy as np
+    from mpi4py import MPI
+
+    if isinstance(view.focus, str) and view.focus not in parts:
+        have = f"its parts: {', '.join(parts)}" if parts else "a body without [[part]]"
+        raise SceneError(f"{source}: output.view.focus: {view.focus!r} is not a part of this "
+                         f"body ({have}); give a part or a point [x, y, z]")  # fmt: skip
+    if isinstance(view.cut, dict):
+        point, normal = np.array(view.cut["point"]), np.array(view.cut["normal"])
+        side = (np.asarray(X) - point) @ (normal / np.linalg.norm(normal))
+        low = comm.allreduce(float(side.min(initial=np.inf)), op=MPI.MIN)
+        high = comm.allreduce(float(side.max(initial=-np.inf)), op=MPI.MAX)
+        if not low < 0.0 < high:
+            raise SceneError(
+                f"{source}: output.view.cut: the plane through {list(view.cut['point'])} "
+                f"normal to {list(view.cut['normal'])} does not cut the body (all its nodes "
+                "lie on one side at the start); give a plane through it"
+            )
