@@ -198,10 +198,14 @@ demo: venv-0.5
 	$(RUN_ENV) $(VENV)/bin/rwall-fem run demos/bar_impact.toml --out results/bar_impact
 
 # Every demo at its full resolution, serially (~2 minutes): scenes into results/NAME/, the
-# Python demos write their own results/ folders.
+# Python demos write their own results/ folders.  A scene's gallery picture
+# (docs/gallery/NAME.png) is its last frame, full size, seen as its [output.view] says.
 demos: venv-0.5
 	for scene in demos/*.toml; do \
-	  $(RUN_ENV) $(VENV)/bin/rwall-fem run $$scene --out results/$$(basename $$scene .toml); \
+	  name=$$(basename $$scene .toml); \
+	  $(RUN_ENV) $(VENV)/bin/rwall-fem run $$scene --out results/$$name; \
+	  last=$$(ls results/$$name/frames/frame_*.png 2>/dev/null | tail -n 1); \
+	  if [ -n "$$last" ] && [ -f docs/gallery/$$name.png ]; then cp $$last docs/gallery/$$name.png; fi; \
 	done
 	for script in demos/demo_*.py; do $(RUN_ENV) $(VENV)/bin/python $$script; done
 

@@ -1,4 +1,5 @@
-"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [--color COLOR]``.
+"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [--color COLOR]
+[--view VIEW]``.
 
 Reads the frame data that :class:`rwall_fem.output.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
@@ -9,8 +10,10 @@ nodes no live cell holds are drawn as points), coloured as
 :mod:`rwall_fem.output.coloring` says, with the walls as
 :mod:`rwall_fem.output.view` draws them: flat walls opaque (the camera sees
 them from their allowed side, behind the body), curved walls translucent with
-their outline. The camera and the colour range are fixed once for all frames.
-This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
+their outline, seen as the run's ``[output.view]`` (or ``--view``) says
+(:mod:`rwall_fem.scene.view`: a cut, the camera, the size, the colour range). The camera
+and the colour range are fixed once for all frames, which one scene
+(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
 """
 
 from __future__ import annotations

@@ -13,9 +13,11 @@ as a rule; from 30 degrees up at a flat body (a plate), so that its face shows;
 square along the body beside a finite wall, so that what hangs over the wall's
 edge shows. Flat walls are always seen from their allowed side, so that they lie
 behind the body: lower elevations are tried until they are (a body between a
-floor and a press is seen level). The view is fitted to everything drawn in
-every frame, between the time at the top and the colour bar at the bottom. The
-body is drawn at true scale by the renderer.
+floor and a press is seen level). ``[output.view]`` turns that camera (azimuth,
+elevation), turns it to a cut face, zooms and centres it on a point. The view is
+fitted to the body's deformed extent in every frame (not the walls', which are
+context) with a margin, between the time at the top and the colour bar at the
+bottom. The body is drawn at true scale by the renderer.
 """
 
 from __future__ import annotations
