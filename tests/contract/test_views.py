@@ -7,6 +7,7 @@ import copy
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -153,15 +154,9 @@ def test_a_fixed_range_colours_every_frame_alike(shared_dir):
          "without [[part]])"),
     ],
 )  # fmt: skip
-def test_a_view_the_body_cannot_give_is_refused_before_the_run(view, message):
-    with pytest.raises(SceneError, match=re_escape(message)):
-        build_simulation(parse_scene(taylor_scene(view), source="test"), COMM)
-
-
-def re_escape(text: str) -> str:
-    import re
-
-    return re.escape(text)
+def test_a_view_the_body_cannot_give_is_refused_before_the_run(view, message, shared_dir):
+    with pytest.raises(SceneError, match=re.escape(message)):
+        build_simulation(parse_scene(taylor_scene(view), source="test"), COMM, shared_dir)
 
 
 # --- issue 28, class 4: a body that erodes away ---------------------------------------------
