@@ -155,14 +155,21 @@ def _stored_view(mesh: dict) -> ViewSpec:
 
 def _cut_plane(cut, points: np.ndarray):
     """(point, unit normal) of the clipping plane ``cut`` ("x", "y", "z" through the centre
-    of the body's box ``points``, or {point, normal}), or None."""
+    of the body's box ``points``, or {point, normal}), or None; RenderError for a plane
+    that misses the body."""
     if cut is None:
         return None
     if isinstance(cut, str):
         centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
         return centre, np.eye(3)["xyz".index(cut)]
-    normal = np.asarray(cut["normal"], float)
-    return np.asarray(cut["point"], float), normal / np.linalg.norm(normal)
+    point, normal = np.asarray(cut["point"], float), np.asarray(cut["normal"], float)
+    normal /= np.linalg.norm(normal)
+    side = (points - point) @ normal
+    if not side.min() < 0.0 < side.max():
+        raise RenderError(f"view.cut: the plane through {list(cut['point'])} normal to "
+                          f"{list(cut['normal'])} does not cut the body (all its nodes lie on "
+                          "one side at the start); give a plane through it")  # fmt: skip
+    return point, normal
 
 
 def _focus(focus, mesh: dict, frames: list[dict], parts: tuple[str, ...]):

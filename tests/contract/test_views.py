@@ -121,6 +121,8 @@ def test_render_view_draws_a_finished_run_again(shared_dir):
         ("range = [2, 1]", "range: must be \"auto\" or [low, high] with low < high"),
         ("size = [10, 10]", "size: must be [width, height], integers in [64, 4096]"),
         ("focus = \"nose\"", "view.focus: 'nose' is not a part of this body"),
+        ("cut = {point = [0, 0, 1], normal = [0, 0, 1]}",
+         "view.cut: the plane through [0.0, 0.0, 1.0] normal to [0.0, 0.0, 1.0] does not cut"),
         ("zoom = ", "--view: not a TOML inline table's keys"),
     ]:
         refused = _render(shared_dir, "--view", text)
