@@ -517,6 +517,7 @@ def _add_recorders(
     if scene.output.frames:
         from rwall_fem.output.coloring import COLORS
         from rwall_fem.output.frames import Frames
+        from rwall_fem.scene.view import check_view
 
         color, fields = scene.output.color, sorted(sim.internal.cell_fields(sim.state))
         if color not in COLORS and color not in fields:
@@ -526,6 +527,10 @@ def _add_recorders(
                 f"({', '.join(fields) or 'no cell fields'} for {models}); "
                 f"use one of {', '.join(COLORS)}"
             )
+        view = scene.output.view
+        if view is not None:
+            names = [part.name for part in solid.parts] if scene.parts else []
+            check_view(view, solid.X, names, scene.source, solid.comm)
         frames = Frames(
             directory,
             count=scene.output.frames,
@@ -536,6 +541,7 @@ def _add_recorders(
             gravity=scene.gravity,
             color=color,
             parts=[part.name for part in solid.parts] if scene.parts else (),
+            view=view,
         )
         sim.recorders.append(frames)
 

@@ -3,7 +3,8 @@
 - ``rwall-fem run SCENE [--out DIR] [--set key=value ...] [--quiet] [--resume]``: run a
   scene, or with ``--resume`` continue the run whose checkpoint is in DIR;
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
-- ``rwall-fem render DIR [--color ...]``: draw the frames of a results folder again;
+- ``rwall-fem render DIR [--color ...] [--view ...]``: draw the frames of a results folder
+  again, in another colouring or view;
 - ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`);
 - ``rwall-fem convert NAME_0000.rad DIR [--force]``: a Radioss deck as a scene and its
   mesh (:mod:`rwall_fem.radioss`; a scene of that name in DIR is replaced only with
@@ -86,6 +87,11 @@ def _command(argv: list[str] | None) -> int:
         default=COLORS[0],
         help=f"{', '.join(COLORS)}, or a cell field of the body such as plastic_strain",
     )
+    render.add_argument(
+        "--view",
+        help="the keys of [output.view] as a TOML inline table's inside, e.g. "
+        "'cut = \"y\", zoom = 1.5' (default: the run's view)",
+    )
     convert = commands.add_parser(
         "convert", help="write a Radioss deck as a scene (TOML) and its mesh (gmsh)"
     )
@@ -99,7 +105,7 @@ def _command(argv: list[str] | None) -> int:
     study.add_argument("--out", default="results/study", help="results directory")
     args = parser.parse_args(argv)
     if args.command == "render":
-        return _render(args.directory, args.color)
+        return _render(args.directory, args.color, args.view)
 
     import numpy as np
     from mpi4py import MPI
@@ -378,7 +384,7 @@ def _check(scene_file, overrides, comm, lift_limits: bool) -> int:
     return 0
 
 
-def _render(directory: str, color: str) -> int:
+def _render(directory: str, color: str, view: str | None) -> int:
     from rwall_fem.output.render import main as render
 
-    return render([directory, "--color", color])
+    return render([directory, "--color", color, *(["--view", view] if view is not None else [])])

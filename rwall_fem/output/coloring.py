@@ -16,11 +16,11 @@ needs neither DOLFINx nor VTK.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["COLORS", "Coloring", "coloring", "round_range"]
+__all__ = ["COLORS", "Coloring", "coloring", "fixed_range", "round_range"]
 
 # Nodal colourings: the velocity along the first wall's normal at each node (m/s, signed;
 # without walls, the upward velocity), the speed (m/s), the magnitude of the displacement (m).
@@ -124,6 +124,17 @@ def coloring(
         n_labels=n_labels,
         fmt=f"%.{decimals}f",
     )
+
+
+def fixed_range(paint: Coloring, low: float, high: float) -> Coloring:
+    """``paint`` with the colour range [``low``, ``high``] (in its colour bar's unit, low <
+    high) in every frame, labelled at 5 values written with the decimals that tell them
+    apart. Categories (parts) keep theirs."""
+    if paint.names:
+        return paint
+    step = (high - low) / 4
+    decimals = next((d for d in range(12) if abs(round(step, d) - step) <= 1e-9 * step), 3)
+    return replace(paint, clim=(float(low), float(high)), n_labels=5, fmt=f"%.{decimals}f")
 
 
 def round_range(top: float, signed: bool) -> tuple[float, float, int, int]:

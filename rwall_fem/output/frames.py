@@ -26,6 +26,7 @@ from dolfinx import fem
 from rwall_fem import _compat
 from rwall_fem.output import OutputError
 from rwall_fem.output.schedule import Times
+from rwall_fem.scene.view import view_to_json
 
 __all__ = ["Frames"]
 
@@ -37,7 +38,9 @@ class Frames:
     ``speed`` (m/s), the initial speed, is the least colour range of the velocity
     colourings; ``gravity`` (m/s^2, or None) says where up is; ``color`` is one of
     :data:`rwall_fem.output.coloring.COLORS` or a cell field of the internal force;
-    ``parts``, the names of the parts of a body of ``[[part]]`` (the ``part`` colouring).
+    ``parts``, the names of the parts of a body of ``[[part]]`` (the ``part`` colouring);
+    ``view``: the scene's [output.view] (:class:`rwall_fem.scene.view.ViewSpec`), or
+    None, stored with the body for the renderer.
     """
 
     def __init__(
@@ -52,12 +55,13 @@ class Frames:
         gravity=None,
         color: str = "normal_velocity",
         parts: tuple[str, ...] = (),
+        view=None,
     ):
         self.steps = Times(count, end_time)
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
-        self.walls, self.color, self.parts = walls, color, tuple(parts)
+        self.walls, self.color, self.parts, self.view = walls, color, tuple(parts), view
         self._field = fem.Function(V)
         self._count = 0
         self._failed = False  # a frame could not be written (rank 0): no more are
@@ -115,6 +119,7 @@ class Frames:
             gravity=self._gravity,
             walls=json.dumps(walls_info),
             **({"parts": json.dumps(self.parts)} if self.parts else {}),
+            **({"view": json.dumps(view_to_json(self.view))} if self.view else {}),
         )
 
     def record(self, sim, s) -> None:

@@ -1,4 +1,5 @@
-"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [--color COLOR]``.
+"""Off-screen pictures of a run: ``python -m rwall_fem.output.render DIR [--color COLOR]
+[--view VIEW]``.
 
 Reads the frame data that :class:`rwall_fem.output.frames.Frames` stored in
 ``DIR/frames/data`` and writes ``DIR/frames/frame_NNNN.png`` and
@@ -9,8 +10,10 @@ nodes no live cell holds are drawn as points), coloured as
 :mod:`rwall_fem.output.coloring` says, with the walls as
 :mod:`rwall_fem.output.view` draws them: flat walls opaque (the camera sees
 them from their allowed side, behind the body), curved walls translucent with
-their outline. The camera and the colour range are fixed once for all frames.
-This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
+their outline, seen as the run's ``[output.view]`` (or ``--view``) says
+(:mod:`rwall_fem.scene.view`: a cut, the camera, the size, the colour range). The camera
+and the colour range are fixed once for all frames, which one scene
+(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
 """
 
 from __future__ import annotations
@@ -25,16 +28,16 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem import interrupts
-from rwall_fem.output.coloring import COLORS, coloring
+from rwall_fem.output.coloring import COLORS, coloring, fixed_range
 from rwall_fem.output.view import choose_view, up_direction, wall_surface
+from rwall_fem.scene.view import ViewSpec, parse_view_text, view_from_json
+from rwall_fem.scene.keys import SceneError
 from rwall_fem.walls.shapes import shape_from_parameters
 
-__all__ = ["COLORS", "RenderError", "body_grid", "main", "render_frames"]
+__all__ = ["COLORS", "RenderError", "main", "render_frames"]
 
-WINDOW = (800, 600)  # pixels
-BAR = (0.2, 0.06, 0.6, 0.04)  # the colour bar's box: x, y, width, height (of the window)
 EDGES = 10  # pixels: the cell edges are drawn when cells are at least this large
-WALL_COLOR = "#a9b4c2"  # a cool grey that no colour map uses
+PNG_COMPRESSION = 3  # zlib level of the PNGs: nearly the size of 9 in a fraction of the time
 TIME_UNITS = ((1e-6, "µs"), (1e-3, "ms"), (1.0, "s"))  # the largest below the end time
 
 
@@ -42,83 +45,145 @@ class RenderError(ValueError):
     """The pictures cannot be drawn from what the folder holds (one line)."""
 
 
-def render_frames(directory: str | Path, color: str = "normal_velocity") -> list[Path]:
+def render_frames(
+    directory: str | Path, color: str = "normal_velocity", view: ViewSpec | None = None
+) -> list[Path]:
     """Render every stored frame of the run in ``directory``, coloured by ``color`` (one of
-    :data:`COLORS` or a cell field the run stored); returns the PNG paths.
+    :data:`COLORS` or a cell field the run stored), seen as ``view`` says (None: the view
+    the run stored, else the automatic one); returns the PNG paths.
 
-    Raises RenderError for a folder without frame data or an unknown colouring.
+    Raises RenderError for a folder without frame data, an unknown colouring or a view
+    the body cannot give (a part it does not have).
     """
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import imageio.v2 as imageio
     import pyvista
+
+    from rwall_fem.output.picture import Picture
 
     directory = Path(directory)
     mesh, walls, paths, frames = _stored(directory)
+    view = _stored_view(mesh) if view is None else view
     points = mesh["points"]
     up = up_direction(mesh.get("gravity"), walls)
+    parts = tuple(json.loads(str(mesh["parts"]))) if "parts" in mesh else ()
     try:
-        parts = tuple(json.loads(str(mesh["parts"]))) if "parts" in mesh else ()
         paint = coloring(color, frames, points, walls, up, float(mesh["speed"]), parts)
     except ValueError as err:
         raise RenderError(str(err)) from None
+    if view.range != "auto":
+        paint = fixed_range(paint, *view.range)
     body = np.concatenate([points + f["u"] for f in frames])
     size = float(np.ptp(body, axis=0).max())
-    surfaces = [
-        [wall_surface(pyvista, w, o, body, size) for w, o in zip(walls, f["offsets"], strict=True)]
-        for f in frames
-    ]
-    clouds = [body, *(s.points for drawn in surfaces for s in drawn)]
-    view = choose_view(points + frames[0]["u"], clouds, walls, up, WINDOW[0] / WINDOW[1])
-    edges = bool(_cell_size(mesh) >= EDGES * 2 * view.scale / WINDOW[1])
+    cut = _cut_plane(view.cut, points)
+    window = tuple(view.size)
+    camera = choose_view(
+        points + frames[0]["u"], [body], walls, up, window[0] / window[1],
+        azimuth=view.azimuth, elevation=view.elevation, zoom=view.zoom,
+        cut_normal=None if cut is None else cut[1], focus=_focus(view.focus, mesh, frames, parts),
+    )  # fmt: skip
+    if cut is not None and isinstance(view.cut, str) and cut[1] @ camera.direction < 0:
+        cut = (cut[0], -cut[1])  # an axis cut removes the half nearer the camera
+    edges = bool(_cell_size(mesh) >= EDGES * 2 * camera.scale / window[1])
     scale, unit = _time_unit(float(frames[-1]["t"]))
     decimals = _time_decimals(frames, scale)
-    files = []
-    for path, frame, values, drawn in zip(paths, frames, paint.values, surfaces, strict=True):
-        # A frame is not cut by a stop signal (interrupts.deferred: it is raised after the
-        # frame), and its plotter is closed however the frame ends: a VTK window left half
-        # made or half closed fails in its destructor at exit, with a traceback.
-        with interrupts.deferred():
-            plotter = pyvista.Plotter(off_screen=True, window_size=WINDOW)
-            try:
-                grid = body_grid(pyvista, mesh, frame)
-                (grid.cell_data if paint.per_cell else grid.point_data)[paint.title] = values
-                if "cell_eroded" in frame:  # eroded cells are not drawn, detached nodes are points
-                    grid = grid.extract_cells(np.flatnonzero(frame["cell_eroded"] < 0.5))
-                    loose = (mesh["points"] + frame["u"])[frame["detached"] > 0.5]
-                    if len(loose):
-                        plotter.add_points(loose, color="#404040", point_size=3.0)
-                plotter.add_mesh(
-                    grid,
-                    scalars=paint.title,
-                    clim=paint.clim,
-                    cmap=paint.cmap,
-                    n_colors=len(paint.names) or 256,
-                    show_edges=edges,
-                    edge_color="#404040",
-                    line_width=0.5,
-                    ambient=0.3,
-                    diffuse=0.7,
-                    show_scalar_bar=False,
-                )
-                _colour_bar(plotter, paint)
-                for wall, surface in zip(walls, drawn, strict=True):
-                    if view.behind(wall):
-                        plotter.add_mesh(surface, color=WALL_COLOR, ambient=0.3, diffuse=0.7)
-                    else:
-                        plotter.add_mesh(surface, color=WALL_COLOR, opacity=0.3, silhouette=True)
+    surfaces: dict = {}  # the walls as drawn, by their offsets (most walls do not move)
+    files, images = [], []
+    # The scene is made once; a frame is not cut by a stop signal (interrupts.deferred:
+    # it is raised after the frame), and the window is closed however the frames end: a
+    # VTK window left half made or half closed fails in its destructor at exit.
+    with interrupts.deferred():
+        picture = Picture(
+            pyvista, mesh, paint, camera, window, erodes="cell_eroded" in frames[0],
+            cut=cut, ghost=view.ghost, edges=edges,
+        )  # fmt: skip
+    try:
+        for path, frame, values in zip(paths, frames, paint.values, strict=True):
+            with interrupts.deferred():
+                offsets = frame["offsets"]
+                drawn = surfaces.get(offsets.tobytes())
+                if drawn is None:
+                    drawn = [wall_surface(pyvista, w, o, body, size)
+                             for w, o in zip(walls, offsets, strict=True)]  # fmt: skip
+                    surfaces[offsets.tobytes()] = drawn
+                picture.set_walls(walls, drawn)
                 time = f"t = {float(frame['t']) / scale:.{decimals}f} {unit}"
-                plotter.add_text(time, position=(12, WINDOW[1] - 32), font_size=12, color="black")
-                view.apply(plotter)
+                image = picture.draw(
+                    frame["u"], values, frame.get("cell_eroded"), frame.get("detached"), time
+                )
                 png = directory / "frames" / path.with_suffix(".png").name
-                plotter.screenshot(str(png))
-            finally:
-                plotter.close()
-        files.append(png)
-    images = [imageio.imread(p) for p in files]
-    imageio.mimsave(directory / "animation.gif", images, duration=0.1, loop=0)
-    if _has_mp4_encoder():
-        imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
+                _write_png(image, png)
+            files.append(png)
+            images.append(image)
+    finally:
+        picture.close()
+    _animate(directory, images)
     return files
+
+
+def _write_png(image: np.ndarray, path: Path) -> None:
+    from PIL import Image
+
+    Image.fromarray(image).save(path, compress_level=PNG_COMPRESSION)
+
+
+def _animate(directory: Path, images: list[np.ndarray]) -> None:
+    """``animation.gif`` (one palette for every frame: no flicker, one quantization) and
+    ``animation.mp4`` when the encoder is installed, each encoded once."""
+    from PIL import Image
+
+    frames = [Image.fromarray(image) for image in images]
+    palette = frames[len(frames) // 2].quantize(colors=255, method=Image.Quantize.FASTOCTREE)
+    gif = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
+    gif[0].save(
+        directory / "animation.gif", save_all=True, append_images=gif[1:], duration=100, loop=0
+    )
+    if _has_mp4_encoder():
+        import imageio.v2 as imageio
+
+        imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
+
+
+def _stored_view(mesh: dict) -> ViewSpec:
+    """The view the run stored with its frame data (the scene's [output.view])."""
+    if "view" not in mesh:
+        return ViewSpec()
+    try:
+        return view_from_json(json.loads(str(mesh["view"])), "frames/data/mesh.npz")
+    except (ValueError, SceneError) as err:
+        raise RenderError(f"{_one_line(err)}") from None
+
+
+def _cut_plane(cut, points: np.ndarray):
+    """(point, unit normal) of the clipping plane ``cut`` ("x", "y", "z" through the centre
+    of the body's box ``points``, or {point, normal}), or None; RenderError for a plane
+    that misses the body."""
+    if cut is None:
+        return None
+    if isinstance(cut, str):
+        centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+        return centre, np.eye(3)["xyz".index(cut)]
+    point, normal = np.asarray(cut["point"], float), np.asarray(cut["normal"], float)
+    normal /= np.linalg.norm(normal)
+    side = (points - point) @ normal
+    if not side.min() < 0.0 < side.max():
+        raise RenderError(f"view.cut: the plane through {list(cut['point'])} normal to "
+                          f"{list(cut['normal'])} does not cut the body (all its nodes lie on "
+                          "one side at the start); give a plane through it")  # fmt: skip
+    return point, normal
+
+
+def _focus(focus, mesh: dict, frames: list[dict], parts: tuple[str, ...]):
+    """The point (m) at the picture's centre: ``focus`` itself, or the centre of the box of
+    the part it names at the start; None for the automatic centre."""
+    if focus is None or not isinstance(focus, str):
+        return focus
+    if focus not in parts or "cell_part" not in frames[0]:
+        have = f"its parts: {', '.join(parts)}" if parts else "a body without [[part]]"
+        raise RenderError(f"view.focus: {focus!r} is not a part of this body ({have})")
+    topology = mesh["topology"].reshape(len(mesh["cell_types"]), -1)[:, 1:]
+    cells = topology[frames[0]["cell_part"] == parts.index(focus)]
+    x = (mesh["points"] + frames[0]["u"])[np.unique(cells)]
+    return 0.5 * (x.min(axis=0) + x.max(axis=0))
 
 
 def _stored(directory: Path):
@@ -181,51 +246,11 @@ def _one_line(err: Exception) -> str:
     return " ".join(str(err).split()) or type(err).__name__
 
 
-def body_grid(pyvista, mesh: dict, frame: dict):
-    """The body of ``frame`` as a pyvista grid, on its deformed points X + u (m): true scale."""
-    return pyvista.UnstructuredGrid(
-        mesh["topology"], mesh["cell_types"], mesh["points"] + frame["u"]
-    )
-
-
 def _cell_size(mesh: dict) -> float:
     """The median length (m) of the first edge of the cells."""
     topology = mesh["topology"].reshape(len(mesh["cell_types"]), -1)
     first, second = mesh["points"][topology[:, 1]], mesh["points"][topology[:, 2]]
     return float(np.median(np.linalg.norm(second - first, axis=1)))
-
-
-def _colour_bar(plotter, paint) -> None:
-    """The colour bar under the picture: the bar from VTK, its title above it and its labels
-    (in one format, at round values) under it, placed here: VTK's own placement lets them
-    overlap the bar and each other."""
-    plotter.add_scalar_bar(
-        title=" ",
-        n_labels=0,
-        position_x=BAR[0],
-        position_y=BAR[1],
-        width=BAR[2],
-        height=BAR[3],
-    )
-    plotter.scalar_bar.SetTitle("")
-    plotter.scalar_bar.SetDrawTickLabels(False)
-    plotter.scalar_bar.SetBarRatio(1.0)  # the bar fills its box
-    (left, bottom), width = np.multiply(BAR[:2], WINDOW), BAR[2] * WINDOW[0]
-    (low, high), n = paint.clim, paint.n_labels
-    if paint.names:  # categories: each name under the middle of its colour
-        labels = [(name, (i + 0.5) / n) for i, name in enumerate(paint.names)]
-    else:  # + 0.0: no "-0"
-        labels = [(paint.fmt % (low + (high - low) * i / (n - 1) + 0.0), i / (n - 1))
-                  for i in range(n)]  # fmt: skip
-    for text, at in labels:
-        _centred_text(plotter, text, left + width * at, bottom - 20, 10)
-    _centred_text(plotter, paint.title, WINDOW[0] / 2, bottom + BAR[3] * WINDOW[1] + 6, 11)
-
-
-def _centred_text(plotter, text: str, x: float, y: float, size: int) -> None:
-    """``text`` centred on ``x`` with its foot at ``y`` (pixels from the lower left)."""
-    actor = plotter.add_text(text, position=(x, y), font_size=size, color="black")
-    actor.GetTextProperty().SetJustificationToCentered()
 
 
 def _time_unit(end: float) -> tuple[float, str]:
@@ -262,11 +287,17 @@ def main(argv: list[str] | None = None) -> int:
         help=f"{', '.join(COLORS)}, a cell field of the body such as plastic_strain, or part "
         f"(a body of parts) (default {COLORS[0]})",
     )
+    parser.add_argument(
+        "--view",
+        help="the keys of [output.view] as a TOML inline table's inside, e.g. "
+        "'cut = \"y\", zoom = 1.5' (default: the run's view)",
+    )
     args = parser.parse_args(argv)
     with interrupts.handling() as say:
         try:
-            files = render_frames(args.directory, args.color)
-        except RenderError as err:
+            view = None if args.view is None else parse_view_text(args.view)
+            files = render_frames(args.directory, args.color, view)
+        except (RenderError, SceneError) as err:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
             return 2
         except interrupts.Interrupted as stop:

@@ -13,9 +13,11 @@ as a rule; from 30 degrees up at a flat body (a plate), so that its face shows;
 square along the body beside a finite wall, so that what hangs over the wall's
 edge shows. Flat walls are always seen from their allowed side, so that they lie
 behind the body: lower elevations are tried until they are (a body between a
-floor and a press is seen level). The view is fitted to everything drawn in
-every frame, between the time at the top and the colour bar at the bottom. The
-body is drawn at true scale by the renderer.
+floor and a press is seen level). ``[output.view]`` turns that camera (azimuth,
+elevation), turns it to a cut face, zooms and centres it on a point. The view is
+fitted to the body's deformed extent in every frame (not the walls', which are
+context) with a margin, between the time at the top and the colour bar at the
+bottom. The body is drawn at true scale by the renderer.
 """
 
 from __future__ import annotations
@@ -35,6 +37,10 @@ SLAB = 0.02  # thickness of a flat wall as a fraction of the scene's size
 # The band of the picture that the scene fills (fractions of the height from the bottom):
 # the time is written above it, the colour bar drawn below.
 BAND = (0.16, 0.90)
+FIT_MARGIN = 0.04  # the body's extent and this fraction of it fill the band
+# A cut by a vertical plane is seen from this many degrees round up from its normal and
+# this high; a cut by a horizontal plane from this far off the vertical.
+CUT_TURN, CUT_ELEVATION = 25.0, 20.0
 
 
 @dataclass(frozen=True)
@@ -74,36 +80,87 @@ def up_direction(gravity, walls) -> np.ndarray:
     return flat[0].normal.copy() if flat else np.array([0.0, 0.0, 1.0])
 
 
-def choose_view(start: np.ndarray, clouds: list[np.ndarray], walls, up, aspect: float) -> View:
+def choose_view(
+    start: np.ndarray,
+    clouds: list[np.ndarray],
+    walls,
+    up,
+    aspect: float,
+    *,
+    azimuth: float | None = None,
+    elevation: float | None = None,
+    cut_normal=None,
+    zoom: float = 1.0,
+    focus=None,
+) -> View:
     """The view of a run whose body starts at the points ``start`` ((n, 3), m) and whose
-    drawn points are ``clouds`` ((n, 3) arrays, m: the body and the walls as drawn in every
-    frame), for a picture ``aspect`` times wider than high; ``walls`` are the shapes, whose
-    flat ones the camera looks at from their allowed side."""
+    drawn points are ``clouds`` ((n, 3) arrays, m: the body in every frame), for a picture
+    ``aspect`` times wider than high; ``walls`` are the shapes, whose flat ones the camera
+    looks at from their allowed side.
+
+    ``azimuth`` (degrees) turns the camera round up from the direction chosen here,
+    ``elevation`` (degrees) sets its height above the horizontal plane; ``cut_normal``
+    (unit, toward the removed half of a cut) turns it toward the cut face, unless the
+    angles are given. ``zoom`` magnifies the fitted view; ``focus`` (m) is the point at
+    the centre of the picture (else the centre of the clouds)."""
     points = np.concatenate(clouds)
+    up = np.asarray(up, float)
     across, along = _horizontal_axes(points, up)
     height = np.ptp(start @ up)
     flat = height < FLAT * min(np.ptp(start @ across), np.ptp(start @ along))
     edge = any(w.kind == "parallelogram" for w in walls)
-    azimuth, elevation = np.radians(ANGLES["flat" if flat else "edge" if edge else "other"])
+    auto_azimuth, auto_elevation = np.radians(ANGLES["flat" if flat else "edge" if edge else "other"])
     normals = [w.normal for w in walls if w.kind in ("plane", "parallelogram")]
     choices = [
-        np.cos(e) * (np.cos(azimuth) * a + np.sin(azimuth) * b) + np.sin(e) * up
-        for e in (elevation, *np.radians([x for x in LOWER if x < np.degrees(elevation)]))
+        np.cos(e) * (np.cos(auto_azimuth) * a + np.sin(auto_azimuth) * b) + np.sin(e) * up
+        for e in (auto_elevation, *np.radians([x for x in LOWER if x < np.degrees(auto_elevation)]))
         for a in (-across, across)
         for b in (-along, along)
     ]
     direction = next((d for d in choices if all(d @ n >= -1e-9 for n in normals)), choices[0])
+    heading = _horizontal(direction, up, across)
+    rise = float(np.arcsin(np.clip(direction @ up, -1.0, 1.0)))
+    if cut_normal is not None and azimuth is None and elevation is None:
+        normal = np.asarray(cut_normal, float)
+        if np.linalg.norm(normal - (normal @ up) * up) > 0.1:  # a vertical plane: look at it
+            heading = _turn(_horizontal(normal, up, across), up, np.radians(CUT_TURN))
+            rise = np.radians(CUT_ELEVATION)
+        else:  # a horizontal plane: look at it from above (or below)
+            rise = np.sign(normal @ up) * np.radians(90.0 - CUT_ELEVATION)
+    if azimuth is not None:
+        heading = _turn(heading, up, np.radians(azimuth))
+    if elevation is not None:
+        rise = np.radians(elevation)
+    direction = np.cos(rise) * heading + np.sin(rise) * up
     view_up = up - (up @ direction) * direction
+    if np.linalg.norm(view_up) < 1e-6:  # straight down (up): the far side is the top
+        view_up = -np.sign(direction @ up) * heading
     view_up /= np.linalg.norm(view_up)
     right = np.cross(view_up, direction)
     x, y = points @ right, points @ view_up
     band = BAND[1] - BAND[0]
-    scale = 1.02 * max(np.ptp(y) / (2 * band), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
-    centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * view_up
-    centre += (points @ direction).mean() * direction
+    scale = (1.0 + FIT_MARGIN) * max(np.ptp(y) / (2 * band), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
+    scale /= zoom
+    if focus is None:
+        centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * view_up
+        centre += (points @ direction).mean() * direction
+    else:
+        centre = np.asarray(focus, float)
     # The middle of the band is above the middle of the picture by this much (m).
     lift = (0.5 * (BAND[0] + BAND[1]) - 0.5) * 2 * scale
     return View(centre - lift * view_up, direction, view_up, scale)
+
+
+def _horizontal(vector: np.ndarray, up: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    """The unit horizontal part of ``vector`` (normal to ``up``), or ``fallback``."""
+    flat = vector - (vector @ up) * up
+    norm = np.linalg.norm(flat)
+    return flat / norm if norm > 1e-9 else fallback
+
+
+def _turn(vector: np.ndarray, up: np.ndarray, angle: float) -> np.ndarray:
+    """``vector`` (normal to ``up``) turned by ``angle`` (rad) round ``up``."""
+    return np.cos(angle) * vector + np.sin(angle) * np.cross(up, vector)
 
 
 def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: float):

@@ -38,6 +38,7 @@ from rwall_fem.scene.keys import (
     table,
 )
 from rwall_fem.scene.rigid_bodies import RigidBodySpec
+from rwall_fem.scene.view import ViewSpec
 from rwall_fem.units import parse_system
 
 __all__ = [
@@ -1175,6 +1176,13 @@ class Output:
         "normal_velocity",
         doc="what colours the frames (plastic_strain: elasto-plastic bodies; damage: bodies "
         "with a failure criterion; part: a body of [[part]], one colour each)",
+    )
+    view: ViewSpec | None = key(
+        Sub(ViewSpec),
+        None,
+        doc="how the frames look at the body: a cut, the camera, the picture size, the colour "
+        "range",
+        default_doc="the whole body, from the camera chosen automatically",
     )
     plot: bool = key(Flag(), True, doc="histories.png: energies and wall forces over time")
     checkpoint_steps: int = key(

@@ -81,7 +81,7 @@ FULL = {
             "angular_velocity": [0.0, 0.0, 1.0],
         }
     ],
-    "output": {"frames": 1},
+    "output": {"frames": 1, "view": {"cut": "x"}},
 }
 
 # The same with the other mesh shapes and wall kinds, so that every key is somewhere allowed.

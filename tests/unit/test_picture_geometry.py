@@ -6,7 +6,7 @@ import pytest
 import pyvista
 
 from rwall_fem.output.coloring import coloring, round_range
-from rwall_fem.output.render import _time_decimals, _time_unit, body_grid
+from rwall_fem.output.render import _time_decimals, _time_unit
 from rwall_fem.output.view import SLAB, choose_view, wall_surface
 from rwall_fem.walls.shapes import CylinderWall, ParallelogramWall, PlaneWall, SphereWall
 
@@ -107,15 +107,27 @@ def test_time_labels_tell_the_frames_apart():
 
 
 def test_body_at_true_scale():
+    """The scene reused for every frame moves the body's points to X + u (m) in place."""
+    from rwall_fem.output.picture import Picture
+
     points = _box([0, 0, 0], [1, 1, 1], n=2)
-    topology = np.array([8, 0, 4, 6, 2, 1, 5, 7, 3])
-    u = np.random.default_rng(1).normal(scale=0.1, size=points.shape)
-    grid = body_grid(
-        pyvista,
-        {"topology": topology, "cell_types": np.array([12], np.uint8), "points": points},
-        {"u": u},
-    )
-    assert np.array_equal(grid.points, points + u)
+    mesh = {
+        "topology": np.array([8, 0, 4, 6, 2, 1, 5, 7, 3]),
+        "cell_types": np.array([12], np.uint8),
+        "points": points,
+    }
+    paint = coloring("displacement", _frames([0 * points], [0 * points]), points, [], UP, 0.0)
+    view = choose_view(points, [points], [], UP, 4 / 3)
+    picture = Picture(pyvista, mesh, paint, view, (160, 120), erodes=False, cut=None,
+                      ghost=False, edges=False)  # fmt: skip
+    try:
+        for seed in (1, 2):
+            u = np.random.default_rng(seed).normal(scale=0.1, size=points.shape)
+            image = picture.draw(u, np.linalg.norm(u, axis=1), None, None, "t")
+            assert np.array_equal(picture.grid.points, points + u)
+            assert image.shape == (120, 160, 3)
+    finally:
+        picture.close()
 
 
 def test_walls_are_drawn_where_the_body_is():
