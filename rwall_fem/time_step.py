@@ -145,8 +145,8 @@ class _StepSize:
         others = f" (and {count - 1} more)" if count > 1 else ""
         return (
             f"step {s.step}: cell at {_position(found[0][1])} inverted at t = {s.t:.6g} s"
-            f"{others}: a volume <= 0 at an integration point or at a corner; the deformation is too large "
-            "for the mesh (refine it, or check the loading)"
+            f"{others}: a volume <= 0 at an integration point or at a corner; the deformation "
+            "is too large for the mesh (refine it, or check the loading)"
         )
 
     def _controlling_here(self, smallest: float):
