@@ -23,32 +23,45 @@ __all__ = ["FLAT", "bad_cells"]
 # Relative corner volume below which a corner is flat: det J_I / (the cell's box diagonal)^3.
 FLAT = 1e-10
 
-# The three neighbours of each corner of a hexahedron along its edges, in gmsh's order,
-# as a right-handed triple at the corners of a cell of positive volume.
-_HEX_EDGES = np.array([[1, 3, 4], [2, 0, 5], [3, 1, 6], [0, 2, 7],
-                       [7, 5, 0], [4, 6, 1], [5, 7, 2], [6, 4, 3]])  # fmt: skip
+# gmsh's (Radioss's) order of the corners of a hexahedron -> the tensor order, where node
+# I = b0 + 2 b1 + 4 b2 sits at xi_k = 2 b_k - 1.
+_TENSOR = [0, 1, 3, 2, 4, 5, 7, 6]
 
 
 def corner_volumes(x: np.ndarray) -> np.ndarray:
-    """The Jacobian determinants (m^3, up to a factor 1/8) at the corners of cells whose
-    corner coordinates (m) are ``x``, shape (cells, 8 or 4, 3): (cells, 8) for
-    hexahedra, (cells, 1), six times the volume, for tetrahedra."""
+    """The Jacobian determinants (m^3, times 8) at the corners of cells whose corner
+    coordinates (m) are ``x``, shape (cells, 8 or 4, 3): for hexahedra (cells, 8), the
+    triple products E_0 . (E_1 x E_2) of the edges through each corner taken along +xi_k
+    (corners in tensor order); for tetrahedra (cells, 1), six times the volume."""
     if x.shape[1] == 4:
         a = x[:, 1:] - x[:, :1]
-        return np.einsum("ci,ci->c", a[:, 0], np.cross(a[:, 1], a[:, 2]))[:, None]
-    a = x[:, _HEX_EDGES] - x[:, :, None, :]  # (cells, corner, edge, xyz)
-    return np.einsum("cki,cki->ck", a[:, :, 0], np.cross(a[:, :, 1], a[:, :, 2]))
+        return _triple(a[:, 0], a[:, 1], a[:, 2])[:, None]
+    t = x[:, _TENSOR].reshape(len(x), 2, 2, 2, 3)  # axes b2, b1, b0
+    e0 = (t[:, :, :, 1] - t[:, :, :, 0])[:, :, :, None]  # by (b2, b1)
+    e1 = (t[:, :, 1] - t[:, :, 0])[:, :, None]  # by (b2, b0)
+    e2 = (t[:, 1] - t[:, 0])[:, None]  # by (b1, b0)
+    return _triple(e0, e1, e2).reshape(len(x), 8)
+
+
+def _triple(a, b, c):
+    """a . (b x c) over the last axis (of length 3), broadcast over the others."""
+    return (a[..., 0] * (b[..., 1] * c[..., 2] - b[..., 2] * c[..., 1])
+            + a[..., 1] * (b[..., 2] * c[..., 0] - b[..., 0] * c[..., 2])
+            + a[..., 2] * (b[..., 0] * c[..., 1] - b[..., 1] * c[..., 0]))  # fmt: skip
 
 
 def bad_cells(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The cells (indices) among those of corners ``x`` (cells, 8 or 4, 3; m) that are
-    flat or inside out, and for each the corner (0-7) where it is worst."""
+    """The cells (indices) among those of corners ``x`` (cells, 8 or 4, 3; m; gmsh's
+    order) that are flat or inside out, and for each the corner (an index into its
+    nodes) where it is worst. A cell whose corners are all negative is mirrored, not
+    inside out."""
     if not len(x):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    det = corner_volumes(np.asarray(x, dtype=np.float64))
-    size = np.linalg.norm(np.ptp(x, axis=1), axis=1)  # the diagonal of its box, m
+    x = np.asarray(x, dtype=np.float64)
+    det = corner_volumes(x)
+    size = np.linalg.norm(x.max(axis=1) - x.min(axis=1), axis=1)  # its box's diagonal, m
     relative = det / (np.maximum(size, np.finfo(float).tiny) ** 3)[:, None]
-    sign = np.where(np.median(relative, axis=1) < 0.0, -1.0, 1.0)[:, None]
-    oriented = sign * relative
+    oriented = np.where(relative.sum(axis=1) < 0.0, -1.0, 1.0)[:, None] * relative
     bad = np.flatnonzero(~(oriented.min(axis=1) > FLAT))
-    return bad, oriented[bad].argmin(axis=1)
+    worst = oriented[bad].argmin(axis=1)
+    return bad, np.asarray(_TENSOR)[worst] if x.shape[1] == 8 else worst
