@@ -235,14 +235,19 @@ study: venv-0.5
 # OLD_TREE: a worktree of the old code (commit c11ba60, with its .venv) whose time loop on the
 # 80k scene is run alternately with the new. PRE_EROSION_TREE: a checkout of the code before
 # failure and erosion, whose kernels bench/erosion.py times beside the new ones.
+# PRE_CORNER_TREE: a checkout before the corner test of one-point hexahedra (864d876), for
+# bench/corners.py (bench/corners.md).
 OLD_TREE ?=
 PRE_EROSION_TREE ?=
+PRE_CORNER_TREE ?=
 bench: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
 	    $(VENV)/bin/python bench/bench.py --out bench/results.md $(if $(OLD_TREE),--old-tree $(OLD_TREE))
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/effects.py
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/erosion.py \
 	    $(if $(PRE_EROSION_TREE),--main-tree $(PRE_EROSION_TREE))
+	$(if $(PRE_CORNER_TREE),$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/corners.py \
+	    --before-tree $(PRE_CORNER_TREE))
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

@@ -441,8 +441,8 @@ class ElementForce:
 
     @property
     def inverted_cells(self) -> int:
-        """How many owned cells were found inverted (a volume <= 0 at an integration point)
-        by the latest force computation."""
+        """How many owned cells were found inverted (a volume <= 0 at an integration point,
+        or at a corner of a hexahedron) by the latest force computation."""
         return int(self.step[5])
 
     def cell_position(self, cell: int) -> np.ndarray:

@@ -20,6 +20,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rwall_fem import _compat, interrupts
+from rwall_fem.cell_shapes import bad_cells
 
 __all__ = [
     "SURFACE_CELLS",
@@ -485,7 +486,55 @@ def _gmsh_model(path: Path) -> tuple[dict[str, int], dict[str, int], int]:
             f"mixed cells ({', '.join(kinds)}); DOLFINx needs one cell type"
             f" (a shape of meshes/: try another element_size or {hint})"
         )
+    if dim == 3:
+        _cells_are_cells(volumes)
     return groups, volumes, dim
+
+
+def _cells_are_cells(volumes: dict[str, int]) -> None:
+    """No two cells of the physical volumes have the same nodes (a cell written twice, in
+    one region or two: DOLFINx would stop on a "Duplicate mesh entity"), and none is flat
+    or inside out (:mod:`rwall_fem.cell_shapes`); the first offender is named by its gmsh
+    element tag, region and place."""
+    import gmsh
+
+    tags, nodes, regions = [], [], []
+    for name, tag in volumes.items():
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(3, tag):
+            for kind, cell_tags, cell_nodes in zip(*gmsh.model.mesh.getElements(3, int(entity)),
+                                                   strict=True):  # fmt: skip
+                corners = gmsh.model.mesh.getElementProperties(kind)[5]
+                rows = np.asarray(cell_nodes, dtype=np.int64).reshape(len(cell_tags), -1)
+                tags.append(np.asarray(cell_tags, dtype=np.int64))
+                nodes.append(rows[:, :corners])
+                regions += [name] * len(cell_tags)
+    if not tags:
+        return
+    tags, nodes = np.concatenate(tags), np.concatenate(nodes)
+    _, first, count = np.unique(np.sort(nodes, axis=1), axis=0, return_index=True,
+                                return_counts=True)  # fmt: skip
+    if (count > 1).any():
+        again = np.flatnonzero(count > 1)
+        k = first[again[0]]
+        same = np.flatnonzero((np.sort(nodes, axis=1) == np.sort(nodes[k])).all(axis=1))
+        said = " and ".join(f"{tags[j]} (region '{regions[j]}')" for j in same[:2])
+        raise _GmshError(
+            f"cells {said} have the same nodes ({int((count[again] - 1).sum())} cell(s) "
+            "written twice in all): a cell can be in one region only, once"
+        )
+    node_tags, coordinates, _ = gmsh.model.mesh.getNodes()
+    order = np.argsort(node_tags)
+    rows = order[np.searchsorted(np.asarray(node_tags)[order], nodes)]
+    x = np.asarray(coordinates).reshape(-1, 3)[rows]
+    bad, corner = bad_cells(x)
+    if len(bad):
+        k = bad[0]
+        where = ", ".join(f"{c:.4g}" for c in x[k].mean(axis=0))
+        raise _GmshError(
+            f"cell {tags[k]} (region '{regions[k]}', at ({where})) is flat or inside out: "
+            f"the volume at its corner node {nodes[k, corner[0]]} is not positive "
+            f"({len(bad)} such cell(s)); every cell needs a positive volume at its corners"
+        )
 
 
 def _surfaces_lie_on_the_volumes(groups: dict[str, int]) -> None:

@@ -376,6 +376,8 @@ class Simulation:
             closing.enter_context(_stop_signals(self))
             if checkpoints is not None:
                 checkpoints.start(self.first_step)
+            if history is not None and hasattr(history, "start"):
+                history.start(self)  # summary.json says "running", and keeps its room
             started = time.perf_counter()
             updated = s.step - 1 if not self.first_step else s.step  # the latest update done
             try:

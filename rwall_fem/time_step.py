@@ -145,8 +145,8 @@ class _StepSize:
         others = f" (and {count - 1} more)" if count > 1 else ""
         return (
             f"step {s.step}: cell at {_position(found[0][1])} inverted at t = {s.t:.6g} s"
-            f"{others}: a volume <= 0 at an integration point; the deformation is too large "
-            "for the mesh (refine it, or check the loading)"
+            f"{others}: a volume <= 0 at an integration point or at a corner; the deformation "
+            "is too large for the mesh (refine it, or check the loading)"
         )
 
     def _controlling_here(self, smallest: float):
@@ -362,9 +362,22 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
     mass_scaling = None
     if run.dt_min_action == "mass_scaling":
         floor = run.dt_min / run.dt_scale
+        added = comm.allreduce(added_at_rest(force, floor))
+        if added > run.max_added_mass * body_mass:
+            raise SceneError(
+                f"{scene.source}: run.dt_min: {run.dt_min:g} s would have mass scaling add "
+                f"{added:.4g} kg to the cells at rest ({100.0 * added / body_mass:.3g} % of "
+                f"the body's {body_mass:.4g} kg, above run.max_added_mass = "
+                f"{run.max_added_mass:g}) at the first step, whose step at rest is "
+                f"{initial:.4g} s; lower run.dt_min"
+            )
         mass_scaling = MassScaling(force, V, body_mass, run.max_added_mass, floor)
     elif run.dt_min > initial:
-        outcome = "erode every cell" if run.dt_min_action == "erode" else "stop"
+        outcome = (
+            eroded_at_rest(force, run.dt_min / run.dt_scale, comm)
+            if run.dt_min_action == "erode"
+            else "stop"
+        )
         raise SceneError(
             f"{scene.source}: run.dt_min: {run.dt_min:g} s is above the step at rest, "
             f"{initial:.4g} s: the run would {outcome} at its first step; lower it, or set "
@@ -383,3 +396,35 @@ def step_size(scene, force, dt_stable: float, *, V, body_mass: float, limits: bo
     )
     adaptive.at_rest = dt_stable / ratio
     return adaptive
+
+
+def added_at_rest(body, floor: float) -> float:
+    """The mass (kg, this rank's cells) mass scaling would add at the first step to hold
+    the cells of ``body`` at rest at ``floor`` (s): (floor / dt_e)^2 - 1 of each cell's
+    mass (:mod:`rwall_fem.mass_scaling`)."""
+    added = 0.0
+    for part, force in zip(body.parts, body.elements, strict=True):
+        steps = force.steps_at_rest()
+        below = steps < floor
+        ratio = (floor / steps[below]) ** 2 - 1.0
+        added += float(np.sum(part.material.density * force.volume0[below] * ratio))
+    return added
+
+
+def eroded_at_rest(body, floor: float, comm) -> str:
+    """What ``run.dt_min_action = "erode"`` would erode at the first step, in words: the
+    cells of ``body`` whose estimate at rest is below ``floor`` (s), every cell, or how
+    many of which parts (collective)."""
+    below = [int(np.count_nonzero(f.steps_at_rest() < floor)) for f in body.elements]
+    cells = [f.num_cells for f in body.elements]
+    below, cells = comm.allreduce(np.array(below)), comm.allreduce(np.array(cells))
+    if below.sum() == cells.sum():
+        return "erode every cell"
+    if not body.explicit:
+        return f"erode {below.sum()} of its {cells.sum()} cells"
+    named = [
+        f"{n} of the {total} of part {part.name}"
+        for part, n, total in zip(body.parts, below.tolist(), cells.tolist(), strict=True)
+        if n
+    ]
+    return f"erode {below.sum()} of its {cells.sum()} cells ({', '.join(named)})"

@@ -293,7 +293,10 @@ INLINE void hex8r_force(int model, int hourglass, int64_t num_cells,
       gather(cells, 8, &b, v, ve);
     hex8r_cell(model, hourglass, x, ue, ve, fe, &stored, &hourglass_energy, p, &jacobian,
                &modulus, &volume);
-    const ivec inverted = jacobian <= 0.0;
+    vec xc[24];
+    for (int i = 0; i < 24; ++i)
+      xc[i] = x[i] + ue[i];
+    const ivec inverted = (jacobian <= 0.0) | hex8_corners_inverted(xc);
     vec dte = VZERO + INFINITY;
     if (p->estimate)
     {
@@ -367,7 +370,7 @@ INLINE void hex8r_plastic(int hourglass, int64_t num_cells, const int32_t *restr
     store_point(state, stride, &b, 0, sigma, eps_p, T);
     const vec damage = accumulate_damage(p, state, stride, &b, p->damage_slot, &done, T);
     hex8r_geometry(x, &geo);
-    const ivec inverted = geo.V <= 0.0;
+    const ivec inverted = (geo.V <= 0.0) | hex8_corners_inverted(x);
     vec dte = VZERO + INFINITY;
     if (p->estimate)
     {

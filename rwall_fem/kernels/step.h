@@ -10,7 +10,8 @@
  * (STEP_SLOTS values, accumulated over its calls):
  *   step[0]     the smallest dt_e of its cells (s; +inf: none estimated),
  *   step[1]     that cell (local index), step[2..4] its centroid (m, current position),
- *   step[5]     how many cells are inverted (a volume <= 0 at an integration point),
+ *   step[5]     how many cells are inverted (a volume <= 0 at an integration point, or
+ *               for hexahedra at a corner: hex8_corners_inverted),
  *   step[6]     the first of them, step[7..9] its centroid (m),
  *   step[10]    how many cells it listed in p->below (dt_e below p->step_floor),
  *   step[11]    how many cells it eroded, listed in p->eroded (failure.h).
@@ -122,6 +123,38 @@ INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
       p->below_step[i] = dte[k];
     }
   }
+}
+
+/* The lanes whose hexahedron (nodes at x, DOLFINx numbering, oriented so that the volume
+ * at rest is positive) has a corner turned inside out: det J <= 0 at one of its eight
+ * nodes.  At node I the trilinear map's Jacobian has the columns (x_high - x_low) / 2 of
+ * the three edges through I, each taken along +xi_k (the nodes with bit k of their
+ * number 1 and 0), so 8 det J_I = E_0 . (E_1 x E_2): twelve edge vectors, then eight
+ * triple products, about 150 flops per cell.  A one-point cell's centre can keep a
+ * positive volume while its corners invert (docs/theory.md, "Stable time step"). */
+INLINE ivec hex8_corners_inverted(const vec *restrict x)
+{
+  vec edge[3][4][3]; /* edge[k][m]: along xi_k, the m-th of its four edges */
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 4; ++m)
+    {
+      /* the low node: bit k of its number 0, the other two bits those of m */
+      const int low = ((m >> k) << (k + 1)) | (m & ((1 << k) - 1));
+      const int high = low | (1 << k);
+      for (int i = 0; i < 3; ++i)
+        edge[k][m][i] = x[3 * high + i] - x[3 * low + i];
+    }
+  vec smallest = VZERO + INFINITY;
+  for (int I = 0; I < 8; ++I)
+  {
+    /* the edge of each direction through node I: its number without bit k */
+    const vec *e0 = edge[0][I >> 1], *e1 = edge[1][(I & 1) | ((I >> 2) << 1)],
+              *e2 = edge[2][I & 3];
+    vec n[3];
+    cross(e1, e2, n);
+    smallest = vmin(smallest, dot3(e0, n));
+  }
+  return smallest <= 0.0;
 }
 
 /* Count the cells of the batch that are inverted (`bad` lanes), and note the first. */

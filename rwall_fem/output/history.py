@@ -34,7 +34,7 @@ from rwall_fem.output import OutputError
 from rwall_fem.output.energy import TINY, EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every
-from rwall_fem.output.summary import momentum, run_summary, write_summary
+from rwall_fem.output.summary import momentum, reserve_summary, run_summary, write_summary
 from rwall_fem.output.tables import CsvTable
 from rwall_fem.output.units import column_scales, summary_in
 from rwall_fem.output.wall_table import WALL_COLUMNS, WallTable
@@ -112,6 +112,20 @@ class History:
         self._last: tuple[int, float] | None = None
         self._built = time.perf_counter()
         self._drawing: subprocess.Popen | None = None
+
+    def start(self, sim) -> None:
+        """Write ``summary.json`` as the run starts (or resumes): ``status`` "running",
+        with room for the final summary, so that a disk that fills during the run cannot
+        keep the run's verdict from being written (collective; a failure to write it
+        ends the run at the ranks' next agreement)."""
+        summary = run_summary(sim, self.balance, self.wall_table.peak_contacts,
+                              self.initial_momentum)  # fmt: skip
+        summary |= {"status": "running", "reason": None}
+        if sim.comm.rank == 0:
+            try:
+                reserve_summary(self.directory, summary_in(summary, self.units))
+            except OutputError as err:
+                self.write_failed(err)
 
     def due(self, s) -> bool:
         return self.steps.due(s) or s.step >= self._next_poll

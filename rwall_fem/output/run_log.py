@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import TextIO
 
 from rwall_fem.output import OutputError
+from rwall_fem.output.projection import CycleSteps, StepCollapse, steps_left
 from rwall_fem.output.schedule import Every, Times
 
 __all__ = ["CycleLines", "RunLog", "cycle_schedule", "scene_text"]
@@ -33,19 +34,41 @@ log = logging.getLogger("rwall_fem")
 
 _HEADER = (
     f"{'cycle':>10} {'time (s)':>12} {'dt (s)':>11} {'energy error %':>15} {'elapsed (s)':>12}"
-    f" {'limit (s)':>11}  controlling cell"
+    f" {'steps left':>11} {'left (s)':>10} {'limit (s)':>11}  controlling cell"
 )
 
 
-def cycle_schedule(end_time: float, every: int | None) -> Every | Times:
-    """When cycle lines are written: every ``every`` steps, or 21 times over the run (s)."""
-    return Every(every) if every else Times(21, end_time)
+def cycle_schedule(end_time: float, every: int | None) -> CycleSteps:
+    """When cycle lines are written: every ``every`` steps, or 21 times over the run (s)
+    and at least every 1/20 of the steps planned (:class:`CycleSteps`)."""
+    return CycleSteps(Every(every) if every else Times(21, end_time))
 
 
-def _cycle_line(sim, s, elapsed: float) -> str:
+class _Pace:
+    """The wall time per step (s) since the first cycle line, for the time left."""
+
+    def __init__(self):
+        self.started, self.step = None, 0
+
+    def elapsed(self, s) -> float:
+        if self.started is None:
+            self.started, self.step = time.perf_counter(), s.step
+        return time.perf_counter() - self.started
+
+    def left(self, steps: int, s, elapsed: float) -> str:
+        """The wall time (s) ``steps`` more steps take at the pace so far, in words."""
+        done = s.step - self.step
+        return f"{steps * elapsed / done:.4g}" if done > 0 else "-"
+
+
+def _cycle_line(sim, s, elapsed: float, pace: _Pace) -> str:
+    """A cycle line; "steps left" and "left (s)": the steps to the end at the current step
+    and the wall time they take at the pace so far (:mod:`rwall_fem.output.projection`)."""
     error = sim.history.balance.error if sim.history is not None else None
     percent = "-" if error is None else f"{100.0 * error:.4g}"
-    line = f"{s.step:>10d} {s.t:>12.5e} {s.dt:>11.4e} {percent:>15} {elapsed:>12.1f}"
+    left = steps_left(sim, s)
+    line = (f"{s.step:>10d} {s.t:>12.5e} {s.dt:>11.4e} {percent:>15} {elapsed:>12.1f}"
+            f" {left:>11d} {pace.left(left, s, elapsed):>10}")  # fmt: skip
     cell = sim.step_size.controlling_cell()
     if cell is None:
         return line
@@ -61,17 +84,16 @@ class CycleLines:
 
     def __init__(self, stream: TextIO, schedule: Every | Times):
         self.stream, self.steps = stream, schedule
-        self._started = None
+        self._pace = _Pace()
 
     def due(self, s) -> bool:
         return self.steps.due(s)
 
     def record(self, sim, s) -> None:
-        self.steps.taken(s)
-        if self._started is None:
-            self._started = time.perf_counter()
+        self.steps.taken(sim, s)
+        if self._pace.started is None:
             print(f"rwall-fem: {_HEADER}", file=self.stream, flush=True)
-        line = _cycle_line(sim, s, time.perf_counter() - self._started)
+        line = _cycle_line(sim, s, self._pace.elapsed(s), self._pace)
         print(f"rwall-fem: {line}", file=self.stream, flush=True)
 
     def close(self, sim) -> None:
@@ -92,7 +114,8 @@ class RunLog:
         self.steps, self.frames = schedule, frames
         self.ended_at = None
         self._file = None
-        self._started = None
+        self._pace = _Pace()
+        self._collapse = StepCollapse()  # warns once when the step collapses
         self._failed = False  # the file could not be written: it is written no more
 
     def due(self, s) -> bool:
@@ -101,15 +124,16 @@ class RunLog:
     def record(self, sim, s) -> None:
         """A cycle line (rank 0). A log that cannot be written (a full disk) is no longer
         written, and the history ends the run on every rank (it makes them agree)."""
-        self.steps.taken(s)
+        self.steps.taken(sim, s)
         sim.step_size.controlling_cell()  # collective: on every rank, for the cycle lines
+        warning = self._collapse.check(sim, s)  # collective when it warns
         if self.comm.rank != 0 or self._failed:
             return
         try:
             if self._file is None:
                 self._start(sim)
-            line = _cycle_line(sim, s, time.perf_counter() - self._started)
-            self._write(line)
+            line = _cycle_line(sim, s, self._pace.elapsed(s), self._pace)
+            self._write(line if warning is None else f"{line}\nwarning: {warning}")
         except OutputError as err:
             sim.history.write_failed(err)
 
@@ -151,7 +175,6 @@ class RunLog:
             self._file = open(self.path, "a" if sim.first_step else "w")  # a resume continues
         except OSError as err:
             raise self._failure(err) from None
-        self._started = time.perf_counter()
         versions = ", ".join(f"{k} {v}" for k, v in library_versions().items())
         resumed = ["", f"resumed at step {sim.first_step}"] if sim.first_step else []
         lines = [
@@ -167,16 +190,17 @@ class RunLog:
             "",
             *self.facts,
             "",
-            f"cycles ({self._when()}; energy error of the latest sample; limit: the "
+            f"cycles ({self._when()}; energy error of the latest sample; steps left and "
+            "left (s): to the end at the current step and at the pace so far; limit: the "
             "stable step of the controlling cell):",
             _HEADER,
         ]
         self._write("\n".join(lines))
 
     def _when(self) -> str:
-        if isinstance(self.steps, Every):
+        if isinstance(self.steps.schedule, Every):
             return f"a line every {self.steps.k} steps"
-        return "21 lines over the run"
+        return "21 lines over the run, and one at least every 1/20 of the steps planned"
 
     def close(self, sim) -> None:
         """Write the final figures of the run (the history's summary) and close the file."""

@@ -33,6 +33,7 @@ from rwall_fem.output import OutputError
 __all__ = [
     "deformed_bounds",
     "momentum",
+    "reserve_summary",
     "run_summary",
     "truthful_when_interrupted",
     "write_summary",
@@ -219,25 +220,77 @@ def write_summary(directory: Path, summary: dict) -> None:
     """Write ``summary`` to ``directory/summary.json``, whole or not at all (a new file
     renamed over the old), as strict JSON: a value that is NaN or Inf is written null,
     and the key ``non_finite`` lists where (``energy.kinetic``, ``final_momentum[2]``).
+    When the new file cannot be written (a full disk), the summary is written in place
+    into the room :func:`reserve_summary` kept at the start of the run, if it fits.
     Raises :class:`~rwall_fem.output.OutputError` naming the file."""
     path = Path(directory) / "summary.json"
-    lost: list[str] = []
-    clean = _strict(summary, "", lost)
-    if lost:
-        clean["non_finite"] = lost
-    text = json.dumps(clean, indent=2, allow_nan=False) + "\n"
+    text = _json_text(summary)
     partial = path.with_name(".summary.json.partial")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        partial.write_text(text)
+        _write_new(partial, text)
         os.replace(partial, path)
     except OSError as err:
         with contextlib.suppress(OSError):
             partial.unlink(missing_ok=True)
-        raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
+        if not _overwrite_in_place(path, text):
+            raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
     except BaseException:  # a stop signal: no half-written file is left
         partial.unlink(missing_ok=True)
         raise
+
+
+def reserve_summary(directory: Path, summary: dict) -> None:
+    """Write the summary of a run that starts (``status`` "running") to
+    ``directory/summary.json``, followed by blanks up to twice its size and 16 kB more
+    (still valid JSON), synced to disk: the room the final summary takes if the disk is
+    full by then (:func:`write_summary`). Raises :class:`~rwall_fem.output.OutputError`
+    naming the file."""
+    path = Path(directory) / "summary.json"
+    text = _json_text(summary)
+    room = 2 * len(text.encode()) + RESERVE_BYTES
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "wb") as file:
+            file.write(text.encode().ljust(room, b" "))
+            file.flush()
+            os.fsync(file.fileno())
+    except OSError as err:
+        raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
+
+
+RESERVE_BYTES = 16384  # room kept in summary.json beyond twice the start's summary, bytes
+
+
+def _json_text(summary: dict) -> str:
+    lost: list[str] = []
+    clean = _strict(summary, "", lost)
+    if lost:
+        clean["non_finite"] = lost
+    return json.dumps(clean, indent=2, allow_nan=False) + "\n"
+
+
+def _write_new(path: Path, text: str) -> None:
+    """Write ``text`` into a new file (what a full disk refuses)."""
+    path.write_text(text)
+
+
+def _overwrite_in_place(path: Path, text: str) -> bool:
+    """Write ``text`` over the start of ``path`` and blank the rest of it, without growing
+    it (the blocks are the file's already); False when it does not fit or cannot be
+    written."""
+    data = text.encode()
+    try:
+        with open(path, "r+b") as file:
+            size = os.fstat(file.fileno()).st_size
+            if len(data) > size:
+                return False
+            file.write(data.ljust(size, b" "))
+            file.flush()
+            os.fsync(file.fileno())
+    except OSError:
+        return False
+    return True
 
 
 def _strict(value, path: str, lost: list[str]):

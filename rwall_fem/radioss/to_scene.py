@@ -20,6 +20,7 @@ from rwall_fem.radioss.cards.rigid_bodies import scene_tables as rigid_body_tabl
 from rwall_fem.radioss.groups import node_ids, part_ids
 from rwall_fem.radioss.loads import load_groups, load_tables
 from rwall_fem.radioss.materials import element_table, material_table
+from rwall_fem.cell_shapes import bad_cells
 from rwall_fem.radioss.mesh import WRITER, FaceGroups, face_groups, write_msh
 from rwall_fem.radioss.model import Deck, Prescribed, Wall
 from rwall_fem.radioss.parts import DeckPart, deck_parts, initial_velocities, uniform_velocity
@@ -294,6 +295,8 @@ def _vec(v) -> str:
 
 
 def _check_element_nodes(deck: Deck) -> None:
+    """Every node of an element is a /NODE, and no element is flat or inside out
+    (:mod:`rwall_fem.cell_shapes`: Radioss's order of nodes is gmsh's)."""
     for body in deck.bodies:
         rows = deck.node_positions(body.nodes.ravel()).reshape(body.nodes.shape)
         bad = np.argwhere(rows < 0)
@@ -301,6 +304,19 @@ def _check_element_nodes(deck: Deck) -> None:
             k, j = bad[0]
             body.card.fail(
                 f"element {body.ids[k]}: node {body.nodes[k, j]} refers to no /NODE",
+                body.card.lines[k],
+            )
+        if body.cell not in ("hexahedron", "tetrahedron"):
+            continue  # shells: their own readers refuse degenerate ones
+        flat, corner = bad_cells(deck.coordinates[rows])
+        if len(flat):
+            k = flat[0]
+            more = f" ({len(flat)} such elements in this card)" if len(flat) > 1 else ""
+            body.card.fail(
+                f"element {body.ids[k]} is flat or inside out: its volume at node "
+                f"{body.nodes[k, corner[0]]} is not positive (a face on the opposite one, or "
+                f"nodes out of order){more}; an element needs a positive volume at every "
+                "corner",
                 body.card.lines[k],
             )
 

@@ -59,17 +59,22 @@ def test_run_log_holds_versions_scene_mesh_cycles_and_figures(shared_dir):
     assert "velocity = [0.0, 0.0, -2.0]" in echo and "dt_scale = 0.9" in echo
     assert "mesh: 40 hexahedron cells, 99 nodes" in log
     assert "wall[0]: plane, slide free, 90 secondary nodes" in log
-    cycle = r"^ +(\d+) +(\S+) +(\S+) +(\S+) +(\S+) +(\S+)  at \((\S+), (\S+), (\S+)\) m$"
+    cycle = (r"^ +(\d+) +(\S+) +(\S+) +(\S+) +(\S+) +(\d+) +(\S+) +(\S+)"
+             r"  at \((\S+), (\S+), (\S+)\) m$")  # fmt: skip
     cycles = re.findall(cycle, log, re.MULTILINE)
     steps = summary["steps"]
     assert [int(c[0]) for c in cycles] == [*range(0, steps, 10), steps]
     assert all(float(c[2]) == pytest.approx(summary["dt"], rel=1e-4) for c in cycles)
+    # The projection: an elastic body's step does not change, so the steps left at each
+    # line are those the run then took.
+    assert [int(c[5]) for c in cycles] == [steps - int(c[0]) for c in cycles]
+    assert cycles[0][6] == "-" and float(cycles[-1][6]) == 0.0
     # The cell that controls the step: its stable step (dt = dt_scale x it, rounded down to
     # 4 figures) and where it is, inside the bar.
     low, high = summary["deformed_bounds"]
     for c in cycles:
-        assert 0.9 * float(c[5]) == pytest.approx(float(c[2]), rel=1e-3)
-        where = [float(x) for x in c[6:]]
+        assert 0.9 * float(c[7]) == pytest.approx(float(c[2]), rel=1e-3)
+        where = [float(x) for x in c[8:]]
         assert all(lo - 1e-3 <= x <= hi + 1e-3 for lo, x, hi in zip(low, where, high, strict=True))
     assert "ended: done" in log and f"steps: {steps} of {steps} planned" in log
     assert f"max energy balance error: {summary['energy']['max_balance_error']:.3e}" in log
@@ -92,7 +97,7 @@ def test_batch_runs_print_cycle_lines_and_no_compiler_chatter(tmp_path):
     assert loud.returncode == quiet.returncode == 0, loud.stderr + quiet.stderr
     lines = loud.stderr.splitlines()
     assert lines[0].split() == ["rwall-fem:", "cycle", "time", "(s)", "dt", "(s)", "energy",
-                                "error", "%", "elapsed", "(s)", "limit", "(s)", "controlling",
-                                "cell"]  # fmt: skip
+                                "error", "%", "elapsed", "(s)", "steps", "left", "left", "(s)",
+                                "limit", "(s)", "controlling", "cell"]  # fmt: skip
     assert len(lines) > 10 and all(re.match(r"rwall-fem: +\d+ ", line) for line in lines[1:])
     assert quiet.stderr == ""

@@ -112,6 +112,10 @@ BEYOND = {
     "104_wall_points_overflow",
     "207_erode_below_a_dt_min_above_the_step",
     "208_damage_colour_without_failure",  # the cell fields are the body's
+    "220_erode_below_a_dt_min_above_the_step_of_one_part",
+    "221_mass_scaling_that_would_add_the_body_mass_at_rest",
+    "222_mesh_file_with_the_same_cells_in_two_regions",
+    "223_mesh_file_with_a_flat_cell",
     "210_output_units_unknown",  # a unit system's codes and sizes are read by rwall_fem.units
     "211_output_units_deck_of_a_toml_scene",
     "242_view_cut_misses_the_body",  # the body's nodes

@@ -114,6 +114,19 @@ def failure_strain_negative(lines):
                       f"{0.4:20g}{0.1:20g}{0.5:20g}{-0.2:20g}"]  # fmt: skip
 
 
+def flat_brick(lines):
+    """The top face of the first brick on its bottom face: its nodes 5-8 moved to z = 0
+    (distinct node IDs, no node repeated)."""
+    k = line_of(lines, "/BRICK") + 1
+    top = [int(lines[k][10 * m : 10 * m + 10]) for m in range(5, 9)]
+    first = line_of(lines, "/NODE") + 1
+    for n, line in enumerate(lines[first:], start=first):
+        if line.startswith("/"):
+            break
+        if int(line[:10]) in top:
+            lines[n] = line[:50] + f"{0.0:20g}"
+
+
 CASES = {
     # name: (edit, the card's header or line text, what the message says)
     "truncated line": (
@@ -149,6 +162,11 @@ CASES = {
         brick_id_twice, "/BRICK",
         r"/BRICK/1: element ID 1 is used twice \(again at .*model_0000.rad:\d+, /BRICK/1\): "
         "an element ID names one element",
+    ),
+    # class 3: a flat brick (its top face on its bottom face), without a repeated node
+    "flat brick": (
+        flat_brick, "/BRICK", r"/BRICK/1: element 1 is flat or inside out: its volume at "
+        r"node \d+ is not positive",
     ),
     "version 44": (
         version_44, "/BEGIN", r"input version 44: the block format of version 5.1 and later "

@@ -1,6 +1,5 @@
 """The block format: fixed and free fields, comments, #include, units by hand, speed."""
 
-import time
 
 import numpy as np
 import pytest
@@ -52,7 +51,9 @@ def test_include_of_itself_is_refused(tmp_path):
         read_cards(tmp_path / "a.rad")
 
 
-def test_a_large_node_block_reads_in_seconds(tmp_path):
+def test_a_large_node_block_reads_every_node_exactly(tmp_path):
+    """200,000 nodes (a block read as a whole array, not line by line): every ID and
+    coordinate back to the 12 digits written. Its speed is not tested (about 1 s)."""
     n = 200_000
     ids = np.arange(1, n + 1)
     xyz = np.random.default_rng(1).random((n, 3)) * 100
@@ -60,9 +61,6 @@ def test_a_large_node_block_reads_in_seconds(tmp_path):
         f.write("/NODE\n")
         np.savetxt(f, np.column_stack([ids, xyz]), fmt=["%10d", "%20.12g", "%20.12g", "%20.12g"],
                    delimiter="")  # fmt: skip
-    started = time.perf_counter()
     (card,) = read_cards(tmp_path / "big.rad")
     i, x, y, z = fixed_table(card, 0, "i:id f:x f:y f:z")
-    elapsed = time.perf_counter() - started
     assert np.array_equal(i, ids) and np.allclose(np.column_stack([x, y, z]), xyz, rtol=1e-11)
-    assert elapsed < 5.0  # about 1 s here: 5 s per million nodes
