@@ -63,7 +63,7 @@ from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
-from rwall_fem.solver import Simulation, State
+from rwall_fem.solver import CentralDifference, Simulation, State
 from rwall_fem.time_step import step_size
 from rwall_fem.units import parse_system
 from rwall_fem.walls import RigidWall
@@ -151,6 +151,15 @@ def build_simulation(
         refuse_above_limits(scene, estimate(scene, comm.size))
     solid = _solid(scene, comm, body, scene.run.max_cells if limits else None)
     sim = _pipeline(scene, solid, limits)
+    if scene.contacts:
+        from rwall_fem.contact import build_contacts
+
+        sim.contacts = build_contacts(scene, solid, sim.state)
+        sim.step_size.contacts = sim.contacts
+        if sim.step_size.varies and not sim.internal.books_work:
+            # Contact makes the step vary: the stored energies take its correction.
+            sim.internal.books_work = True
+            sim.update = CentralDifference(sim.state, sim.internal)
     dt = sim.state.dt
     if limits:
         steps_above_limit(scene, sim.planned_steps, dt)
@@ -164,7 +173,9 @@ def build_simulation(
     ]
     for line in facts:
         log.info("%s", line)
-    warnings = _starter_warnings(sim, solid) + piece_overlaps(sim.internal, solid.X, sim.comm)
+    touching = [set(c.main + c.secondary) or {p.name for p in solid.parts} for c in scene.contacts]
+    overlaps = piece_overlaps(sim.internal, solid.X, sim.comm, touching)
+    warnings = _starter_warnings(sim, solid) + overlaps
     for line in warnings:
         log.warning("%s", line)
     sim.info["warnings"] = warnings

@@ -14,7 +14,9 @@
  *   penalty force of the penetration p = gap - d (d the signed distance, < 0 behind the
  *   surface) stiffening toward p = gap (k0 g / (g - p), held beyond p = cap g), Coulomb
  *   friction on an elastic tangential spring of stiffness k0 (friction.h's law and filter),
- *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m).
+ *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m): the
+ *   tangent of the springs in contact, k0 for those within reach of a segment but not in
+ *   contact (so that the step does not jump as nodes come and go).
  * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
  */
 #include <stdlib.h>
@@ -391,7 +393,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       const double distance = sqrt(cdot(r, r));
       const double along = cdot(r, n);
       const double d = along >= 0.0 ? distance : -distance;
-      if (!(d < g && -d < depth[j])) /* out of reach (and NaN) */
+      /* The closest segment decides, in contact or not: a node just beyond the gap in
+       * front of one face is not inside its neighbour at the edge. */
+      if (!(distance < (g > depth[j] ? g : depth[j]))) /* out of reach (and NaN) */
         continue;
       const double cosine = distance > 0.0 ? fabs(along) / distance : 1.0;
       const double tie = 1e-9 * (distance + best_distance);
@@ -409,6 +413,17 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
           best_n[c] = n[c];
     }
     double *ft = tangential + 3 * i;
+    if (best >= 0 && !(best_d < g && -best_d < depth[best]))
+    {
+      /* Near but not in contact: its spring's stiffness counts in the step all the same,
+       * so that the step does not jump as nodes come into and out of contact. */
+      const int64_t *seg = segs + 4 * best;
+      stiffness[s] += stiffness0[best];
+      for (int m = 0; m < 4; ++m)
+        if (seg[m] >= 0)
+          stiffness[seg[m]] += best_weights[m] * stiffness0[best];
+      best = -1;
+    }
     if (best < 0)
     {
       ft[0] = ft[1] = ft[2] = 0.0;

@@ -32,6 +32,7 @@ from rwall_fem.scene.schema import (
     Scene,
     Secondary,
     WallSpec,
+    ContactSpec,
 )
 
 __all__ = [
@@ -53,6 +54,7 @@ __all__ = [
     "SceneError",
     "Secondary",
     "WallSpec",
+    "ContactSpec",
     "apply_override",
     "load_scene",
     "parse_scene",
