@@ -87,7 +87,7 @@ class ContactInterface:
     ``state`` holds."""
 
     def __init__(self, name, nodes, passes, *, gap, friction, alpha, margin, state, comm,
-                 owned_global):  # fmt: skip
+                 owned_global, damping=0.05):  # fmt: skip
         self.name, self.passes, self.comm, self.state = name, passes, comm, state
         self.gap, self.friction, self.alpha, self.margin = gap, friction, alpha, margin
         self.ffi, self.lib = load()
@@ -110,6 +110,8 @@ class ContactInterface:
         self._params = self.ffi.new("contact_params *")
         self._params.gap, self._params.cap = gap, CAP
         self._params.friction, self._params.alpha = friction, alpha
+        self._params.damping = damping
+        self.damping = damping
         self.dt_limit = math.inf  # the nodal stable step of the latest pass, s
         self.sorts = 0
         # The books: stored energies of the latest pass, the friction's dissipation and the
@@ -201,7 +203,7 @@ class ContactInterface:
             lib.contact_forces(
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
                 p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-                p(ps.depth), p(self.x), p(self.v), self._params, p(ps.tangential),
+                p(ps.depth), p(self.x), p(self.v), p(self.mass), self._params, p(ps.tangential),
                 p(self.force), p(self.stiffness), p(ps.out),
             )  # fmt: skip
             out = ps.out

@@ -148,7 +148,7 @@ double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const do
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
                         double out[2]);
 typedef struct {
-  double gap, cap, friction, alpha, dt;
+  double gap, cap, friction, damping, alpha, dt;
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
@@ -158,7 +158,7 @@ int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                     const int64_t *candidates, const int64_t *segs, const double *stiffness0,
                     const double *depth, const double *x, const double *v,
-                    const contact_params *prm, double *tangential, double *force,
+                    const double *mass, const contact_params *prm, double *tangential, double *force,
                     double *stiffness, double out[11]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
 """

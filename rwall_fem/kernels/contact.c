@@ -29,6 +29,7 @@ typedef struct
   double gap;      /* m */
   double cap;      /* the penetration ratio p / gap beyond which the stiffness stays */
   double friction; /* Coulomb's mu (0: none) */
+  double damping;  /* the normal damping's fraction of critical (Radioss VISs) */
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
 } contact_params;
@@ -365,13 +366,14 @@ static double penalty(double p, double k0, double g, double cap, double *tangent
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
  * (N), updated.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
  * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
- * tangential springs' energy (J), [9] the friction's dissipation over the step (J),
+ * tangential springs' energy (J), [9] what friction and damping dissipated over the step (J),
  * [10] the sum of the normal forces' sizes (N). */
 void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const int64_t *restrict offsets, const int64_t *restrict candidates,
                     const int64_t *restrict segs, const double *restrict stiffness0,
                     const double *restrict depth, const double *restrict x,
-                    const double *restrict v, const contact_params *prm,
+                    const double *restrict v, const double *restrict mass,
+                    const contact_params *prm,
                     double *restrict tangential, double *restrict force,
                     double *restrict stiffness, double out[11])
 {
@@ -432,22 +434,35 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const int64_t *seg = segs + 4 * best;
     const double k0 = stiffness0[best];
     double kt, energy;
-    const double fn = penalty(g - best_d, k0, g, prm->cap, &kt, &energy);
+    const double spring = penalty(g - best_d, k0, g, prm->cap, &kt, &energy);
+    /* The velocity relative to the segment's point, and the normal damping of the pair
+     * (masses m_s and sum w_i m_i): c = 2 damping sqrt(kt m_s m_main / (m_s + m_main)),
+     * the normal force kept >= 0 (contact only pushes). */
+    double w[3];
+    double main_mass = 0.0;
+    for (int c = 0; c < 3; ++c)
+      w[c] = v[3 * s + c];
+    for (int m = 0; m < 4; ++m)
+      if (seg[m] >= 0)
+      {
+        main_mass += best_weights[m] * mass[seg[m]];
+        for (int c = 0; c < 3; ++c)
+          w[c] -= best_weights[m] * v[3 * seg[m] + c];
+      }
+    const double wn = cdot(w, best_n);
+    const double reduced = mass[s] * main_mass / (mass[s] + main_mass);
+    const double viscous = 2.0 * prm->damping * sqrt(kt * reduced);
+    double fn = spring - viscous * wn;
+    fn = fn > 0.0 ? fn : 0.0;
+    out[9] += (spring - fn) * wn * prm->dt; /* what the damping took over the step */
     double f[3];
     for (int c = 0; c < 3; ++c)
       f[c] = fn * best_n[c];
     if (prm->friction > 0.0)
     {
-      /* The relative velocity's tangential part, and the elastic trial force. */
-      double w[3], old[3], trial[3];
-      for (int c = 0; c < 3; ++c)
-      {
-        w[c] = v[3 * s + c];
-        for (int m = 0; m < 4; ++m)
-          if (seg[m] >= 0)
-            w[c] -= best_weights[m] * v[3 * seg[m] + c];
-      }
-      const double wn = cdot(w, best_n), on = cdot(ft, best_n);
+      /* The tangential relative velocity, and the elastic trial force. */
+      double old[3], trial[3];
+      const double on = cdot(ft, best_n);
       for (int c = 0; c < 3; ++c)
       {
         w[c] -= wn * best_n[c];
