@@ -76,7 +76,7 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
         interface = ContactInterface(
             f"contact[{i}]", nodes, passes, gap=gap, friction=spec.friction,
             alpha=filter_alpha(spec.friction_filter, state.dt), margin=edge, state=state,
-            comm=comm, owned_global=owned,
+            comm=comm, owned_global=owned, damping=spec.damping,
         )  # fmt: skip
         interface._gather(state)
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):

@@ -960,6 +960,12 @@ class ContactSpec:
         doc="Radioss Stfac: scales the penalty stiffness k0 = B A^2 / V of the cell under "
         "each segment",
     )
+    damping: float = key(
+        Real(low=0.0, low_open=False, high=1.0),
+        0.05,
+        doc="Radioss VISs: the normal damping of each pair, a fraction of its critical "
+        "damping 2 sqrt(k m)",
+    )
     friction: float = key(Real(low=0.0, low_open=False), 0.0, doc="the Coulomb coefficient mu")
     friction_filter: tuple[str, float] | None = key(
         Sub(FrictionFilter, then=_filter),
@@ -969,7 +975,19 @@ class ContactSpec:
     )
 
 
-@rule(ContactSpec)
+@rule(
+    ContactSpec,
+    json=[
+        {
+            "if": {"properties": {"self": {"const": True}}, "required": ["self"]},
+            "then": {"properties": {"secondary": {"maxItems": 0}}},
+            "else": {
+                "required": ["main", "secondary"],
+                "properties": {"main": {"minItems": 1}, "secondary": {"minItems": 1}},
+            },
+        }
+    ],
+)
 def _sides_are_named(v, raw, fail):
     """Without self, main and secondary each name at least one part; with self, secondary
     is not given."""
