@@ -128,24 +128,42 @@ class ContactInterface:
         self._first = 0.0
         self._pending = False
         self._previous_dt = 0.0
+        # Pointers for the compiled passes (the state's arrays never move).
+        p = self._pointer
+        self.mine, self.where = self.mine.astype(np.int64), self.where.astype(np.int64)
+        self.order = self.order.astype(np.int64)
+        self._state = [p(x) for x in (state.X, state.u, state.v, state.mass, state.a)]
+        self._rows = (p(self.mine, "int64_t[]"), p(self.where, "int64_t[]"),
+                      p(self.order, "int64_t[]"))  # fmt: skip
+        self._surface = [p(x) for x in (self.x, self.v, self.mass, self.force, self.stiffness,
+                                        self._send, self._receive, self._owned_force)]  # fmt: skip
+        self._passes = [self._pass_pointers(ps) for ps in passes]
 
     def _pointer(self, array, kind="double[]"):
         return self.ffi.from_buffer(kind, array)
 
+    def _pass_pointers(self, ps: Pass) -> tuple:
+        """The arguments of contact_forces for pass ``ps`` after its number of nodes."""
+        p = self._pointer
+        x, v, mass, force, stiffness = self._surface[:5]
+        return (
+            p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
+            p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
+            p(ps.depth), x, v, mass, self._params, p(ps.tangential), force, stiffness,
+            p(ps.out),
+        )  # fmt: skip
+
     def _gather(self, s) -> None:
         """x^n, v^{n-1/2} and masses of the surface nodes, from every rank."""
-        send, mine = self._send, self.mine
-        send[:, :3] = s.X[mine] + s.u[mine]
-        send[:, 3:6] = s.v[mine]
-        send[:, 6] = s.mass[mine]
-        if self.comm.size == 1:
-            received = send
-        else:
-            self.comm.Allgatherv(send, [self._receive, self.counts * 7])
-            received = self._receive
-        self.x[self.order] = received[:, :3]
-        self.v[self.order] = received[:, 3:6]
-        self.mass[self.order] = received[:, 6]
+        X, u, v, mass, _ = self._state
+        mine, _, order = self._rows
+        send, receive = self._surface[5:7]
+        self.lib.contact_pack(len(self.mine), mine, X, u, v, mass, send)
+        if self.comm.size > 1:
+            self.comm.Allgatherv(self._send, [self._receive, self.counts * 7])
+            send = receive
+        x, v, mass = self._surface[:3]
+        self.lib.contact_unpack(self.size, order, send, x, v, mass)
 
     def _sort(self) -> None:
         lib, p = self.lib, self._pointer
@@ -163,7 +181,9 @@ class ContactInterface:
                 if count <= len(ps.candidates):
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
+        self._passes = [self._pass_pointers(ps) for ps in self.passes]
         self._sorted_at = self.x.copy()
+        self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
 
     def _pending_books(self, dt_v: float, v: np.ndarray) -> tuple[np.ndarray, float]:
@@ -171,7 +191,8 @@ class ContactInterface:
         of the latest pass over its velocity step dt_v (s), v^{n+1/2} being ``v``."""
         if not self._pending:
             return np.zeros(3), 0.0
-        second = float(np.einsum("ij,ij->", self._owned_force, v[self.mine]))
+        v = self._pointer(v)
+        second = self.lib.contact_power(len(self.mine), self._rows[0], self._surface[7], v)
         return dt_v * self.latest, 0.5 * dt_v * (self._first + second)
 
     def _book_pending(self, dt_v: float, v: np.ndarray) -> None:
@@ -190,22 +211,16 @@ class ContactInterface:
         if self._sorted_at is None:
             self._sort()
         else:
-            moved = self.lib.contact_moved(self.size, self._pointer(self.x),
-                                           self._pointer(self._sorted_at))  # fmt: skip
+            moved = self.lib.contact_moved(self.size, self._surface[0], self._sorted_pointer)
             if not moved <= (0.5 * self.margin) ** 2:
                 self._sort()
         self.force[:] = 0.0
         self._params.dt = s.dt_previous
-        lib, p = self.lib, self._pointer
+        lib = self.lib
         energy, tangential, dissipated, normal, contacts = 0.0, 0.0, 0.0, 0.0, 0
         latest = np.zeros(3)
-        for k, ps in enumerate(self.passes):
-            lib.contact_forces(
-                len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-                p(ps.depth), p(self.x), p(self.v), p(self.mass), self._params, p(ps.tangential),
-                p(self.force), p(self.stiffness), p(ps.out),
-            )  # fmt: skip
+        for k, (ps, arguments) in enumerate(zip(self.passes, self._passes, strict=True)):
+            lib.contact_forces(len(ps.secondary), *arguments)
             out = ps.out
             latest += out[:3] if k == 0 else -out[:3]
             contacts += int(out[6])
@@ -213,11 +228,12 @@ class ContactInterface:
             tangential += out[8]
             dissipated += out[9]
             normal += out[10]
-        self.dt_limit = lib.contact_step(self.size, p(self.mass), p(self.stiffness))
-        owned_force = self._owned_force
-        owned_force[:] = self.force[self.where]
-        s.a[self.mine] += owned_force / s.mass[self.mine, None]
-        self._first = float(np.einsum("ij,ij->", owned_force, s.v[self.mine]))
+        x, v, mass, force, stiffness = self._surface[:5]
+        self.dt_limit = lib.contact_step(self.size, mass, stiffness)
+        _, _, state_v, state_mass, a = self._state
+        mine, where, _ = self._rows
+        self._first = lib.contact_apply(len(self.mine), mine, where, force, state_mass, state_v,
+                                        a, self._surface[7])  # fmt: skip
         self.energy = energy + tangential
         self.dissipated += dissipated
         self.latest, self.normal_force, self.contacts = latest, normal, contacts

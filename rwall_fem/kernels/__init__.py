@@ -161,6 +161,13 @@ void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offse
                     const double *mass, const contact_params *prm, double *tangential, double *force,
                     double *stiffness, double out[11]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
+void contact_pack(int64_t n, const int64_t *rows, const double *X, const double *u,
+                  const double *v, const double *mass, double *packed);
+void contact_unpack(int64_t n, const int64_t *order, const double *packed, double *x,
+                    double *v, double *mass);
+double contact_apply(int64_t n, const int64_t *rows, const int64_t *where, const double *force,
+                     const double *mass, const double *v, double *a, double *kept);
+double contact_power(int64_t n, const int64_t *rows, const double *kept, const double *v);
 """
     + "".join(
         f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"

@@ -515,3 +515,70 @@ double contact_step(int64_t n, const double *restrict mass, double *restrict sti
   }
   return smallest;
 }
+
+/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg). */
+void contact_pack(int64_t n, const int64_t *restrict rows, const double *restrict X,
+                  const double *restrict u, const double *restrict v,
+                  const double *restrict mass, double *restrict packed)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t r = rows[i];
+    double *p = packed + 7 * i;
+    for (int c = 0; c < 3; ++c)
+    {
+      p[c] = X[3 * r + c] + u[3 * r + c];
+      p[3 + c] = v[3 * r + c];
+    }
+    p[6] = mass[r];
+  }
+}
+
+/* Packed rows to the surface nodes `order` (their positions, velocities and masses). */
+void contact_unpack(int64_t n, const int64_t *restrict order, const double *restrict packed,
+                    double *restrict x, double *restrict v, double *restrict mass)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t k = order[i];
+    const double *p = packed + 7 * i;
+    for (int c = 0; c < 3; ++c)
+    {
+      x[3 * k + c] = p[c];
+      v[3 * k + c] = p[3 + c];
+    }
+    mass[k] = p[6];
+  }
+}
+
+/* Add the surface forces (rows `where`) to the accelerations of the state's rows `rows`,
+ * keep them in `kept` (n rows) and return sum f . v (W) over them. */
+double contact_apply(int64_t n, const int64_t *restrict rows, const int64_t *restrict where,
+                     const double *restrict force, const double *restrict mass,
+                     const double *restrict v, double *restrict a, double *restrict kept)
+{
+  double power = 0.0;
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t r = rows[i], k = where[i];
+    for (int c = 0; c < 3; ++c)
+    {
+      const double f = force[3 * k + c];
+      kept[3 * i + c] = f;
+      a[3 * r + c] += f / mass[r];
+      power += f * v[3 * r + c];
+    }
+  }
+  return power;
+}
+
+/* sum f . v (W) of the kept forces (n rows) at the state's rows `rows`. */
+double contact_power(int64_t n, const int64_t *restrict rows, const double *restrict kept,
+                     const double *restrict v)
+{
+  double power = 0.0;
+  for (int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      power += kept[3 * i + c] * v[3 * rows[i] + c];
+  return power;
+}
