@@ -111,6 +111,10 @@ class ContactInterface:
         self._params.gap, self._params.cap = gap, CAP
         self._params.friction, self._params.alpha = friction, alpha
         self._params.damping = damping
+        # The segments within this distance of a node compete for it, whatever their own
+        # depth, so that the closest (the best aligned) decides; the sort finds them all.
+        self.reach = max([gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
+        self._params.reach = self.reach
         self.damping = damping
         self.dt_limit = math.inf  # the nodal stable step of the latest pass, s
         self.sorts = 0
@@ -168,7 +172,7 @@ class ContactInterface:
     def _sort(self) -> None:
         lib, p = self.lib, self._pointer
         for ps in self.passes:
-            reach = np.maximum(ps.depth, self.gap) + self.margin
+            reach = np.full(len(ps.segments), self.reach + self.margin)
             while True:
                 work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
                 count = lib.contact_sort(

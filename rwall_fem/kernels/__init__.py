@@ -148,7 +148,7 @@ double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const do
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
                         double out[2]);
 typedef struct {
-  double gap, cap, friction, damping, alpha, dt;
+  double gap, cap, friction, damping, alpha, dt, reach;
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,

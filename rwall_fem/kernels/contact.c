@@ -32,6 +32,7 @@ typedef struct
   double damping;  /* the normal damping's fraction of critical (Radioss VISs) */
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
+  double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
 } contact_params;
 
 INLINE double cdot(const double x[3], const double y[3])
@@ -397,7 +398,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       const double d = along >= 0.0 ? distance : -distance;
       /* The closest segment decides, in contact or not: a node just beyond the gap in
        * front of one face is not inside its neighbour at the edge. */
-      if (!(distance < (g > depth[j] ? g : depth[j]))) /* out of reach (and NaN) */
+      if (!(distance < prm->reach)) /* out of reach (and NaN) */
         continue;
       const double cosine = distance > 0.0 ? fabs(along) / distance : 1.0;
       const double tie = 1e-9 * (distance + best_distance);
