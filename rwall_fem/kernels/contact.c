@@ -438,7 +438,8 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double spring = penalty(g - best_d, k0, g, prm->cap, &kt, &energy);
     /* The velocity relative to the segment's point, and the normal damping of the pair
      * (masses m_s and sum w_i m_i): c = 2 damping sqrt(kt m_s m_main / (m_s + m_main)),
-     * the normal force kept >= 0 (contact only pushes). */
+     * its force bounded by the spring's: the normal force starts at 0 as a node comes
+     * into contact (no jump for round-off to decide) and never pulls. */
     double w[3];
     double main_mass = 0.0;
     for (int c = 0; c < 3; ++c)
@@ -453,8 +454,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double wn = cdot(w, best_n);
     const double reduced = mass[s] * main_mass / (mass[s] + main_mass);
     const double viscous = 2.0 * prm->damping * sqrt(kt * reduced);
-    double fn = spring - viscous * wn;
-    fn = fn > 0.0 ? fn : 0.0;
+    double damper = -viscous * wn;
+    damper = damper > spring ? spring : (damper < -spring ? -spring : damper);
+    const double fn = spring + damper;
     out[9] += (spring - fn) * wn * prm->dt; /* what the damping took over the step */
     double f[3];
     for (int c = 0; c < 3; ++c)
