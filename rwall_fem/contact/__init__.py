@@ -15,7 +15,7 @@ import numpy as np
 from rwall_fem.contact.interface import ContactInterface, Pass
 from rwall_fem.contact.surface import Surface, part_surface
 
-__all__ = ["ContactInterface", "build_contacts"]
+__all__ = ["build_contacts"]
 
 
 def build_contacts(scene, solid, state) -> list[ContactInterface]:
