@@ -19,7 +19,7 @@ Books (J), like every force's, at mid-step velocities: the work W of the contact
 friction dissipated, ``contact_friction`` (D, from the slip of each node: -f_t . du_slip),
 and the rest, ``contact_energy`` = -W - D, what the penalty springs hold as the scheme books
 it; the energy balance then closes to round-off. ``contacts.csv`` also gives the springs'
-potential at step n, ``penalty_energy`` (-k0 g^2 ((1 - x) ln(1 - x) + x) summed, x = p / g,
+potential at step n, ``penalty_energy`` (k0 g^2 ((1 - x) ln(1 - x) + x) summed, x = p / g,
 plus ``|f_t|^2 / 2 k0``): the two differ by the error of a penalty spring integrated by
 central differences, at most about k0 (w dt)^2 / 2 per node that comes into or out of
 contact at a normal speed w within a step (the spring is switched on or off between two
