@@ -28,6 +28,13 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
     from rwall_fem.walls.constraint import filter_alpha
 
     body, comm = solid.elastic, solid.comm
+    failing = any(getattr(p.material, "failure", None) for p in scene.body_parts)
+    if failing or scene.run.dt_min_action == "erode":
+        raise SceneError(
+            f"{scene.source}: contact[0]: contact in a body whose cells may erode (a failure "
+            "criterion, or run.dt_min_action = 'erode') is not supported yet: the faces of "
+            "eroded cells would stay in the contact surface; drop [[contact]] or the erosion"
+        )
     names = [part.name for part in solid.parts]
     owned = solid.V.dofmap.index_map.local_to_global(np.arange(solid.owned, dtype=np.int32))
     surfaces: dict[str, Surface] = {}
