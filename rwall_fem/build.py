@@ -179,7 +179,8 @@ def build_simulation(
     for line in warnings:
         log.warning("%s", line)
     sim.info["warnings"] = warnings
-    facts += [*_constraint_facts(sim), *(f"warning: {w}" for w in warnings)]
+    facts += [*_constraint_facts(sim), *(c.describe() for c in sim.contacts)]
+    facts += [f"warning: {w}" for w in warnings]
     _add_recorders(sim, scene, solid, directory, facts)
     identity = {
         "code": __version__,

@@ -263,6 +263,16 @@ class ContactInterface:
         return (t, index, *self.latest.tolist(), *(self.impulse + impulse).tolist(),
                 self.normal_force, self.contacts, energy, self.dissipated, self.energy)  # fmt: skip
 
+    def describe(self) -> str:
+        """One line for ``run.log``: the surface, the gap, the stiffness and the friction."""
+        k0 = np.concatenate([ps.stiffness for ps in self.passes])
+        return (
+            f"{self.name}: {len(self.passes)} pass(es), {self.size} surface nodes, "
+            f"{sum(len(ps.segments) for ps in self.passes)} segments; gap {self.gap:.4g} m, "
+            f"k0 {k0.min(initial=np.inf):.4g} to {k0.max(initial=0.0):.4g} N/m, damping "
+            f"{self.damping:g}, friction {self.friction:g}"
+        )
+
     def summary(self) -> dict:
         """What ``summary.json`` says of the interface (the same on every rank)."""
         impulse = self.impulse + self._pending_books(self.state.dt_velocity, self.state.v)[0]
