@@ -10,9 +10,9 @@ step size is chosen (its stiffness enters the stable step). Each step it
    when some node moved more than half the margin since the last sort;
 3. runs its passes (secondary nodes against main segments; two, each side against the
    other, by default) in compiled code, on every rank alike: each rank then adds the forces
-   of its own nodes to a^n. The results are thus the same on any number of ranks, to the
-   bit; the price is that every rank treats the whole contact surface (fine up to some
-   10^5 surface nodes; a partitioned search is for later).
+   of its own nodes to a^n. The same nodal state thus gives the same forces on any number
+   of ranks, to the bit; the price is that every rank treats the whole contact surface
+   (fine up to some 10^5 surface nodes; a partitioned search is for later).
 
 Books (J), like every force's, at mid-step velocities: the work W of the contact forces,
 1/2 f^n . (v^{n-1/2} + v^{n+1/2}) dt^n summed over the steps, is split into the work that
