@@ -596,9 +596,10 @@ def shared_velocities(body: Body, comm) -> str | None:
     return None
 
 
-def piece_overlaps(body: Body, X: np.ndarray, comm) -> list[str]:
+def piece_overlaps(body: Body, X: np.ndarray, comm, touching=frozenset()) -> list[str]:
     """Warnings, one line each, for parts of pieces that share no node whose boxes overlap
-    at the start (collective): the pieces of one body do not touch each other."""
+    at the start (collective): the pieces of one body do not touch each other unless a
+    contact interface names both (``touching``: pairs of part names that it does)."""
     owned = len(X)
     held = body.held[:owned] > 0
     count = len(body.parts)
@@ -623,13 +624,14 @@ def piece_overlaps(body: Body, X: np.ndarray, comm) -> list[str]:
     warnings = []
     for k in range(count):
         for j in range(k + 1, count):
-            if piece[k] == piece[j]:
+            names = {body.parts[k].name, body.parts[j].name}
+            if piece[k] == piece[j] or any(names <= pair for pair in touching):
                 continue
             (a, b), (c, d) = boxes[k], boxes[j]
             if np.all(a <= d) and np.all(c <= b):
                 warnings.append(
                     f"the parts '{body.parts[k].name}' and '{body.parts[j].name}' are pieces "
                     "that share no node, and their boxes overlap at the start: pieces do not "
-                    "touch each other (there is no contact between bodies)"
+                    "touch each other unless a [[contact]] names both"
                 )
     return warnings

@@ -74,7 +74,7 @@ from rwall_fem.provenance import git_hash
 from rwall_fem.rigid_body import RigidBodyError, build_rigid_bodies, deactivate_rigid_cells
 from rwall_fem.rigid_contact import RigidContact
 from rwall_fem.scene import SHAPE_KEYS, Scene, SceneError, WallSpec, load_scene
-from rwall_fem.solver import Simulation, State
+from rwall_fem.solver import CentralDifference, Simulation, State
 from rwall_fem.time_step import step_size
 from rwall_fem.units import parse_system
 from rwall_fem.walls import RigidWall
@@ -162,6 +162,15 @@ def build_simulation(
         refuse_above_limits(scene, estimate(scene, comm.size))
     solid = _solid(scene, comm, body, scene.run.max_cells if limits else None)
     sim = _pipeline(scene, solid, limits)
+    if scene.contacts:
+        from rwall_fem.contact import build_contacts
+
+        sim.contacts = build_contacts(scene, solid, sim.state)
+        sim.step_size.contacts = sim.contacts
+        if sim.step_size.varies and not sim.internal.books_work:
+            # Contact makes the step vary: the stored energies take its correction.
+            sim.internal.books_work = True
+            sim.update = CentralDifference(sim.state, sim.internal)
     dt = sim.state.dt
     if limits:
         steps_above_limit(scene, sim.planned_steps, dt)
@@ -175,11 +184,14 @@ def build_simulation(
     ]
     for line in facts:
         log.info("%s", line)
-    warnings = _starter_warnings(sim, solid) + piece_overlaps(sim.internal, solid.X, sim.comm)
+    touching = [set(c.main + c.secondary) or {p.name for p in solid.parts} for c in scene.contacts]
+    overlaps = piece_overlaps(sim.internal, solid.X, sim.comm, touching)
+    warnings = _starter_warnings(sim, solid) + overlaps
     for line in warnings:
         log.warning("%s", line)
     sim.info["warnings"] = warnings
-    facts += [*_constraint_facts(sim), *(f"warning: {w}" for w in warnings)]
+    facts += [*_constraint_facts(sim), *(c.describe() for c in sim.contacts)]
+    facts += [f"warning: {w}" for w in warnings]
     _add_recorders(sim, scene, solid, directory, facts)
     identity = {
         "code": __version__,

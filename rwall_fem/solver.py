@@ -4,6 +4,7 @@ One step, in the order of ``docs/theory.md`` (section "The step"):
 
 1. the internal force *sets* the acceleration ``a^n`` and estimates every cell's stable
    step on the way;
+   The contact interfaces then add their forces and note their nodal stable steps;
 2. the step size chooses ``dt^{n+1/2}`` from those estimates (:mod:`rwall_fem.time_step`),
    adding mass to the cells below ``run.dt_min`` when the scene asks for mass scaling;
 3. body forces add to ``a^n``, constraints edit it: the rigid bodies, the rigid walls,
@@ -283,6 +284,9 @@ class Simulation:
     internal: InternalForce
     comm: Any  # the body's MPI communicator
     forces: list[BodyForce] = field(default_factory=list)
+    # Contact interfaces (rwall_fem.contact): forces after the internal force, before the
+    # step size is chosen (their stiffness enters the stable step).
+    contacts: list = field(default_factory=list)
     walls: list[Constraint] = field(default_factory=list)  # RigidWall
     boundaries: list[Constraint] = field(default_factory=list)  # VelocityBoundary
     # Rigid bodies (rwall_fem.rigid_body), before the walls; their contact after the walls.
@@ -329,7 +333,7 @@ class Simulation:
     @property
     def effects(self) -> list[str]:
         """Names of the effects in the step pipeline, in the order they act."""
-        return [e.name for e in [self.internal, *self.forces, *self.constraints]]
+        return [e.name for e in [self.internal, *self.contacts, *self.forces, *self.constraints]]
 
     @property
     def stateful(self) -> dict[str, Stateful]:
@@ -339,6 +343,7 @@ class Simulation:
         pieces["step_size"] = self.step_size
         forces = [f for f in self.forces if hasattr(f, "checkpoint_state")]
         pieces |= {f"force[{i}]": f for i, f in enumerate(forces)}
+        pieces |= {f"contact[{i}]": c for i, c in enumerate(self.contacts)}
         pieces |= {f"wall[{i}]": w for i, w in enumerate(self.walls)}
         pieces |= {f"boundary[{i}]": b for i, b in enumerate(self.boundaries)}
         pieces |= {f"rigid_body[{i}]": r for i, r in enumerate(self.rigid_bodies)}
@@ -366,6 +371,7 @@ class Simulation:
             )
         s, update, history, step_size = self.state, self.update, self.history, self.step_size
         internal, forces, constraints = self.internal, self.forces, self.constraints
+        contacts = self.contacts
         checkpoints = self.checkpoints
         # A resumed run goes on after its checkpoint's step, unless that step was the last.
         going = not (self.first_step and s.last)
@@ -386,6 +392,8 @@ class Simulation:
                 while going:
                     s.last = s.t >= self.end_time - 1e-9 * s.dt_previous
                     internal.accelerate(s)
+                    for contact in contacts:
+                        contact.accelerate(s)
                     step_size.choose(self, s)
                     for force in forces:
                         force.accelerate(s)

@@ -115,6 +115,7 @@ class _StepSize:
         self._total = np.zeros(4)
         self._reductions = 0  # steps reduced so far: the cache key of controlling_cell
         self._cell = None  # (key, what controlling_cell found)
+        self.contacts = []  # contact interfaces: their nodal stable steps (s) bound the step
 
     def _reduce(self, s) -> tuple[float, int, int]:
         """The smallest estimate (s) over the ranks, and the largest number of inverted and
@@ -128,6 +129,12 @@ class _StepSize:
             self._local[:] = (step[0], -step[5], -step[10], -step[11])
             self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
             smallest, inverted, listed, eroded = self._total.tolist()
+        if self.contacts:  # the same on every rank: no reduction
+            # A node held by cells and contact springs: 1/dt^2 adds up (conservatively,
+            # with the smallest cell's step).
+            contact = min(c.dt_limit for c in self.contacts)
+            if math.isfinite(contact):
+                smallest = 1.0 / math.sqrt(1.0 / smallest**2 + 1.0 / contact**2)
         self._reductions += 1
         self.limit = smallest
         if inverted:
@@ -265,8 +272,8 @@ class AdaptiveStep(_StepSize):
     @property
     def varies(self) -> bool:
         """Whether the step may change: not for a small-strain body, whose limit does not
-        (unless mass scaling changes it)."""
-        return self.force.estimate_every_step
+        (unless mass scaling changes it), without contact."""
+        return self.force.estimate_every_step or bool(self.contacts)
 
     @property
     def floor(self) -> float:

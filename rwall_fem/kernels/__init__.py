@@ -1,8 +1,9 @@
 """Compiled element kernels: C compiled at first use through cffi and cached.
 
 The C sources beside this file (one per element family, with the formulas in
-their header comments; ``update.c`` and ``wall.c`` for the per-node passes of a step,
-the update and the rigid walls) are compiled into one extension module the first time a
+their header comments; ``update.c``, ``wall.c`` and ``contact.c`` for the per-node passes
+of a step, the update, the rigid walls and the contact interfaces, which share the
+friction law of ``friction.h``) are compiled into one extension module the first time a
 process needs them, the way FFCx compiles forms, and cached per user under
 ``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
 ``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
@@ -53,7 +54,7 @@ log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
            "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
-           "wall.c")  # fmt: skip
+           "friction.h", "wall.c", "contact.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -146,6 +147,27 @@ double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const do
                       const wall_shape *s, const double offset[3], double *clearance);
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
                         double out[2]);
+typedef struct {
+  double gap, cap, friction, damping, alpha, dt, reach;
+} contact_params;
+double contact_moved(int64_t n, const double *x, const double *x0);
+int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
+                     const double *reach, const double *x, int exclude,
+                     const int64_t *node_offsets, const int64_t *node_segs, int64_t capacity,
+                     int64_t *offsets, int64_t *candidates, int64_t *work);
+void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
+                    const int64_t *candidates, const int64_t *segs, const double *stiffness0,
+                    const double *depth, const double *x, const double *v,
+                    const double *mass, const contact_params *prm, double *tangential, double *force,
+                    double *stiffness, double out[11]);
+double contact_step(int64_t n, const double *mass, double *stiffness);
+void contact_pack(int64_t n, const int64_t *rows, const double *X, const double *u,
+                  const double *v, const double *mass, double *packed);
+void contact_unpack(int64_t n, const int64_t *order, const double *packed, double *x,
+                    double *v, double *mass);
+double contact_apply(int64_t n, const int64_t *rows, const int64_t *where, const double *force,
+                     const double *mass, const double *v, double *a, double *kept);
+double contact_power(int64_t n, const int64_t *rows, const double *kept, const double *v);
 """
     + "".join(
         f"void {family}_{model}(int64_t n, const int32_t *cells, const double *X, const double *u,"

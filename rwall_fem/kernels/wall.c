@@ -6,7 +6,8 @@
  *   parallelogram inside it and at most two steps of normal travel behind it) and list
  *   the nodes in contact with what the response needs of them.
  * wall_impulses: the normal and tangential impulses (free, tied, Coulomb with the
- *   friction filter) of the listed nodes for a wall velocity.
+ *   friction filter of friction.h, the law the contact interfaces share) of the listed
+ *   nodes for a wall velocity.
  * wall_apply: add the impulses to a^n and sum what the wall books (impulses, works).
  * wall_work: the sum of impulse . (v - V) over listed nodes (the second half of a work).
  * wall_clearance: how far each secondary node is from being treated (selects the near set).
@@ -20,6 +21,7 @@
  * reductions (numpy_sum: pairwise in blocks of its buffer); no fused multiply-add.
  */
 #include "batch.h"
+#include "friction.h"
 
 #pragma GCC optimize("fp-contract=off")
 
@@ -300,17 +302,8 @@ void wall_impulses(int64_t k, int slide, double friction, double alpha,
     slip[i] = 0;
     if (slide == SLIDE_TIED)
       continue;
-    if (kept)
-      for (int c = 0; c < 3; ++c)
-        stick[c] = alpha * stick[c] + (1.0 - alpha) * kept[3 * i + c];
-    const double limit = friction * norm3(normal + 3 * i), size = norm3(stick);
-    if (size > limit)
-    {
-      slip[i] = 1;
-      const double scale = limit / size;
-      for (int c = 0; c < 3; ++c)
-        stick[c] = stick[c] * scale;
-    }
+    const double limit = friction * norm3(normal + 3 * i);
+    slip[i] = coulomb_law(stick, kept ? kept + 3 * i : NULL, alpha, limit);
   }
 }
 

@@ -32,7 +32,7 @@ LOCK = ".rwall-fem.lock"
 # What a run writes; whatever of it an earlier run left is removed when a run starts.
 STALE = (
     "summary.json", "energy.csv", "walls.csv", "histories.png", "run.log", "fields.xdmf",
-    "fields.h5", "animation.gif", "animation.mp4", "frames",
+    "fields.h5", "animation.gif", "animation.mp4", "frames", "contacts.csv",
 )  # fmt: skip
 
 

@@ -79,9 +79,12 @@ class History:
         # A body of [[part]]s: the energies of each part, which add up to the body's.
         explicit = getattr(sim.internal, "explicit", False)
         self.part_columns = sim.internal.part_columns() if explicit else ()
+        self.contacts = sim.contacts
+        contact_energies = ("contact_energy", "contact_friction") if sim.contacts else ()
         self.balance = EnergyBalance(
             initial_kinetic_energy(sim.state, walls, comm, rigid),
-            stored=("kinetic", *(("rigid_body",) if rigid else ()), *sim.internal.energy_names),
+            stored=("kinetic", *(("rigid_body",) if rigid else ()), *sim.internal.energy_names,
+                    *contact_energies),  # fmt: skip
             parts=sim.internal.energy_parts,
             works=works,
             extras=(("added_mass", "added_mass_percent") if scaled else ())
@@ -95,6 +98,13 @@ class History:
         self._walls_csv = CsvTable(self.directory / "walls.csv", WALL_COLUMNS, comm,
                                    column_scales(WALL_COLUMNS, "walls", units))  # fmt: skip
         self._tables = [self._energy_csv] + ([self._walls_csv] if walls else [])
+        self._contacts_csv = None
+        if sim.contacts:
+            from rwall_fem.contact.interface import CONTACT_COLUMNS
+
+            self._contacts_csv = CsvTable(self.directory / "contacts.csv", CONTACT_COLUMNS,
+                                          comm, column_scales(CONTACT_COLUMNS, "walls", units))
+            self._tables.append(self._contacts_csv)
         self._written_at = time.monotonic()
         self._sums = _Sums(
             comm,
@@ -103,6 +113,7 @@ class History:
             | {"damping_work": ()}
             | {"step_change_work": (), "eroded_cells": (), "parts": (len(self.part_columns),)}
             | {"signals": (len(SIGNALS),), "seconds": (), "failed": ()}
+            | {f"contact[{i}]": () for i in range(len(sim.contacts))}
             | self.wall_table.sums,
         )
         self._poll = _Sums(comm, {"signals": (len(SIGNALS),), "seconds": (), "failed": ()})
@@ -144,6 +155,12 @@ class History:
         local["kinetic"][...] = s.kinetic - sum(r.nodal_kinetic(s) for r in self.rigid)
         for name, value in sim.internal.energies(s).items():
             local[name][...] = value
+        if sim.contacts:
+            books = [c.energies() for c in sim.contacts]
+            for name in ("contact_energy", "contact_friction"):
+                local[name][...] = sum(b[name] for b in books)
+            for i, b in enumerate(books):
+                local[f"contact[{i}]"][...] = b["contact_energy"]
         local["external_work"][...] = (
             sum(f.work(s) for f in sim.forces if f not in self.damping)
             + sum(w.driving_work for w in sim.walls)
@@ -195,6 +212,9 @@ class History:
         self._energy_csv.append(self.balance.sample(s.t, energies, s.dt, extras))
         for row in self.wall_table.rows(s, total):
             self._walls_csv.append(row)
+        for i, contact in enumerate(sim.contacts):
+            energy = float(total[f"contact[{i}]"])
+            self._contacts_csv.append(contact.row(s.t, i, energy))
         signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
         self.guards.check(
             s,
@@ -251,6 +271,8 @@ class History:
                 raise table.error
         rows = [self._energy_csv.count, self._walls_csv.count]
         arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
+        if self._contacts_csv is not None:
+            arrays["contact_rows"] = np.array(self._contacts_csv.count)
         arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
         return arrays | {f"walls_{k}": v for k, v in self.wall_table.checkpoint_state().items()}
 
@@ -268,6 +290,8 @@ class History:
         energy_rows, wall_rows = arrays["rows"].tolist()
         latest = self._energy_csv.resume(energy_rows) or ()
         self._walls_csv.resume(wall_rows)
+        if self._contacts_csv is not None:
+            self._contacts_csv.resume(int(arrays["contact_rows"]))
         if list(latest) != list(self._energy_csv.in_units(arrays["balance_latest"].tolist())):
             raise ValueError(
                 f"{self._energy_csv.path}: row {energy_rows} is not the checkpoint's (the file "
@@ -286,6 +310,11 @@ class History:
     def energy(self) -> np.ndarray:
         """Energy samples, read back from ``energy.csv``, with its columns (collective)."""
         return self._energy_csv.read()
+
+    def contact(self, i: int) -> np.ndarray:
+        """Samples of contact ``i``, read back from ``contacts.csv`` (collective)."""
+        rows = self._contacts_csv.read()
+        return rows[rows[:, 1] == i]
 
     def wall(self, i: int) -> np.ndarray:
         """Samples of wall ``i``, read back from ``walls.csv``, with its columns (collective)."""

@@ -84,6 +84,7 @@ def run_summary(sim, balance, peak_contacts, initial_momentum: np.ndarray) -> di
         **_parts(sim, latest, comm),
         "walls": [_wall(w, peak, comm) for w, peak in zip(sim.walls, peak_contacts, strict=True)],
         "rigid_bodies": [_rigid_body(r, comm) for r in sim.rigid_bodies],
+        **({"contacts": [c.summary() for c in sim.contacts]} if sim.contacts else {}),
         "boundaries": [
             {
                 "name": b.name,

@@ -54,7 +54,8 @@ def _wall_column(name: str) -> str | None:
     return {"time": "time", "force": "force", "normal_force": "force",
             "tangential_force": "force", "impulse": "impulse", "normal_impulse": "impulse",
             "tangential_impulse": "impulse", "position": "length",
-            "velocity": "velocity"}.get(head)  # fmt: skip
+            "velocity": "velocity", "contact_energy": "energy",
+            "contact_friction": "energy"}.get(head)  # fmt: skip
 
 
 def column_scales(columns: Sequence[str], table: str, units: UnitSystem) -> list[float] | None:

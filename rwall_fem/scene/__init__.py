@@ -33,6 +33,7 @@ from rwall_fem.scene.schema import (
     Scene,
     Secondary,
     WallSpec,
+    ContactSpec,
 )
 
 __all__ = [
@@ -55,6 +56,7 @@ __all__ = [
     "SceneError",
     "Secondary",
     "WallSpec",
+    "ContactSpec",
     "apply_override",
     "load_scene",
     "parse_scene",

@@ -50,6 +50,7 @@ __all__ = [
     "AddedMassSpec",
     "BoundarySpec",
     "Damping",
+    "ContactSpec",
     "Element",
     "Failure",
     "Heating",
@@ -1105,6 +1106,90 @@ def _points_span_the_shape(v, raw, fail):
             fail("corner2", "sides corner1 - point and corner2 - point are parallel")
 
 
+# --- [[contact]] ----------------------------------------------------------------------
+
+
+@table(
+    "A contact interface between parts (Radioss /INTER/TYPE7, LS-DYNA *CONTACT_AUTOMATIC_"
+    "SURFACE_TO_SURFACE / _SINGLE_SURFACE): penalty forces between the boundary faces of "
+    "solid parts, with a gap and Coulomb friction."
+)
+@dataclass(frozen=True)
+class ContactSpec:
+    main: tuple[str, ...] = key(
+        Names(),
+        (),
+        doc="the parts whose boundary faces are the main segments (with self: the parts "
+        "in contact with themselves)",
+        default_doc="with self: every part",
+    )
+    secondary: tuple[str, ...] = key(
+        Names(), (), doc="the parts whose boundary nodes are the secondary nodes (not with self)"
+    )
+    single_surface: bool = key(
+        Flag(),
+        False,
+        toml="self",
+        doc="self-contact of the main parts (a node against every segment but its own and "
+        "their neighbours')",
+    )
+    symmetric: bool = key(
+        Flag(), True, doc="two passes: each side's nodes against the other's segments"
+    )
+    gap: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="the contact distance (Radioss Gapmin): forces act below it and stiffen toward "
+        "it, k0 g / (g - p) at penetration p",
+        default_doc="0.1 x the shortest edge of the segments",
+    )
+    stiffness_scale: float = key(
+        Real(low=0.0),
+        1.0,
+        doc="Radioss Stfac: scales the penalty stiffness k0 = B A^2 / V of the cell under "
+        "each segment",
+    )
+    damping: float = key(
+        Real(low=0.0, low_open=False, high=1.0),
+        0.05,
+        doc="Radioss VISs: the normal damping of each pair, a fraction of its critical "
+        "damping 2 sqrt(k m)",
+    )
+    friction: float = key(Real(low=0.0, low_open=False), 0.0, doc="the Coulomb coefficient mu")
+    friction_filter: tuple[str, float] | None = key(
+        Sub(FrictionFilter, then=_filter),
+        None,
+        doc="(how, value): smooths the friction force, as the walls' filter",
+        default_doc="none",
+    )
+
+
+@rule(
+    ContactSpec,
+    json=[
+        {
+            "if": {"properties": {"self": {"const": True}}, "required": ["self"]},
+            "then": {"properties": {"secondary": {"maxItems": 0}}},
+            "else": {
+                "required": ["main", "secondary"],
+                "properties": {"main": {"minItems": 1}, "secondary": {"minItems": 1}},
+            },
+        }
+    ],
+)
+def _sides_are_named(v, raw, fail):
+    """Without self, main and secondary each name at least one part; with self, secondary
+    is not given."""
+    if v["single_surface"]:
+        if v["secondary"]:
+            fail("secondary", "self-contact has no secondary parts: name the parts in main")
+        return
+    for side in ("main", "secondary"):
+        if not v[side]:
+            fail(side, "names no part; give at least one part name (or self = true)")
+
+
 # --- [[part]] -------------------------------------------------------------------------
 
 
@@ -1289,6 +1374,9 @@ class Scene:
     )  # fmt: skip
     damping: Damping | None = key(
         Sub(Damping), None, doc="Rayleigh damping", default_doc="none"
+    )
+    contacts: tuple[ContactSpec, ...] = key(
+        Each(ContactSpec), (), toml="contact", doc="contact interfaces between parts"
     )
     parts: tuple[PartSpec, ...] = key(
         Each(PartSpec), (), toml="part", doc="the parts of the body", default_doc="one: the body"

@@ -1,0 +1,119 @@
+"""The main surface of a contact interface: the boundary faces of solid parts as segments.
+
+A face of a part's cells is on the part's boundary when no other cell of the part holds
+it (faces between two parts bonded by shared nodes belong to both parts' surfaces). Each
+segment is oriented outward (its normal ``(p2 - p0) x (p3 - p1)``, or ``(p1 - p0) x (p2 -
+p0)`` for a triangle, points away from its cell) and carries, from that cell at the start:
+
+- the penalty stiffness of Radioss's TYPE7 for a solid main segment (Istf = 0 with the
+  default Stfac): ``k0 = stiffness_scale x B A^2 / V`` (N/m), B = lambda + 2 mu / 3 the
+  bulk modulus of the cell's material, A the face's area, V the cell's volume;
+- the depth ``V / (2 A)`` (m, half the cell's height under the face): how far behind the
+  face a node is still pushed out (deeper, it is taken for a node of the other side);
+- its shortest edge (m): the default gap is 0.1 x the shortest of them (Radioss Gapmin).
+
+Every rank gets every segment of the interface, in global node numbers, in one order that
+does not depend on the partition (sorted by their nodes): the contact is then computed the
+same way on any number of ranks (:mod:`rwall_fem.contact.interface`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Surface", "part_surface"]
+
+# The faces of DOLFINx's reference cells as cycles of their vertices.
+_FACES = {
+    8: ((0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5)),
+    4: ((1, 2, 3, -1), (0, 2, 3, -1), (0, 1, 3, -1), (0, 1, 2, -1)),
+}
+
+
+@dataclass
+class Surface:
+    """Segments (rows of 4 global node numbers, -1 as the 4th of a triangle), their
+    stiffness k0 (N/m, before the interface's scale), depth (m) and shortest edge (m)."""
+
+    segments: np.ndarray
+    stiffness: np.ndarray
+    depth: np.ndarray
+    edge: np.ndarray
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """The global numbers of the segments' nodes, sorted."""
+        ids = self.segments.ravel()
+        return np.unique(ids[ids >= 0])
+
+    def __add__(self, other: Surface) -> Surface:
+        return Surface(*(np.concatenate([a, b]) for a, b in zip(
+            (self.segments, self.stiffness, self.depth, self.edge),
+            (other.segments, other.stiffness, other.depth, other.edge), strict=True)))  # fmt: skip
+
+
+def _area_vector(p: np.ndarray, triangle: np.ndarray) -> np.ndarray:
+    """(faces, 3): the normal times the area of each face of corners p (faces, 4, 3)."""
+    quad = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
+    tri = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return 0.5 * np.where(triangle[:, None], tri, quad)
+
+
+def part_surface(body, k: int, comm) -> Surface:
+    """The boundary faces of part ``k`` of ``body`` (a :class:`~rwall_fem.body.Body`), the
+    same on every rank of ``comm`` (collective)."""
+    force = body.elements[k]
+    cells, X = force.cells, body.X
+    faces = np.array(_FACES[cells.shape[1]])
+    triangle_cells = cells.shape[1] == 4
+    lmbda, mu = body.parts[k].material.lame
+    bulk = lmbda + 2.0 * mu / 3.0
+    imap = body.V.dofmap.index_map
+    to_global = imap.local_to_global
+    n, per = len(cells), len(faces)
+    local = np.full((n, per, 4), -1, dtype=np.int64)
+    for f, face in enumerate(faces):
+        for c, vertex in enumerate(face):
+            if vertex >= 0:
+                local[:, f, c] = cells[:, vertex]
+    local = local.reshape(-1, 4)
+    triangle = np.full(len(local), triangle_cells)
+    corners = X[np.where(local >= 0, local, local[:, :1])]  # (faces, 4, 3)
+    centre = np.repeat(X[cells].mean(axis=1), per, axis=0)
+    face_centre = np.where(triangle[:, None], corners[:, :3].mean(axis=1), corners.mean(axis=1))
+    area_vector = _area_vector(corners, triangle)
+    outward = np.einsum("ij,ij->i", area_vector, face_centre - centre) >= 0.0
+    flipped = local.copy()
+    flipped[:, 1:] = np.where(triangle[:, None], local[:, [2, 1, 3]], local[:, [3, 2, 1]])
+    local = np.where(outward[:, None], local, flipped)
+    # The cell's volume: the cones of its faces (triangles about their centres) to its centre.
+    volume = np.zeros(n * per)
+    for c in range(4):
+        a, b = corners[:, c], corners[:, (c + 1) % 4]
+        cone = np.abs(np.einsum("ij,ij->i", np.cross(a - face_centre, b - face_centre),
+                                face_centre - centre)) / 6.0  # fmt: skip
+        volume += np.where(triangle & (c == 3), 0.0, cone)
+    volume = volume.reshape(n, per).sum(axis=1)
+    if triangle_cells:  # the triangle's fan about its centre covers 3 of the 4 terms
+        volume = np.abs(np.einsum("ij,ij->i", np.cross(X[cells[:, 1]] - X[cells[:, 0]],
+                        X[cells[:, 2]] - X[cells[:, 0]]), X[cells[:, 3]] - X[cells[:, 0]])) / 6.0
+    volume = np.repeat(volume, per)
+    area = np.linalg.norm(area_vector, axis=1)
+    edges = [np.linalg.norm(corners[:, (c + 1) % 4] - corners[:, c], axis=1) for c in range(4)]
+    edge = np.minimum.reduce(edges[:2] + [np.where(triangle, np.linalg.norm(
+        corners[:, 0] - corners[:, 2], axis=1), np.minimum(edges[2], edges[3]))])  # fmt: skip
+    ids = np.where(local >= 0, to_global(np.where(local >= 0, local, 0).ravel().astype(np.int32)).reshape(-1, 4), -1)
+    values = np.column_stack([bulk * area**2 / volume, 0.5 * volume / area, edge])
+    # The faces held once on this rank, then once over all ranks.
+    key = np.sort(ids, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    once = np.sort(first[counts == 1])
+    gathered = comm.allgather((ids[once], key[once], values[once]))
+    ids = np.concatenate([g[0] for g in gathered]).reshape(-1, 4)
+    key = np.concatenate([g[1] for g in gathered]).reshape(-1, 4)
+    values = np.concatenate([g[2] for g in gathered]).reshape(-1, 3)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    keep = first[counts == 1]  # np.unique sorts by key: the same order on any partition
+    return Surface(ids[keep], *values[keep].T.copy())

@@ -1,0 +1,587 @@
+/* Node-to-surface penalty contact (Radioss /INTER/TYPE7; rwall_fem/contact/, docs/theory.md,
+ * "Contact between bodies").  All arrays index the interface's surface nodes (the nodes of
+ * its segments and its secondary nodes, gathered from every rank), rows of 3 for vectors.
+ * A segment is 4 node indices: a quadrilateral, or a triangle whose 4th is -1.
+ *
+ * contact_moved: the largest squared distance a node moved since the last sort.
+ * contact_sort: the candidate segments of each secondary node, by buckets (spatial hashing):
+ *   the secondary nodes go into a grid of cubes, each segment is tested against the nodes
+ *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
+ *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
+ *   segment, whatever the grid.
+ * contact_forces: one pass of the secondary nodes against their candidates: the closest
+ *   point of the closest segment (a quadrilateral as 4 triangles about its centre), the
+ *   penalty force of the penetration p = gap - d (d the signed distance, < 0 behind the
+ *   surface) stiffening toward p = gap (k0 g / (g - p), held beyond p = cap g), Coulomb
+ *   friction on an elastic tangential spring of stiffness k0 (friction.h's law and filter),
+ *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m): the
+ *   tangent of the springs in contact, k0 for those within reach of a segment but not in
+ *   contact (so that the step does not jump as nodes come and go).
+ * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
+ */
+#include <stdlib.h>
+
+#include "batch.h"
+#include "friction.h"
+
+typedef struct
+{
+  double gap;      /* m */
+  double cap;      /* the penetration ratio p / gap beyond which the stiffness stays */
+  double friction; /* Coulomb's mu (0: none) */
+  double damping;  /* the normal damping's fraction of critical (Radioss VISs) */
+  double alpha;    /* the friction filter's weight of the new force (1: no filter) */
+  double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
+  double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+} contact_params;
+
+INLINE double cdot(const double x[3], const double y[3])
+{
+  return (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2];
+}
+
+INLINE void csub(const double *a, const double *b, double r[3])
+{
+  for (int c = 0; c < 3; ++c)
+    r[c] = a[c] - b[c];
+}
+
+INLINE void ccross(const double a[3], const double b[3], double r[3])
+{
+  r[0] = a[1] * b[2] - a[2] * b[1];
+  r[1] = a[2] * b[0] - a[0] * b[2];
+  r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+double contact_moved(int64_t n, const double *restrict x, const double *restrict x0)
+{
+  double largest = 0.0;
+  for (int64_t i = 0; i < 3 * n; i += 3)
+  {
+    const double dx = x[i] - x0[i], dy = x[i + 1] - x0[i + 1], dz = x[i + 2] - x0[i + 2];
+    const double d = dx * dx + dy * dy + dz * dz;
+    largest = d > largest || isnan(d) ? d : largest;
+  }
+  return largest;
+}
+
+/* Whether node s shares a node with a segment that holds s or a neighbour of it: segment
+ * `seg` holds a node of some segment holding s (node_segs: CSR of the segments of each
+ * node). */
+static int excluded(int64_t s, const int64_t *seg, const int64_t *node_offsets,
+                    const int64_t *node_segs, const int64_t *segs)
+{
+  for (int64_t k = node_offsets[s]; k < node_offsets[s + 1]; ++k)
+  {
+    const int64_t *own = segs + 4 * node_segs[k];
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        if (seg[a] >= 0 && seg[a] == own[b])
+          return 1;
+  }
+  return 0;
+}
+
+/* Candidates of the nsec secondary nodes `secondary` among the nseg segments `segs`, each
+ * widened by reach[j] (m), at positions x.  Fills offsets (nsec + 1) and up to `capacity`
+ * candidates (segment indices, sorted per node); `work` holds 2 nsec + 2 capacity + 1
+ * int64.  Returns the number of candidates (more than capacity: call again with room). */
+int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t nseg,
+                     const int64_t *restrict segs, const double *restrict reach,
+                     const double *restrict x, int exclude, const int64_t *restrict node_offsets,
+                     const int64_t *restrict node_segs, int64_t capacity,
+                     int64_t *restrict offsets, int64_t *restrict candidates,
+                     int64_t *restrict work)
+{
+  for (int64_t i = 0; i <= nsec; ++i)
+    offsets[i] = 0;
+  if (nsec == 0 || nseg == 0)
+    return 0;
+  /* The grid: cubes of the largest widened segment box, over the secondary nodes' box. */
+  double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int64_t i = 0; i < nsec; ++i)
+    for (int c = 0; c < 3; ++c)
+    {
+      const double xc = x[3 * secondary[i] + c];
+      low[c] = xc < low[c] ? xc : low[c];
+      high[c] = xc > high[c] ? xc : high[c];
+    }
+  double h = 0.0;
+  for (int64_t j = 0; j < nseg; ++j)
+    for (int c = 0; c < 3; ++c)
+    {
+      double a = INFINITY, b = -INFINITY;
+      for (int k = 0; k < 4; ++k)
+      {
+        const int64_t node = segs[4 * j + k];
+        if (node < 0)
+          continue;
+        a = x[3 * node + c] < a ? x[3 * node + c] : a;
+        b = x[3 * node + c] > b ? x[3 * node + c] : b;
+      }
+      h = b - a + 2.0 * reach[j] > h ? b - a + 2.0 * reach[j] : h;
+    }
+  int64_t dims[3];
+  for (;;)
+  {
+    double cells = 1.0;
+    for (int c = 0; c < 3; ++c)
+    {
+      dims[c] = (int64_t)floor((high[c] - low[c]) / h) + 1;
+      cells *= (double)dims[c];
+    }
+    if (cells <= 2.0 * (double)nsec + 8.0)
+      break;
+    h *= 1.5;
+  }
+  const int64_t buckets = dims[0] * dims[1] * dims[2];
+  /* Counting sort of the secondary nodes into the buckets: start[b] .. start[b + 1]. */
+  int64_t *bucket_of = work, *order = work + nsec;
+  int64_t *start = (int64_t *)calloc(buckets + 1, sizeof(int64_t));
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    int64_t b = 0;
+    for (int c = 0; c < 3; ++c)
+    {
+      int64_t k = (int64_t)floor((x[3 * secondary[i] + c] - low[c]) / h);
+      k = k < 0 ? 0 : (k >= dims[c] ? dims[c] - 1 : k);
+      b = b * dims[c] + k;
+    }
+    bucket_of[i] = b;
+    start[b + 1] += 1;
+  }
+  for (int64_t b = 0; b < buckets; ++b)
+    start[b + 1] += start[b];
+  int64_t *fill = (int64_t *)malloc((buckets + 1) * sizeof(int64_t));
+  for (int64_t b = 0; b <= buckets; ++b)
+    fill[b] = start[b];
+  for (int64_t i = 0; i < nsec; ++i)
+    order[fill[bucket_of[i]]++] = i;
+  /* The pairs (segment, node) in segment order, then sorted by node (stable). */
+  int64_t *pair_node = work + 2 * nsec, *pair_seg = pair_node + capacity;
+  int64_t count = 0;
+  for (int64_t j = 0; j < nseg; ++j)
+  {
+    const int64_t *seg = segs + 4 * j;
+    double a[3] = {INFINITY, INFINITY, INFINITY}, b[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < 4; ++k)
+      if (seg[k] >= 0)
+        for (int c = 0; c < 3; ++c)
+        {
+          const double xc = x[3 * seg[k] + c];
+          a[c] = xc < a[c] ? xc : a[c];
+          b[c] = xc > b[c] ? xc : b[c];
+        }
+    int64_t from[3], to[3];
+    for (int c = 0; c < 3; ++c)
+    {
+      a[c] -= reach[j];
+      b[c] += reach[j];
+      from[c] = (int64_t)floor((a[c] - low[c]) / h);
+      to[c] = (int64_t)floor((b[c] - low[c]) / h);
+      from[c] = from[c] < 0 ? 0 : from[c];
+      to[c] = to[c] >= dims[c] ? dims[c] - 1 : to[c];
+    }
+    for (int64_t p = from[0]; p <= to[0]; ++p)
+      for (int64_t q = from[1]; q <= to[1]; ++q)
+        for (int64_t r = from[2]; r <= to[2]; ++r)
+        {
+          const int64_t bucket = (p * dims[1] + q) * dims[2] + r;
+          for (int64_t m = start[bucket]; m < start[bucket + 1]; ++m)
+          {
+            const int64_t i = order[m], s = secondary[i];
+            int inside = 1;
+            for (int c = 0; c < 3; ++c)
+              inside &= x[3 * s + c] >= a[c] && x[3 * s + c] <= b[c];
+            if (!inside)
+              continue;
+            int own = 0;
+            for (int k = 0; k < 4; ++k)
+              own |= seg[k] == s;
+            if (own || (exclude && excluded(s, seg, node_offsets, node_segs, segs)))
+              continue;
+            if (count < capacity)
+            {
+              pair_node[count] = i;
+              pair_seg[count] = j;
+            }
+            ++count;
+          }
+        }
+  }
+  free(start);
+  free(fill);
+  if (count > capacity)
+    return count;
+  for (int64_t k = 0; k < count; ++k)
+    offsets[pair_node[k] + 1] += 1;
+  for (int64_t i = 0; i < nsec; ++i)
+    offsets[i + 1] += offsets[i];
+  int64_t *next = work; /* nsec + 1 values: bucket_of and order are done with */
+  for (int64_t i = 0; i <= nsec; ++i)
+    next[i] = offsets[i];
+  for (int64_t k = 0; k < count; ++k)
+    candidates[next[pair_node[k]]++] = pair_seg[k];
+  return count;
+}
+
+/* The closest point of triangle (a, b, c) to p as barycentric weights (Ericson, Real-Time
+ * Collision Detection, 5.1.5). */
+static void closest_on_triangle(const double p[3], const double a[3], const double b[3],
+                                const double c[3], double w[3])
+{
+  double ab[3], ac[3], ap[3], bp[3], cp[3];
+  csub(b, a, ab);
+  csub(c, a, ac);
+  csub(p, a, ap);
+  const double d1 = cdot(ab, ap), d2 = cdot(ac, ap);
+  w[0] = 1.0, w[1] = 0.0, w[2] = 0.0;
+  if (d1 <= 0.0 && d2 <= 0.0)
+    return;
+  csub(p, b, bp);
+  const double d3 = cdot(ab, bp), d4 = cdot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3)
+  {
+    w[0] = 0.0, w[1] = 1.0;
+    return;
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+  {
+    const double v = d1 / (d1 - d3);
+    w[0] = 1.0 - v, w[1] = v;
+    return;
+  }
+  csub(p, c, cp);
+  const double d5 = cdot(ab, cp), d6 = cdot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6)
+  {
+    w[0] = 0.0, w[2] = 1.0;
+    return;
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+  {
+    const double t = d2 / (d2 - d6);
+    w[0] = 1.0 - t, w[2] = t;
+    return;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+  {
+    const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    w[0] = 0.0, w[1] = 1.0 - t, w[2] = t;
+    return;
+  }
+  const double denominator = va + vb + vc;
+  if (!(denominator > 0.0)) /* a degenerate triangle: its first corner */
+    return;
+  const double v = vb / denominator, t = vc / denominator;
+  w[0] = 1.0 - v - t, w[1] = v, w[2] = t;
+}
+
+/* The closest point q of segment `seg` to p, its weights on the segment's nodes (4), and
+ * the segment's unit normal (outward). */
+static void closest_on_segment(const double p[3], const int64_t *seg, const double *x,
+                               double q[3], double weights[4], double normal[3])
+{
+  const int corners = seg[3] >= 0 ? 4 : 3;
+  const double *y[4];
+  for (int k = 0; k < corners; ++k)
+    y[k] = x + 3 * seg[k];
+  double e1[3], e2[3];
+  if (corners == 3)
+  {
+    csub(y[1], y[0], e1);
+    csub(y[2], y[0], e2);
+  }
+  else
+  {
+    csub(y[2], y[0], e1);
+    csub(y[3], y[1], e2);
+  }
+  ccross(e1, e2, normal);
+  const double length = sqrt(cdot(normal, normal));
+  for (int c = 0; c < 3; ++c)
+    normal[c] = length > 0.0 ? normal[c] / length : 0.0;
+  for (int k = 0; k < 4; ++k)
+    weights[k] = 0.0;
+  if (corners == 3)
+  {
+    closest_on_triangle(p, y[0], y[1], y[2], weights);
+  }
+  else
+  {
+    double centre[3];
+    for (int c = 0; c < 3; ++c)
+      centre[c] = 0.25 * (((y[0][c] + y[1][c]) + y[2][c]) + y[3][c]);
+    double best = INFINITY;
+    for (int k = 0; k < 4; ++k)
+    {
+      const int l = (k + 1) % 4;
+      double w[3], r[3];
+      closest_on_triangle(p, centre, y[k], y[l], w);
+      for (int c = 0; c < 3; ++c)
+        r[c] = p[c] - (w[0] * centre[c] + w[1] * y[k][c] + w[2] * y[l][c]);
+      const double d = cdot(r, r);
+      if (d < best)
+      {
+        best = d;
+        for (int m = 0; m < 4; ++m)
+          weights[m] = 0.25 * w[0];
+        weights[k] += w[1];
+        weights[l] += w[2];
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    q[c] = 0.0;
+    for (int k = 0; k < corners; ++k)
+      q[c] += weights[k] * y[k][c];
+  }
+}
+
+/* The normal force (N) of penetration p (m) for stiffness k0 (N/m) and gap g (m), its
+ * tangent stiffness (N/m, into *tangent) and stored energy (J, into *energy):
+ * f = -k0 g ln(1 - p/g) up to p = cap g, then on along its tangent there. */
+static double penalty(double p, double k0, double g, double cap, double *tangent,
+                      double *energy)
+{
+  const double x = p / g;
+  if (x <= cap)
+  {
+    const double l = log1p(-x);
+    *tangent = k0 / (1.0 - x);
+    *energy = k0 * g * g * ((1.0 - x) * l + x);
+    return -k0 * g * l;
+  }
+  const double l = log1p(-cap), kc = k0 / (1.0 - cap), beyond = p - cap * g;
+  *tangent = kc;
+  *energy = k0 * g * g * ((1.0 - cap) * l + cap) - k0 * g * l * beyond + 0.5 * kc * beyond * beyond;
+  return -k0 * g * l + kc * beyond;
+}
+
+/* One pass: the nsec secondary nodes against their candidate segments.  `stiffness0` and
+ * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
+ * `tangential` (nsec rows) is each secondary node's friction force of the previous step
+ * (N), updated.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
+ * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
+ * tangential springs' energy (J), [9] what friction and damping dissipated over the step (J),
+ * [10] the sum of the normal forces' sizes (N). */
+void contact_forces(int64_t nsec, const int64_t *restrict secondary,
+                    const int64_t *restrict offsets, const int64_t *restrict candidates,
+                    const int64_t *restrict segs, const double *restrict stiffness0,
+                    const double *restrict depth, const double *restrict x,
+                    const double *restrict v, const double *restrict mass,
+                    const contact_params *prm,
+                    double *restrict tangential, double *restrict force,
+                    double *restrict stiffness, double out[11])
+{
+  for (int c = 0; c < 11; ++c)
+    out[c] = 0.0;
+  const double g = prm->gap;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    const int64_t s = secondary[i];
+    const double *xs = x + 3 * s;
+    int64_t best = -1;
+    double best_distance = INFINITY, best_cos = 0.0, best_weights[4] = {0.0}, best_n[3] = {0.0}, best_d = 0.0;
+    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
+    {
+      const int64_t j = candidates[k];
+      double q[3], w[4], n[3], r[3];
+      closest_on_segment(xs, segs + 4 * j, x, q, w, n);
+      csub(xs, q, r);
+      const double distance = sqrt(cdot(r, r));
+      const double along = cdot(r, n);
+      const double d = along >= 0.0 ? distance : -distance;
+      /* The closest segment decides, in contact or not: a node just beyond the gap in
+       * front of one face is not inside its neighbour at the edge. */
+      if (!(distance < prm->reach)) /* out of reach (and NaN) */
+        continue;
+      const double cosine = distance > 0.0 ? fabs(along) / distance : 1.0;
+      const double tie = 1e-9 * (distance + best_distance);
+      if (best >= 0 && (distance > best_distance + tie ||
+                        (distance >= best_distance - tie && cosine <= best_cos)))
+        continue;
+      best = j, best_distance = distance, best_cos = cosine, best_d = d;
+      for (int m = 0; m < 4; ++m)
+        best_weights[m] = w[m];
+      if (distance > 1e-12 * g)
+        for (int c = 0; c < 3; ++c)
+          best_n[c] = (d >= 0.0 ? r[c] : -r[c]) / distance;
+      else
+        for (int c = 0; c < 3; ++c)
+          best_n[c] = n[c];
+    }
+    double *ft = tangential + 3 * i;
+    if (best >= 0 && !(best_d < g && -best_d < depth[best]))
+    {
+      /* Near but not in contact: its spring's stiffness counts in the step all the same,
+       * so that the step does not jump as nodes come into and out of contact. */
+      const int64_t *seg = segs + 4 * best;
+      stiffness[s] += stiffness0[best];
+      for (int m = 0; m < 4; ++m)
+        if (seg[m] >= 0)
+          stiffness[seg[m]] += best_weights[m] * stiffness0[best];
+      best = -1;
+    }
+    if (best < 0)
+    {
+      ft[0] = ft[1] = ft[2] = 0.0;
+      continue;
+    }
+    const int64_t *seg = segs + 4 * best;
+    const double k0 = stiffness0[best];
+    double kt, energy;
+    const double spring = penalty(g - best_d, k0, g, prm->cap, &kt, &energy);
+    /* The velocity relative to the segment's point, and the normal damping of the pair
+     * (masses m_s and sum w_i m_i): c = 2 damping sqrt(kt m_s m_main / (m_s + m_main)),
+     * its force bounded by the spring's: the normal force starts at 0 as a node comes
+     * into contact (no jump for round-off to decide) and never pulls. */
+    double w[3];
+    double main_mass = 0.0;
+    for (int c = 0; c < 3; ++c)
+      w[c] = v[3 * s + c];
+    for (int m = 0; m < 4; ++m)
+      if (seg[m] >= 0)
+      {
+        main_mass += best_weights[m] * mass[seg[m]];
+        for (int c = 0; c < 3; ++c)
+          w[c] -= best_weights[m] * v[3 * seg[m] + c];
+      }
+    const double wn = cdot(w, best_n);
+    const double reduced = mass[s] * main_mass / (mass[s] + main_mass);
+    const double viscous = 2.0 * prm->damping * sqrt(kt * reduced);
+    double damper = -viscous * wn;
+    damper = damper > spring ? spring : (damper < -spring ? -spring : damper);
+    const double fn = spring + damper;
+    out[9] += (spring - fn) * wn * prm->dt; /* what the damping took over the step */
+    double f[3];
+    for (int c = 0; c < 3; ++c)
+      f[c] = fn * best_n[c];
+    if (prm->friction > 0.0)
+    {
+      /* The tangential relative velocity, and the elastic trial force. */
+      double old[3], trial[3];
+      const double on = cdot(ft, best_n);
+      for (int c = 0; c < 3; ++c)
+      {
+        w[c] -= wn * best_n[c];
+        old[c] = ft[c] - on * best_n[c];
+        trial[c] = old[c] - k0 * prm->dt * w[c];
+      }
+      coulomb_law(trial, prm->alpha < 1.0 ? old : NULL, prm->alpha, prm->friction * fn);
+      double slip = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        slip += trial[c] * (w[c] * prm->dt + (trial[c] - old[c]) / k0);
+        ft[c] = trial[c];
+        f[c] += trial[c];
+        out[3 + c] += trial[c];
+      }
+      out[8] += 0.5 * cdot(trial, trial) / k0;
+      out[9] -= slip;
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      force[3 * s + c] += f[c];
+      out[c] += f[c];
+    }
+    stiffness[s] += kt;
+    for (int m = 0; m < 4; ++m)
+    {
+      if (seg[m] < 0)
+        continue;
+      for (int c = 0; c < 3; ++c)
+        force[3 * seg[m] + c] -= best_weights[m] * f[c];
+      stiffness[seg[m]] += best_weights[m] * kt;
+    }
+    out[6] += 1.0;
+    out[7] += energy;
+    out[10] += fn;
+  }
+}
+
+double contact_step(int64_t n, const double *restrict mass, double *restrict stiffness)
+{
+  double smallest = INFINITY;
+  for (int64_t i = 0; i < n; ++i)
+  {
+    if (stiffness[i] > 0.0)
+    {
+      const double dt = sqrt(2.0 * mass[i] / stiffness[i]);
+      smallest = dt < smallest ? dt : smallest;
+    }
+    stiffness[i] = 0.0;
+  }
+  return smallest;
+}
+
+/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg). */
+void contact_pack(int64_t n, const int64_t *restrict rows, const double *restrict X,
+                  const double *restrict u, const double *restrict v,
+                  const double *restrict mass, double *restrict packed)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t r = rows[i];
+    double *p = packed + 7 * i;
+    for (int c = 0; c < 3; ++c)
+    {
+      p[c] = X[3 * r + c] + u[3 * r + c];
+      p[3 + c] = v[3 * r + c];
+    }
+    p[6] = mass[r];
+  }
+}
+
+/* Packed rows to the surface nodes `order` (their positions, velocities and masses). */
+void contact_unpack(int64_t n, const int64_t *restrict order, const double *restrict packed,
+                    double *restrict x, double *restrict v, double *restrict mass)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t k = order[i];
+    const double *p = packed + 7 * i;
+    for (int c = 0; c < 3; ++c)
+    {
+      x[3 * k + c] = p[c];
+      v[3 * k + c] = p[3 + c];
+    }
+    mass[k] = p[6];
+  }
+}
+
+/* Add the surface forces (rows `where`) to the accelerations of the state's rows `rows`,
+ * keep them in `kept` (n rows) and return sum f . v (W) over them. */
+double contact_apply(int64_t n, const int64_t *restrict rows, const int64_t *restrict where,
+                     const double *restrict force, const double *restrict mass,
+                     const double *restrict v, double *restrict a, double *restrict kept)
+{
+  double power = 0.0;
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int64_t r = rows[i], k = where[i];
+    for (int c = 0; c < 3; ++c)
+    {
+      const double f = force[3 * k + c];
+      kept[3 * i + c] = f;
+      a[3 * r + c] += f / mass[r];
+      power += f * v[3 * r + c];
+    }
+  }
+  return power;
+}
+
+/* sum f . v (W) of the kept forces (n rows) at the state's rows `rows`. */
+double contact_power(int64_t n, const int64_t *restrict rows, const double *restrict kept,
+                     const double *restrict v)
+{
+  double power = 0.0;
+  for (int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      power += kept[3 * i + c] * v[3 * rows[i] + c];
+  return power;
+}
