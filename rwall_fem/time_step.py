@@ -114,7 +114,7 @@ class _StepSize:
         self._local = np.zeros(4)
         self._total = np.zeros(4)
         self._reductions = 0  # steps reduced so far: the cache key of controlling_cell
-        self._cell = None  # (key, what controlling_cell found)
+        self._cells: dict = {}  # what controlling_cell found at this step, by its key
         self.contacts = []  # contact interfaces: their nodal stable steps (s) bound the step
 
     def _reduce(self, s) -> tuple[float, int, int]:
@@ -167,8 +167,8 @@ class _StepSize:
         None), collective; but a second call at the same step, as from a recorder on rank
         0 alone after the run log, reads the first's answer. None without estimates."""
         key = (self._reductions, describe)
-        if self._cell is not None and self._cell[0] == key:
-            return self._cell[1]
+        if key in self._cells:
+            return self._cells[key]
         if self.force is None or not math.isfinite(self.limit):
             return None
         step = self.force.step
@@ -180,7 +180,9 @@ class _StepSize:
             held = (body.cell_position(cell).tolist(), text, part)
         found = next((h for h in self.comm.allgather(held) if h is not None), None)
         answer = None if found is None else (self.limit, *found)
-        self._cell = (key, answer)
+        # both kinds of answer of this step are kept: a recorder on rank 0 alone may ask
+        # for either after the run log asked for both
+        self._cells = {k: v for k, v in self._cells.items() if k[0] == key[0]} | {key: answer}
         return answer
 
     def advance(self, s) -> None:

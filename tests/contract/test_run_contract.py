@@ -331,6 +331,7 @@ def test_the_reference_scene_uses_every_key():
     load_scene(path)
     text = path.read_text()
     keys = set(re.findall(r"(?:^#?\s*|[{,]\s*)(\w+)\s*=", text, re.MULTILINE))
+    keys |= set(re.findall(r"^(?:# )?\[\[?[\w.]*\.(\w+)\]\]?", text, re.MULTILINE))  # [a.b]
     top = set(re.findall(r"^(?:# )?\[\[?(\w+)\]\]?", text, re.MULTILINE))
     accepted = [(where, name) for where, _, cls in tables() for name in keys_of(cls)]
     missing = [

@@ -94,6 +94,16 @@ OTHERS = [
     FULL | {"load": [{"kind": "pressure", "group": "top", "pressure": 1e5}]},
     FULL
     | {
+        "contact": [
+            {
+                "main": ["body"], "self": True, "symmetric": True, "gap": 1e-4,
+                "stiffness_scale": 1.0, "damping": 0.05, "friction": 0.2,
+                "friction_filter": {"coefficient": 0.5},
+            }
+        ]
+    },  # fmt: skip
+    FULL
+    | {
         "mesh": {"shape": "round_bar", "radius": 0.01, "length": 0.1, "element_size": 0.01},
         "material": {
             "model": "elastic_plastic",
