@@ -82,8 +82,9 @@ INLINE vec flow_factor(const element_params *p, vec rate, vec T)
 }
 
 /* The flow stress (Pa) of plasticity.h at plastic strain e: the law capped at p->max_flow_stress
- * times `factor` (flow_factor; cap_flow_stress), and its slope (0 where the cap holds).  The power laws' e^n is taken
- * as exp(n log e) on all lanes at once (batch.h), and its slope as n e^n / e. */
+ * times `factor` (flow_factor; cap_flow_stress), and its slope (0 where the cap holds).
+ * The power laws' e^n is taken as exp(n log e) on all lanes at once (batch.h), and its slope
+ * as n e^n / e. */
 INLINE vec capped_flow_stress(const element_params *p, vec e, vec factor,
                               vec *slope)
 {

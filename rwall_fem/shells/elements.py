@@ -239,8 +239,8 @@ class ShellKernel:
     :meth:`run` adds the internal forces and moments of the cells into ``f`` and ``m``.
     ``material`` needs ``young``, ``poisson``, ``density`` and, elasto-plastic (``plastic``),
     the hardening constants of :class:`rwall_fem.scene.Material`; ``max_flow_stress`` (Pa)
-    caps the flow stress (inf: no cap), ``failed_share`` is the share of a cell's points that must fail
-    for the cell to fail (1: all).
+    caps the flow stress (inf: no cap), ``failed_share`` is the share of a cell's points that
+    must fail for the cell to fail (1: all).
     """
 
     def __init__(
