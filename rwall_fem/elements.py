@@ -355,6 +355,7 @@ class ElementForce:
         p.hardening_exponent = material.hardening_exponent or 0.0
         p.rate_coefficient = material.strain_rate_coefficient
         p.reference_rate = material.reference_strain_rate
+        p.max_flow_stress = material.max_flow_stress or 0.0  # 0: no cap
         if material.hardening_curve is not None:
             p.table_size = len(material.hardening_curve)
             for i, (strain, stress) in enumerate(material.hardening_curve):

@@ -78,6 +78,7 @@ typedef struct {
   double thermal_exponent, melting_temperature, room_temperature, specific_heat, taylor_quinney;
   int table_size;
   double table_strain[64], table_stress[64];
+  double max_flow_stress;
   int estimate;
   double calibration;
   const double *length0;

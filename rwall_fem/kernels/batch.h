@@ -53,6 +53,7 @@ typedef struct
   double taylor_quinney;        /* share of plastic work turned into heat */
   int table_size;               /* rows of the table */
   double table_strain[TABLE_ROWS], table_stress[TABLE_ROWS]; /* eps_p (increasing), Pa */
+  double max_flow_stress;       /* Pa, the cap on the law (0: none; plasticity.h) */
   /* the element time step (step.h) */
   int estimate;                 /* estimate each cell's stable step in this call */
   double calibration;           /* scales the estimates L / c to the exact limit at rest */

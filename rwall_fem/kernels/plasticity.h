@@ -15,7 +15,8 @@
  * sigma_y) interpolated linearly, constant beyond its last row; Johnson-Cook
  * (A + B eps_p^n)(1 + C ln max(rate / rate_0, 1))(1 - T*^m), with rate the
  * equivalent deviatoric strain rate of the step and T* = (T - T_room) /
- * (T_melt - T_room) clipped to [0, 1]; adiabatic heating (when thermal) raises T
+ * (T_melt - T_room) clipped to [0, 1]; the law (before those factors) capped at
+ * max_flow_stress (slope 0 where the cap holds); adiabatic heating (when thermal) raises T
  * by taylor_quinney sigma_y d / (density specific_heat).
  * Symmetric tensors are stored as (xx, yy, zz, xy, yz, xz).
  */
@@ -43,15 +44,31 @@ INLINE vec vpow(vec x, double n)
   return r;
 }
 
-/* Flow stress sigma_y (Pa) at plastic strain e, strain rate (1/s) and temperature T (K);
- * *slope = d sigma_y / d e. */
+/* The law's value y (Pa) and slope *slope at a plastic strain, capped at p->max_flow_stress
+ * (Radioss LAW2's SIG_max0 with its default ICC = 1: the cap applies to the hardening law,
+ * before Johnson-Cook's rate and temperature `factor`), times the factor: min(y, cap) factor,
+ * slope 0 where the cap holds.  No cap (0) takes no comparison. */
+INLINE vec cap_flow_stress(const element_params *p, vec y, vec *slope, vec factor)
+{
+  if (p->max_flow_stress > 0.0)
+  {
+    const ivec capped = y > p->max_flow_stress;
+    *slope = vselect(capped, VZERO, *slope);
+    y = vselect(capped, VZERO + p->max_flow_stress, y);
+  }
+  *slope *= factor;
+  return y * factor;
+}
+
+/* Flow stress sigma_y (Pa) at plastic strain e, strain rate (1/s) and temperature T (K),
+ * capped (cap_flow_stress); *slope = d sigma_y / d e. */
 INLINE vec flow_stress(const element_params *p, vec e, vec rate, vec T, vec *slope)
 {
   const double A = p->yield_stress;
   if (p->hardening == HARDENING_LINEAR)
   {
     *slope = VZERO + p->hardening_modulus;
-    return A + p->hardening_modulus * e;
+    return cap_flow_stress(p, A + p->hardening_modulus * e, slope, VZERO + 1.0);
   }
   if (p->hardening == HARDENING_TABLE)
   {
@@ -66,17 +83,17 @@ INLINE vec flow_stress(const element_params *p, vec e, vec rate, vec T, vec *slo
       s = vselect(in & (e < e1), VZERO + k, vselect(in, VZERO, s));
     }
     *slope = s;
-    return value;
+    return cap_flow_stress(p, value, slope, VZERO + 1.0);
   }
   /* power law and Johnson-Cook: A + B e^n times the rate and temperature factors */
   const double B = p->hardening_coefficient, n = p->hardening_exponent;
   const vec power = vpow(e, n);
-  vec base = A + B * power;
-  vec dbase = n == 0.0 ? VZERO : (B * n) * vpow(vmax(e, VZERO + 1e-300), n - 1.0);
+  const vec base = A + B * power;
+  *slope = n == 0.0 ? VZERO : (B * n) * vpow(vmax(e, VZERO + 1e-300), n - 1.0);
+  vec factor = VZERO + 1.0;
   if (p->hardening == JOHNSON_COOK)
   {
-    vec factor = 1.0 + p->rate_coefficient
-                           * vlog(vmax(rate * (1.0 / p->reference_rate), VZERO + 1.0));
+    factor += p->rate_coefficient * vlog(vmax(rate * (1.0 / p->reference_rate), VZERO + 1.0));
     if (p->thermal)
     {
       const vec star = vmin(vmax((T - p->room_temperature)
@@ -85,11 +102,8 @@ INLINE vec flow_stress(const element_params *p, vec e, vec rate, vec T, vec *slo
                             VZERO + 1.0);
       factor *= 1.0 - vpow(star, p->thermal_exponent);
     }
-    base *= factor;
-    dbase *= factor;
   }
-  *slope = dbase;
-  return base;
+  return cap_flow_stress(p, base, slope, factor);
 }
 
 /* The Hughes-Winget rotation R (row-major) of the spin increment W = skew(dL). */
@@ -166,7 +180,14 @@ INLINE vec plastic_update(const element_params *p, vec sigma[9], vec *eps_p, vec
     return VZERO;
   vec d;
   if (p->hardening == HARDENING_LINEAR)
-    d = (q_trial - yield) / (3.0 * mu + p->hardening_modulus);
+  {
+    /* closed form along the line (slope 0 if already at the cap), and from the cap on if the
+     * line crosses it within the step */
+    d = (q_trial - yield) / (3.0 * mu + slope);
+    if (p->max_flow_stress > 0.0)
+      d = vselect(yield + slope * d > p->max_flow_stress,
+                  (q_trial - p->max_flow_stress) * (1.0 / (3.0 * mu)), d);
+  }
   else
   {
     /* Newton on r(d) = q_trial - 3 mu d - sigma_y(eps_p + d), kept in [lo, hi]. */

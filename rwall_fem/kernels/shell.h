@@ -17,7 +17,7 @@
  * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2).  The normal stress through
  * the thickness is zero at every step by construction, and the plastic flow of the 3-D J2
  * law with sigma_zz = 0 is reproduced exactly (the thickness strain follows from it).
- * The flow stress is capped at s->max_flow_stress (Radioss LAW2's SIG_max0).
+ * The flow stress is capped at p->max_flow_stress (Radioss LAW2's SIG_max0; plasticity.h).
  */
 #ifndef RWALL_SHELL_H
 #define RWALL_SHELL_H
@@ -38,7 +38,6 @@ typedef struct
   double shear_factor;     /* of the transverse shear, 5/6 */
   double bar_speed;        /* sqrt(E / (rho (1 - nu^2))), m/s */
   double hm, hf, hr;       /* viscous hourglass coefficients: membrane, out-of-plane, rotation */
-  double max_flow_stress;  /* Pa (+inf: no cap) */
   double fail_fraction;    /* a cell fails when this share of its points has failed */
   int warping;             /* 1: project out the rigid motion (warped cells), 0: plain BT */
   int omit_energy;         /* 1: skip the stored-energy sum (0 by default) */
@@ -82,10 +81,11 @@ INLINE vec flow_factor(const element_params *p, vec rate, vec T)
   return factor;
 }
 
-/* The flow stress (Pa) of plasticity.h at plastic strain e times `factor` (flow_factor), capped
- * at s->max_flow_stress, and its slope (0 where the cap holds).  The power laws' e^n is taken
- * as exp(n log e) on all lanes at once (batch.h), and its slope as n e^n / e. */
-INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, vec e, vec factor,
+/* The flow stress (Pa) of plasticity.h at plastic strain e: the law capped at p->max_flow_stress
+ * times `factor` (flow_factor; cap_flow_stress), and its slope (0 where the cap holds).
+ * The power laws' e^n is taken as exp(n log e) on all lanes at once (batch.h), and its slope
+ * as n e^n / e. */
+INLINE vec capped_flow_stress(const element_params *p, vec e, vec factor,
                               vec *slope)
 {
   vec y;
@@ -95,22 +95,19 @@ INLINE vec capped_flow_stress(const element_params *p, const shell_params *s, ve
     const ivec positive = e > 0.0;
     const vec safe = vselect(positive, e, VZERO + 1.0);
     const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
-    y = (p->yield_stress + B * power) * factor;
+    y = p->yield_stress + B * power;
     /* at e = 0 the slope of n < 1 is infinite: the Newton steps stay in their bracket */
-    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300) * factor;
+    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300);
+    return cap_flow_stress(p, y, slope, factor);
   }
-  else
-    y = flow_stress(p, e, VZERO, VZERO, slope);
-  const ivec capped = y > s->max_flow_stress;
-  *slope = vselect(capped, VZERO, *slope);
-  return vselect(capped, VZERO + s->max_flow_stress, y);
+  return flow_stress(p, e, VZERO, VZERO, slope); /* capped; factor 1 */
 }
 
 /* The flow stress and slope of capped_flow_stress at e = e0 (1 + x), 0 <= x <= 1/20, of a
  * power law (Johnson-Cook) whose power e0^n = power0 is known: e^n = power0 (1 + x)^n with
  * log(1 + x) = 2 atanh(x / (2 + x)) and the exponential by their series (to about one ulp),
  * a third of the cost of exp(n log e) in the Newton iterations of a return. */
-INLINE vec near_flow_stress(const element_params *p, const shell_params *s, vec e0, vec power0,
+INLINE vec near_flow_stress(const element_params *p, vec e0, vec power0,
                             vec e, vec factor, vec *slope)
 {
   const double B = p->hardening_coefficient, n = p->hardening_exponent;
@@ -128,15 +125,12 @@ INLINE vec near_flow_stress(const element_params *p, const shell_params *s, vec 
     ex = ex * t + 1.0 / factorial;
   }
   const vec power = power0 * ex;
-  vec y = (p->yield_stress + B * power) * factor;
-  *slope = (B * n) * power / e * factor;
-  const ivec capped = y > s->max_flow_stress;
-  *slope = vselect(capped, VZERO, *slope);
-  return vselect(capped, VZERO + s->max_flow_stress, y);
+  *slope = (B * n) * power / e;
+  return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
 }
 
 /* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise). */
-INLINE vec flow_stress_power(const element_params *p, const shell_params *s, vec e, vec factor,
+INLINE vec flow_stress_power(const element_params *p, vec e, vec factor,
                              vec *slope, vec *power_out)
 {
   *power_out = VZERO + 1.0;
@@ -147,13 +141,10 @@ INLINE vec flow_stress_power(const element_params *p, const shell_params *s, vec
     const vec safe = vselect(positive, e, VZERO + 1.0);
     const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
     *power_out = power;
-    const vec y = (p->yield_stress + B * power) * factor;
-    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300) * factor;
-    const ivec capped = y > s->max_flow_stress;
-    *slope = vselect(capped, VZERO, *slope);
-    return vselect(capped, VZERO + s->max_flow_stress, y);
+    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300);
+    return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
   }
-  return capped_flow_stress(p, s, e, factor, slope);
+  return capped_flow_stress(p, e, factor, slope);
 }
 
 /* The exact plane-stress J2 return of the trial stress sig[3] (xx, yy, xy; Pa, in/out) at
@@ -174,7 +165,8 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
    * falls below it (linear and power hardening, Johnson-Cook): no evaluation of the law */
   if (p->hardening != HARDENING_TABLE)
   {
-    const vec floor = vmin(p->yield_stress * factor, VZERO + s->max_flow_stress);
+    const double cap = p->max_flow_stress > 0.0 ? p->max_flow_stress : INFINITY;
+    const vec floor = fmin(p->yield_stress, cap) * factor;
     if (!any_lane(q_trial > floor))
     {
       *flow = VZERO;
@@ -182,7 +174,7 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
     }
   }
   vec slope, power0;
-  const vec y0 = flow_stress_power(p, s, eps_p, factor, &slope, &power0);
+  const vec y0 = flow_stress_power(p, eps_p, factor, &slope, &power0);
   const int power_law = (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
                         && p->hardening_exponent != 0.0;
   const ivec plastic = q_trial > y0;
@@ -199,7 +191,7 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
   {
     const vec d0 = vmax((safe_q - y0) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
     vec unused;
-    const vec secant = (capped_flow_stress(p, s, eps_p + d0, factor, &unused) - y0) / d0;
+    const vec secant = (capped_flow_stress(p, eps_p + d0, factor, &unused) - y0) / d0;
     start = vselect(eps_p <= 0.0, secant, slope);
   }
   vec g = (safe_q - y0)
@@ -215,9 +207,9 @@ INLINE vec plane_stress_return(const element_params *p, const shell_params *s, v
     vec h;
     /* near eps_p (a step's increment, once flowing): the series about it */
     const int near = power_law && !any_lane(plastic & ((eps_p <= 0.0) | (e > 1.05 * eps_p)));
-    const vec F = q - (near ? near_flow_stress(p, s, vmax(eps_p, VZERO + 1e-300), power0, e,
+    const vec F = q - (near ? near_flow_stress(p, vmax(eps_p, VZERO + 1e-300), power0, e,
                                                factor, &h)
-                            : capped_flow_stress(p, s, e, factor, &h));
+                            : capped_flow_stress(p, e, factor, &h));
     lo = vselect(F > 0.0, g, lo);
     hi = vselect(F < 0.0, g, hi);
     const vec dF = dq - vmax(h, VZERO) * (2.0 / 3.0) * (q + g * dq);

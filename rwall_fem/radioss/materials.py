@@ -62,6 +62,9 @@ def _law_table(deck: Deck, mid: int) -> tuple[dict, str]:
                     "hardening_curve": rows}  # fmt: skip
         return material, f"{head} -> elastic_plastic, tabulated hardening ({len(rows)} points)"
     a, b, n = m["a"], m["b"], m["n"]
+    if "cap" in m:  # SIG_max0
+        table |= {"max_flow_stress": m["cap"]}
+        head = f"{head} (flow stress capped at {m['cap']:g} Pa, SIG_max0)"
     if "c" in m or "t_melt" in m:
         material = {"model": "johnson_cook", **table, "yield_stress": a,
                     "hardening_coefficient": b, "hardening_exponent": n}  # fmt: skip

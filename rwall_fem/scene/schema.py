@@ -91,6 +91,7 @@ MATERIAL_KEYS = {model: _ELASTIC_KEYS for model in MATERIAL_MODELS} | {
         "hardening_exponent",
         "hardening_curve",
         "failure",
+        "max_flow_stress",
     ),
     "johnson_cook": (
         *_ELASTIC_KEYS,
@@ -101,6 +102,7 @@ MATERIAL_KEYS = {model: _ELASTIC_KEYS for model in MATERIAL_MODELS} | {
         "reference_strain_rate",
         "heating",
         "failure",
+        "max_flow_stress",
     ),
 }
 # The failure criteria and their keys besides "criterion".
@@ -746,6 +748,15 @@ class Material:
         doc="the failure criterion; failed cells are eroded",
         default_doc="none: the material never fails",
     )
+    max_flow_stress: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="Pa",
+        doc="the cap on the hardening law (Radioss LAW2's SIG_max0): the flow stress is "
+        "min(hardening law, cap) times johnson_cook's rate and temperature factors, and does "
+        "not harden where the cap holds; above the initial yield stress",
+        default_doc="none: no cap",
+    )
 
     @property
     def plastic(self) -> bool:
@@ -773,6 +784,19 @@ def _damage_reference_rate(v, raw, fail):
     if failure is not None and failure.criterion == "johnson_cook":
         if failure.reference_strain_rate is None:
             v["failure"] = replace(failure, reference_strain_rate=v["reference_strain_rate"])
+
+
+@rule(Material)
+def _cap_above_yield(v, raw, fail):
+    """max_flow_stress lies above the initial yield stress (A, or the table's first row)."""
+    cap = v["max_flow_stress"]
+    if cap is None:
+        return
+    curve = v["hardening_curve"]
+    initial = curve[0][1] if v["hardening"] == "table" and curve else v["yield_stress"]
+    if initial is not None and cap <= initial:
+        fail("max_flow_stress", f"{cap:g} Pa is not above the initial yield stress "
+             f"{initial:g} Pa: the cap must lie above it (or leave max_flow_stress out)")
 
 
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")

@@ -21,6 +21,7 @@ energy the kernels report), and the rotations' shadow kinetic energy
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,7 +103,7 @@ class ShellBody:
         self.elements = [
             ShellForce(V, part.material, part.technology.technology, u, v, self.w,
                        thickness=part.technology.thickness, cells=part.cells, f=self.f,
-                       m=self.m)  # fmt: skip
+                       m=self.m, max_flow_stress=_cap(part.material))  # fmt: skip
             for part in parts
         ]
         self.nodal_force = self.f.owned
@@ -339,6 +340,12 @@ class ShellBody:
             prefix = f"part{k}_"
             mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
             force.restore_state(mine)
+
+
+def _cap(material) -> float:
+    """The material's flow-stress cap (Pa; inf: none)."""
+    cap = getattr(material, "max_flow_stress", None)
+    return math.inf if cap is None else cap
 
 
 def _held(V, parts) -> np.ndarray:

@@ -57,7 +57,7 @@ typedef struct {
   double zeta[10], weight[10];
   double young, poisson, shear_factor, bar_speed;
   double hm, hf, hr;
-  double max_flow_stress, fail_fraction;
+  double fail_fraction;
   int warping, omit_energy;
   double hk;
   int hourglass_slot;
@@ -239,8 +239,8 @@ class ShellKernel:
     :meth:`run` adds the internal forces and moments of the cells into ``f`` and ``m``.
     ``material`` needs ``young``, ``poisson``, ``density`` and, elasto-plastic (``plastic``),
     the hardening constants of :class:`rwall_fem.scene.Material`; ``max_flow_stress`` (Pa)
-    caps the flow stress, ``failed_share`` is the share of a cell's points that must fail
-    for the cell to fail (1: all).
+    caps the flow stress (inf: no cap), ``failed_share`` is the share of a cell's points that
+    must fail for the cell to fail (1: all).
     """
 
     def __init__(
@@ -272,13 +272,15 @@ class ShellKernel:
         p.density = rho
         p.wave_speed = math.sqrt(E * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu)))
         p.calibration = 1.0
+        if not max_flow_stress > 0.0:
+            raise ValueError(f"material.max_flow_stress: must be > 0, got {max_flow_stress}")
+        p.max_flow_stress = max_flow_stress if max_flow_stress < math.inf else 0.0  # 0: none
         self.shell = s = ffi.new("shell_params *")
         s.thickness = ffi.cast("double *", self.thickness.ctypes.data)
         s.young, s.poisson, s.shear_factor = E, nu, technology.shear_factor
         s.bar_speed = math.sqrt(E / (rho * (1 - nu * nu)))
         s.hm, s.hf, s.hr = technology.hourglass
         s.warping = int(technology.formulation == "bwc")
-        s.max_flow_stress = max_flow_stress
         if not 0.0 < failed_share <= 1.0:
             raise ValueError(f"failure.thickness_share: must be in (0, 1], got {failed_share}")
         s.fail_fraction = failed_share

@@ -152,11 +152,11 @@ class BarDeck:
                        f20(self.q(E, "stress")) + f20(nu)]  # fmt: skip
 
     def johnson_cook(self, rho, E, nu, a, b, n, c=0.0, rate0=0.0, mid=1, keyword="LAW2",
-                     eps_max=0.0):  # fmt: skip
+                     eps_max=0.0, sig_max=0.0):  # fmt: skip
         s = lambda v: f20(self.q(v, "stress"))  # noqa: E731
         self.cards += [f"/MAT/{keyword}/{mid}", "Johnson-Cook", f20(self.q(rho, "density")),
                        f20(self.q(E, "stress")) + f20(nu) + i10(0) + i10(0) + f20(0.0),
-                       s(a) + s(b) + f20(n) + f20(eps_max) + f20(0.0),
+                       s(a) + s(b) + f20(n) + f20(eps_max) + s(sig_max),
                        f20(c) + f20(self.q(rate0, "rate")) + i10(0) + i10(0) + f20(0) + f20(0),
                        f20(0.0) * 5]  # fmt: skip
 

@@ -114,6 +114,19 @@ def failure_strain_negative(lines):
                       f"{0.4:20g}{0.1:20g}{0.5:20g}{-0.2:20g}"]  # fmt: skip
 
 
+def cap_below_yield(lines):
+    k = line_of(lines, "/MAT/LAW1")
+    lines[k:k + 4] = ["/MAT/LAW2/1", "jc", f"{7.85e-6:20g}", f"{210:20g}{0.3:20g}",
+                      f"{0.4:20g}{0.1:20g}{0.5:20g}{0:20g}{0.3:20g}"]  # fmt: skip
+
+
+def cap_after_the_rate_factor(lines):
+    k = line_of(lines, "/MAT/LAW1")
+    lines[k:k + 4] = ["/MAT/LAW2/1", "jc", f"{7.85e-6:20g}", f"{210:20g}{0.3:20g}",
+                      f"{0.4:20g}{0.1:20g}{0.5:20g}{0:20g}{0.6:20g}",
+                      f"{0.01:20g}{1e-3:20g}{2:10d}"]  # fmt: skip
+
+
 def flat_brick(lines):
     """The top face of the first brick on its bottom face: its nodes 5-8 moved to z = 0
     (distinct node IDs, no node repeated)."""
@@ -178,6 +191,13 @@ CASES = {
     ),
     "failure strain below 0": (
         failure_strain_negative, "/MAT/LAW2", r"EPS_p_max = -0.2: a failure plastic strain is > 0",
+    ),
+    "flow-stress cap below the yield stress": (
+        cap_below_yield, "/MAT/LAW2", r"SIG_max0 = 0.3: the flow-stress cap must be above the "
+        r"yield stress a = 0.4",
+    ),
+    "flow-stress cap after the rate factor": (
+        cap_after_the_rate_factor, "/MAT/LAW2", r"ICC = 2: rwall_fem caps a \+ b eps_p\^n before",
     ),
 }  # fmt: skip
 

@@ -71,13 +71,13 @@ def plastic_deck(units: str) -> BarDeck:
     return d
 
 
-def plastic_reference(d: BarDeck):
+def plastic_reference(d: BarDeck, **material):
     return reference(
         d,
         material={"model": "johnson_cook", "density": 8930.0, "young": 117e9, "poisson": 0.35,
                   "yield_stress": 400e6, "hardening_coefficient": 100e6,
                   "hardening_exponent": 0.5, "strain_rate_coefficient": 0.01,
-                  "reference_strain_rate": 1.0},
+                  "reference_strain_rate": 1.0, **material},
         element={"integration": "reduced", "hourglass": "physical"},
         initial={"velocity": [0.0, 0.0, -40.0]},
         gravity={"acceleration": [0.0, 0.0, -9.81e4]},
@@ -102,6 +102,25 @@ def test_each_unit_system_runs_as_the_si_scene(units, plastic_run, shared_dir):
     sim = run(deck_scene(plastic_deck(units), shared_dir), shared_dir / "out")
     same_run(sim, plastic_run)
     assert plastic_run.history.summary["walls"][1]["peak_contacts"] > 0  # the walls acted
+
+
+def test_sig_max0_runs_as_max_flow_stress(plastic_run, shared_dir):
+    """/MAT/LAW2's SIG_max0 (here in kg-mm-ms) is the scene's max_flow_stress: the same run
+    to round-off, and not the run without the cap (the cap acted)."""
+    d = plastic_deck("kg-mm-ms")
+    k = d.cards.index("/MAT/LAW2/1")
+    capped = BarDeck(units="kg-mm-ms")
+    capped.johnson_cook(8930.0, 117e9, 0.35, a=400e6, b=100e6, n=0.5, c=0.01, rate0=1.0,
+                        sig_max=410e6)  # fmt: skip
+    d.cards[k : k + len(capped.cards)] = capped.cards
+    scene = deck_scene(d, shared_dir)
+    assert scene.material.max_flow_stress == pytest.approx(410e6, rel=1e-14)
+    sim = run(scene, shared_dir / "capped")
+    same_run(sim, run(plastic_reference(d, max_flow_stress=410e6), shared_dir / "reference"))
+    work = [s.history.summary["plastic_work"] for s in (sim, plastic_run)]
+    print(f"plastic work {work[0]:.6g} J capped, {work[1]:.6g} J not; largest eps_p "
+          f"{sim.history.summary['max_plastic_strain']:.4f}")
+    assert work[0] < 0.99 * work[1]  # 5 % less seen: the capped bar flows softer
 
 
 def elastic(d: BarDeck) -> None:

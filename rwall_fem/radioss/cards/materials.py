@@ -82,10 +82,7 @@ def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
                   card.lines[2])  # fmt: skip
     a, b, n, eps_max, sig_max = card.read(3, "f:a f:b f:n f:EPS_p_max f:SIG_max0",
                                           "a b n EPS_p_max SIG_max0")  # fmt: skip
-    if not inactive(sig_max):
-        card.fail(f"SIG_max0 = {sig_max:g}: rwall_fem has no cap on the flow stress; leave "
-                  "SIG_max0 blank", card.lines[3])  # fmt: skip
-    c, rate0, _, smooth, _, chard = card.read_optional(
+    c, rate0, icc, smooth, _, chard = card.read_optional(
         4, "f:c f:EPS_DOT_0 i:ICC i:Fsmooth f:F_cut f:Chard"
     )
     if chard != 0.0:
@@ -99,6 +96,7 @@ def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
     facts = {"young": E * stress, "poisson": nu, "a": a * stress, "b": b * stress,
              "n": n if n else 1.0, "raw_young": E}  # fmt: skip
     facts |= _failure_strain(card, "EPS_p_max", eps_max, card.lines[3])
+    facts |= _flow_stress_cap(card, sig_max, a, icc, c != 0.0 or not inactive(t_melt), stress)
     if c != 0.0:
         if rate0 <= 0.0:
             card.fail("c > 0 needs EPS_DOT_0 > 0 (the reference strain rate)", card.lines[4])
@@ -118,6 +116,22 @@ def _johnson_cook(deck: Deck, card: Card, units: UnitSystem) -> dict:
         deck.warn(card, "the thermal term heats by the plastic work (taylor_quinney = 1), where "
                   "Radioss heats by the internal energy", card.lines[5])  # fmt: skip
     return facts
+
+
+def _flow_stress_cap(card: Card, sig_max: float, a: float, icc: int, factors: bool,
+                     stress: float) -> dict:  # fmt: skip
+    """The max_flow_stress fact of SIG_max0 (none if blank or 1e20-like): above the yield
+    stress a; applied to a + b eps_p^n before the rate and thermal factors, Radioss's ICC 1
+    (its default), so that ICC 2 (the cap after them) is refused where there are factors."""
+    if inactive(sig_max):
+        return {}
+    if sig_max <= a:
+        card.fail(f"SIG_max0 = {sig_max:g}: the flow-stress cap must be above the yield stress "
+                  f"a = {a:g} (blank: no cap)", card.lines[3])  # fmt: skip
+    if icc == 2 and factors:
+        card.fail("ICC = 2: rwall_fem caps a + b eps_p^n before the rate and thermal factors "
+                  "(ICC 1, the default); leave ICC blank or 1", card.lines[4])  # fmt: skip
+    return {"cap": sig_max * stress}
 
 
 def _from_tensile_test(deck: Deck, card: Card, E: float, a: float, uts: float,
