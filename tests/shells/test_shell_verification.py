@@ -61,10 +61,11 @@ def _kinetic(sim) -> float:
 def _first_period(directory, a, t, h, hard, cell="quadrilateral", periods=1.1):
     """The period (s) of the centre of the square plate a x a x t (m) of NAFEMS's steel,
     cells of h (m), its edges' translations held (and, if ``hard``, the rotation about each
-    edge's in-plane normal, the hinge about the edge left free: the hard simple support), started at the velocity
-    V sin(pi x / a) sin(pi y / a) with the matching angular velocity, V such that the
-    amplitude is t / 100 (larger ones stiffen the plate: its edges are held in-plane): the mean of its
-    two downward crossings of zero (T/2 and 3T/2 would need longer; T/2 and T here)."""
+    edge's in-plane normal, the hinge about the edge left free: the hard simple support),
+    started at the velocity V sin(pi x / a) sin(pi y / a) with the matching angular
+    velocity, V such that the amplitude is t / 100 (larger ones stiffen the plate: its
+    edges are held in-plane). The centre's displacement is a sin(omega t): the period is
+    the mean of twice its downward crossing of zero (T/2) and its upward one (T)."""
     raw = {
         "run": {"end_time": 1.0, "dt_scale": 0.9},
         "mesh": {"shape": "plate", "size": [a, a, t], "element_size": h,
@@ -128,10 +129,11 @@ def navier_frequency(a, t, material=NAFEMS) -> float:
 
 @pytest.mark.parametrize("cell, h", [("quadrilateral", 0.05), ("triangle", 0.1)])
 def test_a_simply_supported_thin_plate_vibrates_at_navier_frequency(shared_dir, cell, h):
-    """20 x 20 quadrilaterals, 10 x 10 squares halved into triangles; the edges' rotations
-    free. Measured: quadrilaterals +3.4 % (10 x 10), +1.1 % (20 x 20), +0.6 % (40 x 40),
-    from above as the scaled rotational inertia m A / 6 fades; triangles +0.2 % (10 x 10
-    and 20 x 20)."""
+    """The period of the 1 m x 1 m x 10 mm plate is 1 / f11 within 2 % on 20 x 20
+    quadrilaterals and on 10 x 10 squares halved into triangles, the edges' translations
+    held and their rotations free. Measured: quadrilaterals +3.4 % (10 x 10), +1.1 %
+    (20 x 20), +0.6 % (40 x 40), from above as the scaled rotational inertia m A / 6
+    fades; triangles +0.2 % (10 x 10 and 20 x 20)."""
     f11 = navier_frequency(1.0, 0.01)
     assert f11 == pytest.approx(47.53, abs=0.005)
     period = _first_period(shared_dir, 1.0, 0.01, h, hard=False, cell=cell)
@@ -142,9 +144,11 @@ def test_a_simply_supported_thin_plate_vibrates_at_navier_frequency(shared_dir, 
 
 @pytest.mark.parametrize("cell, h", [("quadrilateral", 0.5), ("triangle", 1.0)])
 def test_nafems_fv52_thick_plate_as_a_shell(shared_dir, cell, h):
-    """20 x 20 quadrilaterals (+0.6 %; +2.4 % at 10 x 10), 10 x 10 squares halved into
-    triangles (+0.2 %); the hard simple support (with the rotations free the soft support's
-    boundary layer makes the plate much more flexible, as a Mindlin plate's)."""
+    """The period of the 10 x 10 x 1 m plate is Mindlin's 1 / f1 (and NAFEMS's 1 / 45.897 Hz)
+    within 3 % on 20 x 20 quadrilaterals (measured +0.6 %; +2.4 % at 10 x 10) and 10 x 10
+    squares halved into triangles (+0.2 %), with the hard simple support (with the
+    rotations free, the soft support's boundary layer makes the plate much more flexible,
+    as a Mindlin plate's)."""
     f1 = mindlin_frequency(10.0, 1.0)
     assert f1 == pytest.approx(45.897, rel=1e-3)  # NAFEMS's answer for the solid plate
     period = _first_period(shared_dir, 10.0, 1.0, h, hard=True, cell=cell)
