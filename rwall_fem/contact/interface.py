@@ -1,5 +1,5 @@
 """A contact interface between parts of the body, or of a part with itself (Radioss
-/INTER/TYPE7; ``docs/theory.md``, "Contact between bodies").
+/INTER/TYPE7; ``docs/theory.md``, "Contact between parts").
 
 :class:`ContactInterface` is a force of the step, after the internal force and before the
 step size is chosen (its stiffness enters the stable step). Each step it

@@ -1,5 +1,5 @@
 /* Node-to-surface penalty contact (Radioss /INTER/TYPE7; rwall_fem/contact/, docs/theory.md,
- * "Contact between bodies").  All arrays index the interface's surface nodes (the nodes of
+ * "Contact between parts").  All arrays index the interface's surface nodes (the nodes of
  * its segments and its secondary nodes, gathered from every rank), rows of 3 for vectors.
  * A segment is 4 node indices: a quadrilateral, or a triangle whose 4th is -1.
  *
