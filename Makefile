@@ -200,12 +200,13 @@ demo: venv-0.5
 # Every demo at its full resolution, serially (~2 minutes): scenes into results/NAME/, the
 # Python demos write their own results/ folders.  A scene's gallery picture
 # (docs/gallery/NAME.png) is a frame of it, full size, seen as its [output.view] says: the
-# last (the outcome), but the bar's 13th (the wave in it, before it leaves the wall).
+# last (the outcome), but the 13th of the bar (the wave in it, before it leaves the wall)
+# and of the perforation (the sphere in the hole it tears, the petals and the damage).
 demos: venv-0.5
 	for scene in demos/*.toml; do \
 	  name=$$(basename $$scene .toml); \
 	  $(RUN_ENV) $(VENV)/bin/rwall-fem run $$scene --out results/$$name; \
-	  case $$name in bar_impact) pick=results/$$name/frames/frame_0012.png ;; \
+	  case $$name in bar_impact | perforation_weldox) pick=results/$$name/frames/frame_0012.png ;; \
 	    *) pick=$$(ls results/$$name/frames/frame_*.png 2>/dev/null | tail -n 1) ;; esac; \
 	  if [ -f "$$pick" ] && [ -f docs/gallery/$$name.png ]; then cp $$pick docs/gallery/$$name.png; fi; \
 	done
