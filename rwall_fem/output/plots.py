@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rwall_fem.output.atomic import whole
+
 __all__ = ["plot_histories"]
 
 
@@ -50,6 +52,7 @@ def plot_histories(directory: str | Path) -> Path:
     axes[-1, 0].set_xlabel("time (ms)")
     figure.tight_layout()
     path = directory / "histories.png"
-    figure.savefig(path, dpi=110)
+    with whole(path) as partial:
+        figure.savefig(partial, dpi=110)
     plt.close(figure)
     return path

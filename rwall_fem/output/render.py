@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem import interrupts
+from rwall_fem.output.atomic import whole
 from rwall_fem.output.coloring import COLORS, coloring, fixed_range
 from rwall_fem.output.view import choose_view, up_direction, wall_surface
 from rwall_fem.scene.view import ViewSpec, parse_view_text, view_from_json
@@ -123,7 +124,8 @@ def render_frames(
 def _write_png(image: np.ndarray, path: Path) -> None:
     from PIL import Image
 
-    Image.fromarray(image).save(path, compress_level=PNG_COMPRESSION)
+    with whole(path) as partial:
+        Image.fromarray(image).save(partial, compress_level=PNG_COMPRESSION)
 
 
 def _animate(directory: Path, images: list[np.ndarray]) -> None:
@@ -134,13 +136,13 @@ def _animate(directory: Path, images: list[np.ndarray]) -> None:
     frames = [Image.fromarray(image) for image in images]
     palette = frames[len(frames) // 2].quantize(colors=255, method=Image.Quantize.FASTOCTREE)
     gif = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
-    gif[0].save(
-        directory / "animation.gif", save_all=True, append_images=gif[1:], duration=100, loop=0
-    )
+    with whole(directory / "animation.gif") as partial:
+        gif[0].save(partial, save_all=True, append_images=gif[1:], duration=100, loop=0)
     if _has_mp4_encoder():
         import imageio.v2 as imageio
 
-        imageio.mimsave(directory / "animation.mp4", images, fps=10, macro_block_size=8)
+        with whole(directory / "animation.mp4") as partial:
+            imageio.mimsave(partial, images, fps=10, macro_block_size=8)
 
 
 def _stored_view(mesh: dict) -> ViewSpec:
