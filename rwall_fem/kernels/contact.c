@@ -314,9 +314,13 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
   {
     /* The closest of the 4 triangles about the centre. Where two of them are (nearly)
      * as close, as for a point over a diagonal of a warped quad, the closest point jumps
-     * from one to the other (by the warp) as the point crosses: their weights are blended
-     * over a band of 1e-6 of the segment's size, so that the weights (and the forces)
-     * stay continuous and round-off cannot pick one side or the other. */
+     * from one to the other (by the warp) as the point crosses: the weights of the
+     * triangles within a band of 1e-7 of the distance of the closest are blended (shares
+     * falling linearly from 1 to 0 over the band), so that the weights (and the forces)
+     * stay continuous and round-off cannot pick one side or the other. On a flat quad the
+     * blend moves the point toward a diagonal by at most sqrt(2e-7) of the distance (the
+     * neighbour's distance grows with the square of the offset), so the direction of the
+     * force turns by at most 4.5e-4 rad, within 4.5e-4 of the distance of a diagonal. */
     double centre[3], distance[4], w[4][3];
     for (int c = 0; c < 3; ++c)
       centre[c] = 0.25 * (((y[0][c] + y[1][c]) + y[2][c]) + y[3][c]);
@@ -331,7 +335,7 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
       distance[k] = sqrt(cdot(r, r));
       best = distance[k] < best ? distance[k] : best;
     }
-    const double band = 1e-6 * sqrt(fmax(cdot(e1, e1), cdot(e2, e2)));
+    const double band = 1e-7 * best;
     double total = 0.0;
     for (int k = 0; k < 4; ++k)
     {
