@@ -5,14 +5,16 @@
 step size is chosen (its stiffness enters the stable step). Each step it
 
 1. gathers the positions x^n, velocities v^{n-1/2} and masses of the interface's surface
-   nodes from every rank (one ``Allgatherv``), in one order on any partition;
+   nodes from every rank (one ``Allgatherv``), in the order of their global numbers;
 2. sorts the secondary nodes' candidate segments again (buckets, ``kernels/contact.c``)
    when some node moved more than half the margin since the last sort;
 3. runs its passes (secondary nodes against main segments; two, each side against the
    other, by default) in compiled code, on every rank alike: each rank then adds the forces
-   of its own nodes to a^n. The same nodal state thus gives the same forces on any number
-   of ranks, to the bit; the price is that every rank treats the whole contact surface
-   (fine up to some 10^5 surface nodes; a partitioned search is for later).
+   of its own nodes to a^n. The global numbers depend on the partition, and so does the
+   element forces' round-off: the forces agree to round-off on any number of ranks since
+   they are continuous in the nodal state (``docs/theory.md``, "MPI" of the contact); the
+   price is that every rank treats the whole contact surface (fine up to some 10^5 surface
+   nodes; a partitioned search is for later).
 
 Books (J), like every force's, at mid-step velocities: the work W of the contact forces,
 1/2 f^n . (v^{n-1/2} + v^{n+1/2}) dt^n summed over the steps, is split into the work that

@@ -12,9 +12,9 @@ p0)`` for a triangle, points away from its cell) and carries, from that cell at 
   face a node is still pushed out (deeper, it is taken for a node of the other side);
 - its shortest edge (m): the default gap is 0.1 x the shortest of them (Radioss Gapmin).
 
-Every rank gets every segment of the interface, in global node numbers, in one order that
-does not depend on the partition (sorted by their nodes): the contact is then computed the
-same way on any number of ranks (:mod:`rwall_fem.contact.interface`).
+Every rank gets every segment of the interface, in global node numbers, sorted by their
+nodes: every rank of a run computes the contact alike (:mod:`rwall_fem.contact.interface`;
+the global numbers, hence the order, depend on the partition).
 """
 
 from __future__ import annotations
@@ -115,5 +115,5 @@ def part_surface(body, k: int, comm) -> Surface:
     key = np.concatenate([g[1] for g in gathered]).reshape(-1, 4)
     values = np.concatenate([g[2] for g in gathered]).reshape(-1, 3)
     _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    keep = first[counts == 1]  # np.unique sorts by key: the same order on any partition
+    keep = first[counts == 1]  # np.unique sorts by key: the same order on every rank
     return Surface(ids[keep], *values[keep].T.copy())

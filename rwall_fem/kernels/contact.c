@@ -312,27 +312,46 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
   }
   else
   {
-    double centre[3];
+    /* The closest of the 4 triangles about the centre. Where two of them are (nearly)
+     * as close, as for a point over a diagonal of a warped quad, the closest point jumps
+     * from one to the other (by the warp) as the point crosses: the weights of the
+     * triangles within a band of 1e-7 of the distance of the closest are blended (shares
+     * falling linearly from 1 to 0 over the band), so that the weights (and the forces)
+     * stay continuous and round-off cannot pick one side or the other. On a flat quad the
+     * blend moves the point toward a diagonal by at most sqrt(2e-7) of the distance (the
+     * neighbour's distance grows with the square of the offset), so the direction of the
+     * force turns by at most 4.5e-4 rad, within 4.5e-4 of the distance of a diagonal. */
+    double centre[3], distance[4], w[4][3];
     for (int c = 0; c < 3; ++c)
       centre[c] = 0.25 * (((y[0][c] + y[1][c]) + y[2][c]) + y[3][c]);
     double best = INFINITY;
     for (int k = 0; k < 4; ++k)
     {
       const int l = (k + 1) % 4;
-      double w[3], r[3];
-      closest_on_triangle(p, centre, y[k], y[l], w);
+      double r[3];
+      closest_on_triangle(p, centre, y[k], y[l], w[k]);
       for (int c = 0; c < 3; ++c)
-        r[c] = p[c] - (w[0] * centre[c] + w[1] * y[k][c] + w[2] * y[l][c]);
-      const double d = cdot(r, r);
-      if (d < best)
-      {
-        best = d;
-        for (int m = 0; m < 4; ++m)
-          weights[m] = 0.25 * w[0];
-        weights[k] += w[1];
-        weights[l] += w[2];
-      }
+        r[c] = p[c] - (w[k][0] * centre[c] + w[k][1] * y[k][c] + w[k][2] * y[l][c]);
+      distance[k] = sqrt(cdot(r, r));
+      best = distance[k] < best ? distance[k] : best;
     }
+    const double band = 1e-7 * best;
+    double total = 0.0;
+    for (int k = 0; k < 4; ++k)
+    {
+      const double share = band > 0.0 ? 1.0 - (distance[k] - best) / band
+                                       : (distance[k] == best ? 1.0 : 0.0);
+      if (!(share > 0.0))
+        continue;
+      const int l = (k + 1) % 4;
+      for (int m = 0; m < 4; ++m)
+        weights[m] += share * 0.25 * w[k][0];
+      weights[k] += share * w[k][1];
+      weights[l] += share * w[k][2];
+      total += share;
+    }
+    for (int m = 0; m < 4; ++m)
+      weights[m] /= total;
   }
   for (int c = 0; c < 3; ++c)
   {
