@@ -43,6 +43,8 @@ typedef struct
   int omit_energy;         /* 1: skip the stored-energy sum (0 by default) */
   double hk;               /* elastic hourglass stiffness coefficient (0: viscous only) */
   int hourglass_slot;      /* the state's first row of the 5 elastic hourglass forces */
+  double kd;               /* drilling stiffness coefficient (quadrilaterals; 0: none) */
+  int drill_slot;          /* the state's first row of the 4 nodal drilling moments */
 } shell_params;
 
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */

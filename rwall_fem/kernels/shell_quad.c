@@ -323,6 +323,48 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   return work;
 }
 
+/* Drilling (s->kd > 0): the nodes' rotation rates about e3 less the cell's in-plane spin at
+ * the centre, spin = (b1.vy - b2.vx) / 2 of the local velocities vl (not projected: a rigid
+ * motion has exactly spin = its rotation rate about e3), are resisted by elastic springs,
+ * incremental in the state rows s->drill_slot + I: mz_I += kd G t A dt (wz_I - spin).
+ * Writes mz (N m) and returns their stored energy sum mz_I^2 / (2 k) (J). */
+INLINE vec quad_drill_update(const quad_frame_t *g, const shell_params *s, double dt,
+                             vec thickness, const vec vl[4][3], const vec wl[4][3],
+                             double *restrict state, int64_t stride, const batch_t *b,
+                             vec mz[4])
+{
+  vec spin = VZERO;
+  for (int I = 0; I < 4; ++I)
+    spin += g->b1[I] * vl[I][1] - g->b2[I] * vl[I][0];
+  spin *= 0.5;
+  const double G = 0.5 * s->young / (1.0 + s->poisson);
+  const vec k = (s->kd * G) * thickness * g->area;
+  vec energy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    mz[I] = load_slot(state, stride, b, s->drill_slot + I) + k * dt * (wl[I][2] - spin);
+    store_slot(state, stride, b, s->drill_slot + I, mz[I]);
+    energy += 0.5 * mz[I] * mz[I] / k;
+  }
+  return energy;
+}
+
+/* The nodal moments mz (about e3) of the drilling springs and the in-plane forces of their
+ * spin term (the transpose: f_I = (sum mz) (b2_I, -b1_I) / 2), added to fe (global). */
+INLINE void quad_drill_forces(const quad_frame_t *g, const vec mz[4], vec *restrict fe)
+{
+  const vec half = 0.5 * (mz[0] + mz[1] + mz[2] + mz[3]);
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec fx = half * g->b2[I], fy = -half * g->b1[I];
+    for (int i = 0; i < 3; ++i)
+    {
+      fe[3 * I + i] += fx * g->e[0][i] + fy * g->e[1][i];
+      fe[12 + 3 * I + i] += mz[I] * g->e[2][i];
+    }
+  }
+}
+
 /* Radioss's characteristic length (m) of the cells of frame g. */
 INLINE vec quad_length(const quad_frame_t *g)
 {
@@ -375,7 +417,9 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
     to_local(&g, ve, vl);
     to_local(&g, we, wl);
-    vec Ji[9];
+    vec Ji[9], mz[4], drill = VZERO;
+    if (s->kd > 0.0)
+      drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
     if (warping)
     {
       rigid_inverse(&g, Ji);
@@ -394,7 +438,9 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     if (warping)
       rigid_inverse(&g, Ji);
     quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
-    elastic *= g.area;
+    if (s->kd > 0.0)
+      quad_drill_forces(&g, mz, fe);
+    elastic = elastic * g.area + drill;
     const vec plastic_work = dissipated * mid_area;
     const ivec inverted = ~(g.area > 0.0);
     vec dte = VZERO + INFINITY;

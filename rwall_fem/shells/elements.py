@@ -61,6 +61,8 @@ typedef struct {
   int warping, omit_energy;
   double hk;
   int hourglass_slot;
+  double kd;
+  int drill_slot;
 } shell_params;
 """
     + "".join(
@@ -190,11 +192,14 @@ class ShellTechnology:
     shear_factor: float = 5.0 / 6.0
     # elastic hourglass stiffness (quadrilaterals; 0: viscous only, shell_quad.c)
     hourglass_stiffness: float = 0.0
+    # drilling stiffness over G t A (quadrilaterals; 0: none, shell_quad.c)
+    drilling_stiffness: float = 0.0
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
                hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
-               hourglass_stiffness: float = 0.0) -> ShellTechnology:
+               hourglass_stiffness: float = 0.0,
+               drilling_stiffness: float = 0.0) -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -217,8 +222,14 @@ class ShellTechnology:
             raise ValueError(
                 f"element.hourglass_stiffness: must be >= 0, got {hourglass_stiffness}"
             )
+        if not drilling_stiffness >= 0.0:
+            raise ValueError(
+                f"element.drilling_stiffness: must be >= 0, got {drilling_stiffness}"
+            )
+        quad = cell == "quadrilateral"
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
-                   float(hourglass_stiffness) if cell == "quadrilateral" else 0.0)  # fmt: skip
+                   float(hourglass_stiffness) if quad else 0.0,
+                   float(drilling_stiffness) if quad else 0.0)  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -298,6 +309,10 @@ class ShellKernel:
         if s.hk > 0.0:  # the elastic hourglass forces, in rows after the others
             s.hourglass_slot = len(self.history)
             self.history = np.concatenate([self.history, np.zeros((5, n))])
+        s.kd = technology.drilling_stiffness
+        if s.kd > 0.0:  # the nodal drilling moments, in rows after the others
+            s.drill_slot = len(self.history)
+            self.history = np.concatenate([self.history, np.zeros((4, n))])
         self.family = FAMILY[technology.cell]
         law = "plastic" if self.plastic else "elastic"
         self.name = f"shell_{self.family}_{law}"
