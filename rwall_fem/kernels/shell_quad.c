@@ -16,7 +16,8 @@
  * and the strain at height z is d + z k.  Stress resultants N (membrane), M (moments) and
  * Q (transverse shear, shear factor 5/6, elastic) act back through the transposed relations
  * (the power A (N.d + M.k + Q.g) equals f.v + m.theta).  The element has no drilling
- * stiffness: its moment about e3 is zero.
+ * stiffness (its moment about e3 is zero) unless s->kd > 0: drilling springs, see
+ * quad_drill_update.
  *
  * Warping (s->warping, Belytschko-Wong-Chiang's correction by the rigid-body projection of
  * Belytschko and Leviathan): a rigid rotation (Ox, Oy) about the in-plane axes gives the

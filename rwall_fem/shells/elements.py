@@ -16,7 +16,8 @@ DOLFINx surface mesh, shaped like :class:`~rwall_fem.elements.ElementForce`.
 
 Nodes have 6 degrees of freedom: translations, and rotations whose angular velocities
 (rad/s, global frame) the kernels read; they write the internal force (N) and moment
-(N m) of each node. The element has no drilling stiffness (no moment about its normal).
+(N m) of each node. The elements have no drilling stiffness (no moment about their normal)
+unless :attr:`ShellTechnology.drilling_stiffness` gives the quadrilaterals drilling springs.
 """
 
 from __future__ import annotations
