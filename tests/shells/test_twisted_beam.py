@@ -10,8 +10,9 @@ its length, gives 5.426e-3 and 1.746e-3 (checked below).
 The element constants: drilling springs 0.01 G t A (without them the twisted mesh is a
 mechanism: nothing holds the nodes' rotations about the normals, and dynamic relaxation
 drifts without bound; holding each node's rotation about its mean normal instead, 5
-degrees of freedom, is a support that puts moments into the strip: +44 % / +37 %, the
-figure the theory page gave before), and the elastic hourglass stiffness 0.5 (two cells
+degrees of freedom, is a support that puts moments into the strip: +44 % / +37 % with
+the viscous hourglass alone, +39 % / +32 % with hk 1, the figure the theory page gave
+before), and the elastic hourglass stiffness 0.5 (two cells
 across the width: the strip's in-plane bending is mostly the cells' hourglass mode).
 Measured at 12 x 2 (docs/theory.md, "Warping"):
 - BWC: -0.1 % (normal) and -2.7 % (width), asserted within 5 %;
