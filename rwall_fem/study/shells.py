@@ -1,0 +1,205 @@
+"""Shells against solids: a clamped 2 mm steel plate struck by a sphere wall.
+
+The plate of the peer decks (``../shared/peer-decks/gen_shell.py plate``): 200 x 200 mm,
+2 mm steel (rho 7850 kg/m^3, E 210 GPa, nu 0.3), its rim clamped, struck at its centre by
+a rigid sphere of 40 mm on a 1 kg main node; elastic at 5 m/s (4 ms), and elasto-plastic
+(J2, sigma_y = 300 MPa + 300 MPa eps_p) at 20 m/s (2 ms). A quarter of it is run (the
+planes x = 0 and y = 0 are planes of symmetry; the sphere's mass is a quarter), and the
+figures are the whole plate's. The reference is the finest solid run: hexahedra through
+the thickness (one point, ``[element] hourglass``, see :data:`SOLID_ELEMENT`), refined in
+the plane and through the thickness together. The sphere starts 0.1 mm above the skin it
+strikes: the solids' top face, the shells' mid-surface (walls act on the shells' nodes,
+with no thickness offset).
+
+Figures per run: the peak force on the sphere (N), the contact time (s, first to last step
+in contact) and the largest deflection under the sphere (m: its largest travel less the
+0.1 mm gap), with the cells, steps and the wall and CPU times of the time loop.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from pathlib import Path
+
+from rwall_fem.build import build_simulation
+from rwall_fem.scene import parse_scene
+
+__all__ = ["LOADS", "SHELL_LEVELS", "SOLID_LEVELS", "plate_scene", "run_plate", "run_shell_study"]
+
+HALF = 0.1  # m, the quarter's side (the plate is 200 mm)
+THICKNESS = 0.002  # m
+RADIUS = 0.02  # m, the sphere's
+GAP = 1.0e-4  # m, from the sphere to the skin it strikes
+STEEL = {"density": 7850.0, "young": 210.0e9, "poisson": 0.3}
+# name -> (material table, impact speed m/s, end time s)
+LOADS = {
+    "elastic": ({"model": "linear_elastic", **STEEL}, 5.0, 4.0e-3),
+    "plastic": ({"model": "elastic_plastic", **STEEL, "hardening": "linear",
+                 "yield_stress": 300.0e6, "hardening_modulus": 300.0e6}, 20.0, 2.0e-3),
+}  # fmt: skip
+# (in-plane size m, layers through the thickness): the aspect of the hexahedra stays 5.
+SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.6667e-3, 6))
+SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
+QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
+SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
+MASS = 1.0  # kg, the whole sphere's
+
+# The quarter plate in hexahedra: a structured box with its symmetry planes and its rim
+# as named face groups (the built-in plate names its sides only together).
+_QUARTER_GEO = """// quarter of a plate, {lx} x {lx} x {t} m, {n} x {n} x {layers} hexahedra
+SetFactory("Built-in");
+Point(1) = {{0, 0, {z0}}};
+ex[] = Extrude {{{lx}, 0, 0}} {{ Point{{1}}; Layers{{{n}}}; Recombine; }};
+ey[] = Extrude {{0, {lx}, 0}} {{ Line{{ex[1]}}; Layers{{{n}}}; Recombine; }};
+ez[] = Extrude {{0, 0, {t}}} {{ Surface{{ey[1]}}; Layers{{{layers}}}; Recombine; }};
+e = {eps};
+Physical Volume("body") = {{ez[1]}};
+Physical Surface("sym_x") = Surface In BoundingBox{{-e, -e, {z0} - e, e, {lx} + e, {z1} + e}};
+Physical Surface("sym_y") = Surface In BoundingBox{{-e, -e, {z0} - e, {lx} + e, e, {z1} + e}};
+Physical Surface("rim_x") = Surface In BoundingBox{{{lx} - e, -e, {z0} - e, {lx} + e, {lx} + e, {z1} + e}};
+Physical Surface("rim_y") = Surface In BoundingBox{{-e, {lx} - e, {z0} - e, {lx} + e, {lx} + e, {z1} + e}};
+"""
+
+
+def _quarter_geo(folder: Path, h: float, layers: int) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"quarter_h{h * 1e3:g}mm_{layers}layers.geo"
+    n = round(HALF / h)
+    path.write_text(_QUARTER_GEO.format(lx=HALF, t=THICKNESS, n=n, layers=layers,
+                                        z0=-THICKNESS / 2, z1=THICKNESS / 2, eps=1e-3 * h))  # fmt: skip
+    return path
+
+
+def plate_scene(load: str, kind: str, h: float, layers: int = 0, folder: Path = Path(".")) -> dict:
+    """The quarter plate of ``kind`` "shell" (quadrilaterals of ``h`` m) or "solid"
+    (hexahedra, ``layers`` through the thickness) under ``load`` (a key of :data:`LOADS`)."""
+    material, speed, end_time = LOADS[load]
+    if kind == "shell":
+        mesh = {"shape": "plate", "origin": [0.0, 0.0, -THICKNESS / 2],
+                "size": [HALF, HALF, THICKNESS], "element_size": h, "cell": "quadrilateral"}  # fmt: skip
+        boundary = [
+            {"group": "side_x0", "components": "x", "rotations": "yz"},
+            {"group": "side_y0", "components": "y", "rotations": "xz"},
+            {"group": "side_x1", "components": "xyz", "rotations": "xyz"},
+            {"group": "side_y1", "components": "xyz", "rotations": "xyz"},
+        ]
+        element, skin = {"points": 5}, 0.0  # the sphere acts on the mid-surface
+    else:
+        mesh = {"file": str(_quarter_geo(folder, h, layers))}
+        boundary = [
+            {"group": "sym_x", "components": "x"},
+            {"group": "sym_y", "components": "y"},
+            {"group": "rim_x", "components": "xyz"},
+            {"group": "rim_y", "components": "xyz"},
+        ]
+        element, skin = dict(SOLID_ELEMENT), THICKNESS / 2
+    return {
+        "run": {"end_time": end_time},
+        "mesh": mesh,
+        "element": element,
+        "material": dict(material),
+        "boundary": boundary,
+        "wall": [{
+            "kind": "sphere", "point": [0.0, 0.0, skin + GAP + RADIUS], "diameter": 2 * RADIUS,
+            "motion": {"mass": MASS / 4, "velocity": [0.0, 0.0, -speed]},
+        }],
+        "output": {"frames": 0, "plot": False, "history_interval": 1},
+    }  # fmt: skip
+
+
+def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -> dict:
+    """One run -> a row: its size, cost and the whole plate's figures."""
+    raw = plate_scene(load, kind, h, layers, folder)
+    scene = parse_scene(raw, source=f"study:shells:{load}:{kind}")
+    sim = build_simulation(scene, comm, folder)
+    cpu = time.process_time()
+    sim.run()
+    cpu = comm.allreduce(time.process_time() - cpu)
+    s = sim.history.summary
+    wall = s["walls"][0]
+    from rwall_fem.output.wall_table import WALL_COLUMNS
+
+    rows = sim.history.wall(0)
+    force = rows[:, WALL_COLUMNS.index("force_z")]
+    z = rows[:, WALL_COLUMNS.index("position_z")]
+    first, last = wall["first_contact"], wall["last_contact"]
+    return {
+        "load": load, "kind": kind, "element_size": h, "layers": layers,
+        "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
+        "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu,
+        "peak_force": 4.0 * abs(force).max(),
+        "contact_time": math.nan if first is None else last - first + s["dt"],
+        "deflection": z[0] - z.min() - GAP,
+        "rebound": wall["velocity"][2],
+        "balance_error": s["energy"]["max_balance_error"],
+    }  # fmt: skip
+
+
+FIGURES = {"peak_force": ("peak force", 1e-3, "kN"), "contact_time": ("contact time", 1e3, "ms"),
+           "deflection": ("largest deflection", 1e3, "mm")}  # fmt: skip
+
+
+def report(rows: list[dict], seconds: float) -> str:
+    """The markdown section: every run, and each shell's error against the finest solid."""
+    lines = ["## Shells against solids: a clamped 2 mm steel plate struck by a sphere", "",
+             __doc__.split("\n\n", 1)[1].strip(), ""]  # fmt: skip
+    for load in LOADS:
+        runs = [r for r in rows if r["load"] == load]
+        solids = [r for r in runs if r["kind"] == "solid"]
+        if not solids:
+            continue
+        ref = solids[-1]
+        material, speed, end = LOADS[load]
+        lines += [f"**{load}** ({material['model']}, {speed:g} m/s, {end * 1e3:g} ms); errors "
+                  f"against the finest solid ({ref['cells']:,} hexahedra):", "",
+                  "| model | h (mm) | layers | cells | steps | loop wall (s) | loop CPU (s) | "
+                  + " | ".join(f"{label} ({unit})" for label, _, unit in FIGURES.values())
+                  + " | balance |",
+                  "|---" * (7 + len(FIGURES) + 1) + "|"]  # fmt: skip
+        for r in runs:
+            cells = [f"{r[k] * scale:.4g} ({100 * (r[k] / ref[k] - 1):+.2f} %)"
+                     if r is not ref else f"{r[k] * scale:.4g}"
+                     for k, (_, scale, _) in FIGURES.items()]  # fmt: skip
+            layers = r["layers"] if r["kind"] == "solid" else "-"
+            lines.append(f"| {r['kind']} | {r['element_size'] * 1e3:.3g} | {layers} | "
+                         f"{r['cells']:,} | {r['steps']:,} | {r['wall_seconds']:.3g} | "
+                         f"{r['cpu_seconds']:.3g} | " + " | ".join(cells)
+                         + f" | {r['balance_error']:.1e} |")  # fmt: skip
+        lines.append("")
+    lines.append(f"The shell study took {seconds:.0f} s (set-up included) on 1 rank; the "
+                 "quarter plate, figures of the whole.")  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=None,
+                    echo=print) -> list[dict]:  # fmt: skip
+    """Every load x (solid levels, shell levels); writes ``shells.csv`` and ``shells.md``."""
+    from mpi4py import MPI
+
+    comm = comm or MPI.COMM_WORLD
+    out = Path(out)
+    started = time.perf_counter()
+    rows = []
+    for load in LOADS:
+        plan = [("solid", h, n) for h, n in (QUICK_SOLID if quick else SOLID_LEVELS)]
+        plan += [("shell", h, 0) for h in (QUICK_SHELL if quick else SHELL_LEVELS)]
+        for kind, h, layers in plan:
+            folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm"
+            row = run_plate(load, kind, h, layers, comm, folder)
+            rows.append(row)
+            if comm.rank == 0 and echo:
+                echo(f"study shells: {load} {kind} h={h * 1e3:.3g}mm layers={layers} "
+                     f"cells={row['cells']} steps={row['steps']} loop={row['wall_seconds']:.3g}s "
+                     f"cpu={row['cpu_seconds']:.3g}s peak={row['peak_force']:.5g}N "
+                     f"contact={row['contact_time']:.5g}s deflection={row['deflection']:.5g}m",
+                     flush=True)  # fmt: skip
+    seconds = comm.allreduce(time.perf_counter() - started, op=MPI.MAX)
+    if comm.rank == 0:
+        with open(out / "shells.csv", "w", newline="") as f:
+            writer = csv.DictWriter(f, list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+        (out / "shells.md").write_text(report(rows, seconds))
+    return rows
