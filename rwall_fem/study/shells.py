@@ -3,17 +3,21 @@
 The plate of the peer decks (``../shared/peer-decks/gen_shell.py plate``): 200 x 200 mm,
 2 mm steel (rho 7850 kg/m^3, E 210 GPa, nu 0.3), its rim clamped, struck at its centre by
 a rigid sphere of 40 mm on a 1 kg main node; elastic at 5 m/s (4 ms), and elasto-plastic
-(J2, sigma_y = 300 MPa + 300 MPa eps_p) at 20 m/s (2 ms). A quarter of it is run (the
-planes x = 0 and y = 0 are planes of symmetry; the sphere's mass is a quarter), and the
-figures are the whole plate's. The reference is the finest solid run: hexahedra through
+(J2, sigma_y = 300 MPa + 300 MPa eps_p) at 20 m/s (2 ms). The solids are a quarter of it
+(the planes x = 0 and y = 0 are planes of symmetry; the sphere's mass is a quarter), the
+shells the whole plate, and the figures are the whole plate's. (A quarter of the shells
+gives the whole plate's answers to every digit in the elastic case, but in the
+elasto-plastic case it departs from 0.3 ms on, and rebounds not at all, while the whole
+plate stays mirror-symmetric to 1e-17 m: an open question for the plastic shells.) The reference is the finest solid run: hexahedra through
 the thickness (one point, ``[element] hourglass``, see :data:`SOLID_ELEMENT`), refined in
 the plane and through the thickness together. The sphere starts 0.1 mm above the skin it
 strikes: the solids' top face, the shells' mid-surface (walls act on the shells' nodes,
 with no thickness offset).
 
-Figures per run: the peak force on the sphere (N), the contact time (s, first to last step
-in contact) and the largest deflection under the sphere (m: its largest travel less the
-0.1 mm gap), with the cells, steps and the wall and CPU times of the time loop.
+Figures per run: the peak force on the sphere (N, its largest 50-us mean), the contact
+time (s, first to last step in contact) and the largest deflection under the sphere (m:
+its largest travel less the 0.1 mm gap), with the cells, steps and the wall and CPU times
+of the time loop.
 """
 
 from __future__ import annotations
@@ -23,28 +27,37 @@ import math
 import time
 from pathlib import Path
 
+import numpy as np
+
 from rwall_fem.build import build_simulation
 from rwall_fem.scene import parse_scene
 
-__all__ = ["LOADS", "SHELL_LEVELS", "SOLID_LEVELS", "plate_scene", "run_plate", "run_shell_study"]
+__all__ = ["LOADS", "SHELL_LEVELS", "SOLID_LEVELS", "measure", "plate_scene", "run_plate",
+           "run_shell_study"]  # fmt: skip
 
 HALF = 0.1  # m, the quarter's side (the plate is 200 mm)
 THICKNESS = 0.002  # m
 RADIUS = 0.02  # m, the sphere's
 GAP = 1.0e-4  # m, from the sphere to the skin it strikes
 STEEL = {"density": 7850.0, "young": 210.0e9, "poisson": 0.3}
-# name -> (material table, impact speed m/s, end time s)
+# name -> (material table, impact speed m/s, end time s). The elastic solids take the
+# large-deformation Saint Venant-Kirchhoff law: "linear_elastic" is geometrically linear
+# on solids (no membrane stiffening: 34 % more deflection here), while the shells'
+# co-rotational frame makes it exact for large rotations (the strains stay small).
 LOADS = {
     "elastic": ({"model": "linear_elastic", **STEEL}, 5.0, 4.0e-3),
     "plastic": ({"model": "elastic_plastic", **STEEL, "hardening": "linear",
                  "yield_stress": 300.0e6, "hardening_modulus": 300.0e6}, 20.0, 2.0e-3),
 }  # fmt: skip
+SOLID_MODEL = {"linear_elastic": "saint_venant_kirchhoff"}
 # (in-plane size m, layers through the thickness): the aspect of the hexahedra stays 5.
 SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.6667e-3, 6))
-SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
+SHELL_LEVELS = (5.0e-3, 2.5e-3)  # m, quadrilaterals
 QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
 SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
 MASS = 1.0  # kg, the whole sphere's
+PEAK_WINDOW = 50e-6  # s, the peak force is the largest mean over this long
+SHARE = {"solid": 4, "shell": 1}  # the whole plate over the part that is run
 
 # The quarter plate in hexahedra: a structured box with its symmetry planes and its rim
 # as named face groups (the built-in plate names its sides only together).
@@ -76,15 +89,12 @@ def plate_scene(load: str, kind: str, h: float, layers: int = 0, folder: Path = 
     """The quarter plate of ``kind`` "shell" (quadrilaterals of ``h`` m) or "solid"
     (hexahedra, ``layers`` through the thickness) under ``load`` (a key of :data:`LOADS`)."""
     material, speed, end_time = LOADS[load]
-    if kind == "shell":
-        mesh = {"shape": "plate", "origin": [0.0, 0.0, -THICKNESS / 2],
-                "size": [HALF, HALF, THICKNESS], "element_size": h, "cell": "quadrilateral"}  # fmt: skip
-        boundary = [
-            {"group": "side_x0", "components": "x", "rotations": "yz"},
-            {"group": "side_y0", "components": "y", "rotations": "xz"},
-            {"group": "side_x1", "components": "xyz", "rotations": "xyz"},
-            {"group": "side_y1", "components": "xyz", "rotations": "xyz"},
-        ]
+    if kind == "shell":  # the whole plate
+        mesh = {"shape": "plate", "origin": [-HALF, -HALF, -THICKNESS / 2],
+                "size": [2 * HALF, 2 * HALF, THICKNESS], "element_size": h,
+                "cell": "quadrilateral"}  # fmt: skip
+        boundary = [{"group": side, "components": "xyz", "rotations": "xyz"}
+                    for side in ("side_x0", "side_x1", "side_y0", "side_y1")]  # fmt: skip
         element, skin = {"points": 5}, 0.0  # the sphere acts on the mid-surface
     else:
         mesh = {"file": str(_quarter_geo(folder, h, layers))}
@@ -95,22 +105,25 @@ def plate_scene(load: str, kind: str, h: float, layers: int = 0, folder: Path = 
             {"group": "rim_y", "components": "xyz"},
         ]
         element, skin = dict(SOLID_ELEMENT), THICKNESS / 2
+    material = dict(material)
+    if kind == "solid":
+        material["model"] = SOLID_MODEL.get(material["model"], material["model"])
     return {
         "run": {"end_time": end_time},
         "mesh": mesh,
         "element": element,
-        "material": dict(material),
+        "material": material,
         "boundary": boundary,
         "wall": [{
             "kind": "sphere", "point": [0.0, 0.0, skin + GAP + RADIUS], "diameter": 2 * RADIUS,
-            "motion": {"mass": MASS / 4, "velocity": [0.0, 0.0, -speed]},
+            "motion": {"mass": MASS / SHARE[kind], "velocity": [0.0, 0.0, -speed]},
         }],
         "output": {"frames": 0, "plot": False, "history_interval": 1},
     }  # fmt: skip
 
 
 def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -> dict:
-    """One run -> a row: its size, cost and the whole plate's figures."""
+    """One run -> a row: its size, cost and the whole plate's figures (:func:`measure`)."""
     raw = plate_scene(load, kind, h, layers, folder)
     scene = parse_scene(raw, source=f"study:shells:{load}:{kind}")
     sim = build_simulation(scene, comm, folder)
@@ -118,23 +131,37 @@ def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -
     sim.run()
     cpu = comm.allreduce(time.process_time() - cpu)
     s = sim.history.summary
-    wall = s["walls"][0]
+    row = {"load": load, "kind": kind, "element_size": h, "layers": layers,
+           "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
+           "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu}  # fmt: skip
+    return row | measure(s, sim.history.wall(0), SHARE[kind])
+
+
+def measure(summary: dict, rows, share: int = 1) -> dict:
+    """The whole plate's figures from the run's summary and its wall's rows (walls.csv):
+    the peak force (N) is the largest mean over PEAK_WINDOW (the solids' contact chatters:
+    from one step to the next their force doubles as a node strikes the sphere), the
+    contact time (s) from the first to the last step in contact, the largest deflection
+    (m) the sphere's largest travel less the gap, the rebound its final velocity (m/s);
+    ``share`` is the whole plate over the part that ran."""
     from rwall_fem.output.wall_table import WALL_COLUMNS
 
-    rows = sim.history.wall(0)
-    force = rows[:, WALL_COLUMNS.index("force_z")]
+    t = rows[:, WALL_COLUMNS.index("time")]
+    impulse = share * rows[:, WALL_COLUMNS.index("impulse_z")]
     z = rows[:, WALL_COLUMNS.index("position_z")]
+    centre = np.arange(PEAK_WINDOW / 2, t[-1] - PEAK_WINDOW / 2, PEAK_WINDOW / 10)
+    mean = (np.interp(centre + PEAK_WINDOW / 2, t, impulse)
+            - np.interp(centre - PEAK_WINDOW / 2, t, impulse)) / PEAK_WINDOW  # fmt: skip
+    wall = summary["walls"][0]
     first, last = wall["first_contact"], wall["last_contact"]
     return {
-        "load": load, "kind": kind, "element_size": h, "layers": layers,
-        "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
-        "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu,
-        "peak_force": 4.0 * abs(force).max(),
-        "contact_time": math.nan if first is None else last - first + s["dt"],
+        "peak_force": mean.max(),
+        "peak_time": centre[mean.argmax()],
+        "contact_time": math.nan if first is None else last - first + summary["dt"],
         "deflection": z[0] - z.min() - GAP,
         "rebound": wall["velocity"][2],
-        "balance_error": s["energy"]["max_balance_error"],
-    }  # fmt: skip
+        "balance_error": summary["energy"]["max_balance_error"],
+    }
 
 
 FIGURES = {"peak_force": ("peak force", 1e-3, "kN"), "contact_time": ("contact time", 1e3, "ms"),
@@ -168,21 +195,21 @@ def report(rows: list[dict], seconds: float) -> str:
                          f"{r['cpu_seconds']:.3g} | " + " | ".join(cells)
                          + f" | {r['balance_error']:.1e} |")  # fmt: skip
         lines.append("")
-    lines.append(f"The shell study took {seconds:.0f} s (set-up included) on 1 rank; the "
-                 "quarter plate, figures of the whole.")  # fmt: skip
+    lines.append(f"The shell study took {seconds:.0f} s (set-up included) on 1 rank.")
     return "\n".join(lines) + "\n"
 
 
 def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=None,
-                    echo=print) -> list[dict]:  # fmt: skip
-    """Every load x (solid levels, shell levels); writes ``shells.csv`` and ``shells.md``."""
+                    loads=tuple(LOADS), echo=print) -> list[dict]:  # fmt: skip
+    """Every load (of ``loads``) x (solid levels, shell levels); writes ``shells.csv`` and
+    ``shells.md``."""
     from mpi4py import MPI
 
     comm = comm or MPI.COMM_WORLD
     out = Path(out)
     started = time.perf_counter()
     rows = []
-    for load in LOADS:
+    for load in loads:
         plan = [("solid", h, n) for h, n in (QUICK_SOLID if quick else SOLID_LEVELS)]
         plan += [("shell", h, 0) for h in (QUICK_SHELL if quick else SHELL_LEVELS)]
         for kind, h, layers in plan:
