@@ -47,8 +47,9 @@ def openradioss(folder: Path, name: str, exe: Path) -> dict:
     subprocess.run([str(exe / STARTER), "-i", f"{name}_0000.rad", "-np", "1", "-nt", "1"],
                    cwd=folder, env=env, check=True, capture_output=True)  # fmt: skip
     cpu, wall = children_cpu(), time.perf_counter()
-    done = subprocess.run([str(exe / ENGINE), "-i", f"{name}_0001.rad", "-nt", "1"],
-                          cwd=folder, env=env, check=True, capture_output=True, text=True)  # fmt: skip
+    command = [str(exe / ENGINE), "-i", f"{name}_0001.rad", "-nt", "1"]
+    done = subprocess.run(command, cwd=folder, env=env, check=True, capture_output=True,
+                          text=True)  # fmt: skip
     cycles = re.findall(r"NC=\s*(\d+)", done.stdout)
     return {"cpu": children_cpu() - cpu, "wall": time.perf_counter() - wall,
             "cycles": int(cycles[-1]) if cycles else None}  # fmt: skip

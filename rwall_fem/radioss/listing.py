@@ -6,8 +6,8 @@ A cell's step is its stable estimate ``L / c`` at rest, the one the run starts f
 (``docs/theory.md``): ``L`` its volume over its largest face area (a tetrahedron: three
 times that), ``c`` the dilatational wave speed of its material,
 ``sqrt(E (1 - nu) / (rho (1 + nu) (1 - 2 nu)))``; a shell's ``L`` is Radioss's L_c and
-``c`` Radioss's shell sound speed ``sqrt(E / rho)``, its mass rho t A. The volume of a hexahedron is the
-2 x 2 x 2 Gauss integral of its Jacobian, exact for the trilinear map.
+``c`` Radioss's shell sound speed ``sqrt(E / rho)``, its mass rho t A. The volume of a
+hexahedron is the 2 x 2 x 2 Gauss integral of its Jacobian, exact for the trilinear map.
 """
 
 from __future__ import annotations

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem.build import build_simulation
+from rwall_fem.output import OutputError
 from rwall_fem.scene import parse_scene
 
 __all__ = ["LOADS", "SHELL_LEVELS", "SOLID_LEVELS", "measure", "plate_scene", "run_plate",
@@ -68,11 +69,12 @@ ex[] = Extrude {{{lx}, 0, 0}} {{ Point{{1}}; Layers{{{n}}}; Recombine; }};
 ey[] = Extrude {{0, {lx}, 0}} {{ Line{{ex[1]}}; Layers{{{n}}}; Recombine; }};
 ez[] = Extrude {{0, 0, {t}}} {{ Surface{{ey[1]}}; Layers{{{layers}}}; Recombine; }};
 e = {eps};
+lo = {z0} - e; hi = {z1} + e; L = {lx};
 Physical Volume("body") = {{ez[1]}};
-Physical Surface("sym_x") = Surface In BoundingBox{{-e, -e, {z0} - e, e, {lx} + e, {z1} + e}};
-Physical Surface("sym_y") = Surface In BoundingBox{{-e, -e, {z0} - e, {lx} + e, e, {z1} + e}};
-Physical Surface("rim_x") = Surface In BoundingBox{{{lx} - e, -e, {z0} - e, {lx} + e, {lx} + e, {z1} + e}};
-Physical Surface("rim_y") = Surface In BoundingBox{{-e, {lx} - e, {z0} - e, {lx} + e, {lx} + e, {z1} + e}};
+Physical Surface("sym_x") = Surface In BoundingBox{{-e, -e, lo, e, L + e, hi}};
+Physical Surface("sym_y") = Surface In BoundingBox{{-e, -e, lo, L + e, e, hi}};
+Physical Surface("rim_x") = Surface In BoundingBox{{L - e, -e, lo, L + e, L + e, hi}};
+Physical Surface("rim_y") = Surface In BoundingBox{{-e, L - e, lo, L + e, L + e, hi}};
 """
 
 
@@ -80,14 +82,17 @@ def _quarter_geo(folder: Path, h: float, layers: int) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"quarter_h{h * 1e3:g}mm_{layers}layers.geo"
     n = round(HALF / h)
-    path.write_text(_QUARTER_GEO.format(lx=HALF, t=THICKNESS, n=n, layers=layers,
-                                        z0=-THICKNESS / 2, z1=THICKNESS / 2, eps=1e-3 * h))  # fmt: skip
+    text = _QUARTER_GEO.format(lx=HALF, t=THICKNESS, n=n, layers=layers, z0=-THICKNESS / 2,
+                               z1=THICKNESS / 2, eps=1e-3 * h)  # fmt: skip
+    path.write_text(text)
     return path
 
 
-def plate_scene(load: str, kind: str, h: float, layers: int = 0, folder: Path = Path(".")) -> dict:
-    """The quarter plate of ``kind`` "shell" (quadrilaterals of ``h`` m) or "solid"
-    (hexahedra, ``layers`` through the thickness) under ``load`` (a key of :data:`LOADS`)."""
+def plate_scene(load: str, kind: str, h: float, layers: int = 0,
+                folder: Path = Path(".")) -> dict:  # fmt: skip
+    """The scene of ``kind`` "shell" (the whole plate in quadrilaterals of ``h`` m) or
+    "solid" (its quarter in hexahedra, ``layers`` through the thickness, the mesh file in
+    ``folder``) under ``load`` (a key of :data:`LOADS`)."""
     material, speed, end_time = LOADS[load]
     if kind == "shell":  # the whole plate
         mesh = {"shape": "plate", "origin": [-HALF, -HALF, -THICKNESS / 2],
@@ -131,7 +136,7 @@ def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -
     sim.run()
     cpu = comm.allreduce(time.process_time() - cpu)
     s = sim.history.summary
-    row = {"load": load, "kind": kind, "element_size": h, "layers": layers,
+    row = {"load": load, "kind": kind, "status": s["status"], "element_size": h, "layers": layers,
            "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
            "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu}  # fmt: skip
     return row | measure(s, sim.history.wall(0), SHARE[kind])
@@ -222,6 +227,8 @@ def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=Non
         for kind, h, layers in plan:
             folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm"
             row = run_plate(load, kind, h, layers, comm, folder)
+            if row["status"] != "done":  # stopped (a signal, a limit): so is the study
+                raise OutputError(f"study shells: {folder}: the run {row['status']}")
             rows.append(row)
             if comm.rank == 0 and echo:
                 echo(f"study shells: {load} {kind} h={h * 1e3:.3g}mm layers={layers} "
