@@ -34,7 +34,8 @@ SHELLS = {
     "tube": (["tube"], {"cycles": 21666, "travel": 28.57e-3, "velocity": -5.29,
                         "plastic": 734.0, "fold": 81.8e3, "fold_time": 0.07e-3, "impulse": 94.1}),
     "tube_ishell1": (["tube", "--ishell", "1"], {"cycles": 19651, "travel": 28.63e-3,
-                     "velocity": -5.19, "plastic": 727.0, "fold": 81.6e3}),
+                     "velocity": -5.19, "plastic": 727.0, "fold": 81.6e3,
+                     "hourglass": 33.0}),
     "plate": (["plate"], {"cycles": 5219, "travel": 17.95e-3, "rebound": 4.85,
                           "impulse": 24.92, "peak": 24.8e3, "peak_time": 1.26e-3,
                           "plastic": 186.9}),
@@ -85,10 +86,11 @@ def shell_figures(starter: Path, out: Path) -> dict:
     rows = sim.history.wall(0)
     col = {name: rows[:, WALL_COLUMNS.index(name)] for name in WALL_COLUMNS}
     t, z = col["time"], col["position_z"]
-    figures = {"cycles": s["steps"], "travel": z[0] - z.min(), "velocity": col["velocity_z"][-1],
+    tube = "tube" in starter.name
+    figures = {"cycles": s["steps"], "travel": z[0] - z.min(),
+               "velocity" if tube else "rebound": col["velocity_z"][-1],
                "impulse": col["impulse_z"][-1]}  # fmt: skip
-    figures["rebound"] = figures["velocity"]
-    if "tube" in starter.name:
+    if tube:
         # the mean force over [t - w/2, t + w/2], from the cumulative impulse, every w up
         # to 0.2 ms: the first fold is its largest maximum after its first minimum (the
         # elastic wave of the tied wall's first cycles comes before)
