@@ -238,10 +238,13 @@ study: venv-0.5
 # 80k scene is run alternately with the new. PRE_EROSION_TREE: a checkout of the code before
 # failure and erosion, whose kernels bench/erosion.py times beside the new ones.
 # PRE_CORNER_TREE: a checkout before the corner test of one-point hexahedra (864d876), for
-# bench/corners.py (bench/corners.md).
+# bench/corners.py (bench/corners.md). OPENRADIOSS: the folder of OpenRadioss's
+# starter_linux64_gf and engine_linux64_gf for bench/openradioss_timing.py (the peer shell
+# decks in both codes, CPU times; one SKIPPED line without them).
 OLD_TREE ?=
 PRE_EROSION_TREE ?=
 PRE_CORNER_TREE ?=
+OPENRADIOSS ?=
 bench: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
 	    $(VENV)/bin/python bench/bench.py --out bench/results.md $(if $(OLD_TREE),--old-tree $(OLD_TREE))
@@ -250,6 +253,8 @@ bench: venv-0.5
 	    $(if $(PRE_EROSION_TREE),--main-tree $(PRE_EROSION_TREE))
 	$(if $(PRE_CORNER_TREE),$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/corners.py \
 	    --before-tree $(PRE_CORNER_TREE))
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/openradioss_timing.py \
+	    $(if $(OPENRADIOSS),--openradioss $(OPENRADIOSS))
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials
