@@ -36,7 +36,7 @@ typedef struct
   double weight[SHELL_MAX_POINTS]; /* their weights, summing to 1 */
   double young, poisson;   /* E (Pa), nu */
   double shear_factor;     /* of the transverse shear, 5/6 */
-  double bar_speed;        /* sqrt(E / (rho (1 - nu^2))), m/s */
+  double bar_speed;        /* sqrt(E / rho), m/s (Radioss's shell sound speed) */
   double hm, hf, hr;       /* viscous hourglass coefficients: membrane, out-of-plane, rotation */
   double fail_fraction;    /* a cell fails when this share of its points has failed */
   int warping;             /* 1: project out the rigid motion (warped cells), 0: plain BT */

@@ -290,7 +290,9 @@ class ShellKernel:
         self.shell = s = ffi.new("shell_params *")
         s.thickness = ffi.cast("double *", self.thickness.ctypes.data)
         s.young, s.poisson, s.shear_factor = E, nu, technology.shear_factor
-        s.bar_speed = math.sqrt(E / (rho * (1 - nu * nu)))
+        # Radioss's shell sound speed (PM(27) = sqrt(E / rho), the engine's CDT3 and CNDT3):
+        # the step L_c / c is sqrt(1 - nu^2) times longer than with the plate speed.
+        s.bar_speed = math.sqrt(E / rho)
         s.hm, s.hf, s.hr = technology.hourglass
         s.warping = int(technology.formulation == "bwc")
         if not 0.0 < failed_share <= 1.0:
