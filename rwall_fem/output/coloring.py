@@ -7,9 +7,9 @@ fits the scene: a nodal quantity spans the 95th percentile of its magnitude
 over all nodes and frames (the spikes at a wave front or under a ball
 saturate, the bulk of the motion spans the range), velocities at least the
 initial speed; a cell field spans its maximum (plastic strain is often zero
-but in a few cells, which are the point). The range is rounded up to a round
-number, in a unit with a prefix that keeps the labels short (``µm``, ``MPa``),
-and its labels fall on round values written with one format. This module
+but in a few cells, which are the point), up to its physical bound (damage
+ends at 1: :data:`BOUNDS`). The range is rounded up to a round number, in a
+unit with a prefix that keeps the labels short (``µm``, ``MPa``), and its labels fall on round values written with one format. This module
 needs neither DOLFINx nor VTK.
 """
 
@@ -32,6 +32,9 @@ CELL_FIELDS = {
     "von_mises_stress": ("von Mises stress", "Pa"),
     "damage": ("damage D", ""),
 }
+# Physical bounds of the cell fields that have one: an automatic range stops there (a
+# damage of 1 is failure: the values a failed cell accumulates beyond it saturate).
+BOUNDS = {"damage": 1.0, "eroded": 1.0}
 # The colours of the parts (matplotlib's "tab10"), in the order of the parts, cycled.
 PART_COLORS = (
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
@@ -107,7 +110,7 @@ def coloring(
         name, unit = CELL_FIELDS.get(color, (color.replace("_", " "), ""))
     everything = np.abs(np.concatenate(values))
     if color not in COLORS:
-        top = float(everything.max(initial=0.0))
+        top = min(float(everything.max(initial=0.0)), BOUNDS.get(color, math.inf))
     else:
         top = float(np.percentile(everything, 95)) if everything.size else 0.0
         if unit == "m/s":

@@ -92,6 +92,17 @@ def test_displacement_in_micrometres_and_cell_fields_on_cells():
         coloring("plastic_strain", _frames([u], [u]), points, [], UP, 0.0)
 
 
+def test_damage_ranges_up_to_failure_at_most():
+    """Damage is in [0, 1] (1: failed): a failed cell's damage of 1.13 does not stretch the
+    range to 1.2; a damage of at most 0.31 is ranged to 0.4 as any field."""
+    points, u = np.zeros((20, 3)), np.zeros((20, 3))
+    for largest, top in [(1.13, 1.0), (1.0, 1.0), (0.31, 0.4)]:
+        frames = [{"u": u, "v": u, "offsets": np.zeros((0, 3)),
+                   "cell_damage": np.array([0.0, 0.5, largest])}]  # fmt: skip
+        paint = coloring("damage", frames, points, [], UP, 0.0)
+        assert paint.clim == (0.0, top) and paint.title == "damage D"
+
+
 @pytest.mark.parametrize(
     "end, unit", [(6e-5, "µs"), (3e-3, "ms"), (0.45, "ms"), (2.0, "s"), (0.0, "µs")]
 )
