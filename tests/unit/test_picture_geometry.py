@@ -98,7 +98,7 @@ def test_damage_ranges_up_to_failure_at_most():
     points, u = np.zeros((20, 3)), np.zeros((20, 3))
     for largest, top in [(1.13, 1.0), (1.0, 1.0), (0.31, 0.4)]:
         frames = [{"u": u, "v": u, "offsets": np.zeros((0, 3)),
-                   "cell_damage": np.array([0.0, 0.5, largest])}]  # fmt: skip
+                   "cell_damage": np.array([0.0, 0.2, largest])}]  # fmt: skip
         paint = coloring("damage", frames, points, [], UP, 0.0)
         assert paint.clim == (0.0, top) and paint.title == "damage D"
 
