@@ -64,10 +64,7 @@ def render_frames(
     Raises RenderError for a folder without frame data, an unknown colouring or a view
     the body cannot give (a part it does not have).
     """
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista
-
-    from rwall_fem.output.picture import Picture
+    from rwall_fem.output.picture import Picture  # VTK: imported when drawing only
 
     directory = Path(directory)
     mesh, walls, paths, frames = _stored(directory, read or {})
@@ -102,7 +99,7 @@ def render_frames(
     # VTK window left half made or half closed fails in its destructor at exit.
     with interrupts.deferred():
         picture = Picture(
-            pyvista, mesh, paint, camera, window, erodes="cell_eroded" in frames[0],
+            mesh, paint, camera, window, erodes="cell_eroded" in frames[0],
             cut=cut, ghost=view.ghost, edges=edges,
         )  # fmt: skip
     try:
@@ -111,7 +108,7 @@ def render_frames(
                 offsets = frame["offsets"]
                 drawn = surfaces.get(offsets.tobytes())
                 if drawn is None:
-                    drawn = [wall_surface(pyvista, w, o, body, size)
+                    drawn = [wall_surface(w, o, body, size)
                              for w, o in zip(walls, offsets, strict=True)]  # fmt: skip
                     surfaces[offsets.tobytes()] = drawn
                 picture.set_walls(walls, drawn)
@@ -291,8 +288,7 @@ def _follow(directory: Path, parent: int) -> dict[str, dict] | None:
     None when stdin ends first (the run is gone or does not want the pictures). When
     the process ``parent`` ends, this one is sent SIGTERM: it never draws on after it."""
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
-    import pyvista  # noqa: F401  (imported now, while the loop runs)
-    from PIL import Image  # noqa: F401
+    from PIL import Image  # noqa: F401  (imported now, while the loop runs)
 
     from rwall_fem.output import picture  # noqa: F401
     read = {}

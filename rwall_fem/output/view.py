@@ -23,10 +23,11 @@ bottom. The body is drawn at true scale by the renderer.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["View", "choose_view", "up_direction", "wall_surface"]
+__all__ = ["Surface", "View", "choose_view", "up_direction", "wall_surface"]
 
 # (azimuth, elevation) of the camera (degrees), see above; then the elevations LOWER.
 ANGLES = {"flat": (30.0, 30.0), "edge": (0.0, 20.0), "other": (30.0, 20.0)}
@@ -34,6 +35,7 @@ LOWER = (10.0, 0.0, -10.0, -20.0)
 FLAT = 0.2  # a body is flat when its height is below this fraction of its width
 MARGIN = 0.15  # walls reach this fraction of the scene's size beyond the body (m / m)
 SLAB = 0.02  # thickness of a flat wall as a fraction of the scene's size
+ROUND = 96  # points round a cylinder or a sphere's circles
 # The band of the picture that the scene fills (fractions of the height from the bottom):
 # the time is written above it, the colour bar drawn below.
 BAND = (0.16, 0.90)
@@ -59,16 +61,24 @@ class View:
         seen from that side."""
         return shape.kind in ("plane", "parallelogram") and shape.normal @ self.direction >= -1e-9
 
-    def apply(self, plotter) -> None:
-        """Set ``plotter``'s camera to this view."""
-        camera = plotter.camera
-        camera.parallel_projection = True
+    def apply(self, renderer) -> None:
+        """Set the camera of ``renderer`` (VTK's) to this view."""
+        camera = renderer.GetActiveCamera()
+        camera.ParallelProjectionOn()
         distance = 10.0 * self.scale
-        camera.position = tuple(self.focal + distance * self.direction)
-        camera.focal_point = tuple(self.focal)
-        camera.up = tuple(self.up)
-        camera.parallel_scale = self.scale
-        plotter.renderer.ResetCameraClippingRange()
+        camera.SetPosition(*(self.focal + distance * self.direction))
+        camera.SetFocalPoint(*self.focal)
+        camera.SetViewUp(*self.up)
+        camera.SetParallelScale(self.scale)
+        renderer.ResetCameraClippingRange()
+
+
+class Surface(NamedTuple):
+    """A wall as drawn: its ``points`` ((n, 3), m) and ``faces`` (VTK's legacy cell array,
+    ``[k, i0, .., ik-1, k, ...]``)."""
+
+    points: np.ndarray
+    faces: np.ndarray
 
 
 def up_direction(gravity, walls) -> np.ndarray:
@@ -163,26 +173,34 @@ def _turn(vector: np.ndarray, up: np.ndarray, angle: float) -> np.ndarray:
     return np.cos(angle) * vector + np.sin(angle) * np.cross(up, vector)
 
 
-def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: float):
-    """A pyvista surface of ``shape`` translated by ``offset`` (m), drawn where the ``body``
+def wall_surface(shape, offset: np.ndarray, body: np.ndarray, size: float) -> Surface:
+    """The surface of ``shape`` translated by ``offset`` (m), drawn where the ``body``
     ((n, 3) points, m: of every frame) is, in a scene of ``size`` (m)."""
     margin = MARGIN * size
     point = shape.point + offset
     if shape.kind == "cylinder":
         along = (body - point) @ shape.axis
         low, high = along.min() - margin, along.max() + margin
-        return pyvista.Cylinder(
-            center=point + 0.5 * (low + high) * shape.axis,
-            direction=shape.axis,
-            radius=shape.radius,
-            height=high - low,
-            resolution=96,
-            capping=False,
-        )
+        ring = _circle(shape.axis, shape.radius, ROUND)
+        points = np.vstack([point + low * shape.axis + ring, point + high * shape.axis + ring])
+        k = np.arange(ROUND)
+        quads = np.column_stack([k, (k + 1) % ROUND, ROUND + (k + 1) % ROUND, ROUND + k])
+        return Surface(points, _cells(quads))  # no end caps: the cylinder is infinite
     if shape.kind == "sphere":
-        return pyvista.Sphere(
-            radius=shape.radius, center=point, theta_resolution=64, phi_resolution=64
-        )
+        polar = np.linspace(0.0, np.pi, ROUND // 2 + 1)[1:-1]
+        axis = np.array([0.0, 0.0, 1.0])
+        rings = [shape.radius * np.cos(a) * axis + _circle(axis, shape.radius * np.sin(a), ROUND)
+                 for a in polar]  # fmt: skip
+        poles = np.array([axis, -axis]) * shape.radius
+        points = point + np.vstack([*rings, poles])
+        k, top, bottom = np.arange(ROUND), len(points) - 2, len(points) - 1
+        quads = [np.column_stack([r * ROUND + k, r * ROUND + (k + 1) % ROUND,
+                                  (r + 1) * ROUND + (k + 1) % ROUND, (r + 1) * ROUND + k])
+                 for r in range(len(polar) - 1)]  # fmt: skip
+        last = (len(polar) - 1) * ROUND
+        caps = [np.column_stack([np.full(ROUND, top), (k + 1) % ROUND, k]),
+                np.column_stack([np.full(ROUND, bottom), last + k, last + (k + 1) % ROUND])]
+        return Surface(points, np.concatenate([_cells(q) for q in (*quads, *caps)]))
     if shape.kind == "parallelogram":
         corners = point + np.array([[0, 0], [1, 0], [1, 1], [0, 1]]) @ shape.sides
     else:  # an infinite plane: under the body's footprint, with a margin
@@ -193,15 +211,30 @@ def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: flo
         footprint = [[a.min(), b.min()], [a.max(), b.min()], [a.max(), b.max()], [a.min(), b.max()]]
         outward = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
         corners = point + (np.array(footprint) + margin * outward) @ [e1, e2]
-    return _slab(pyvista, corners, -SLAB * size * shape.normal)
+    return _slab(corners, -SLAB * size * shape.normal)
 
 
-def _slab(pyvista, corners: np.ndarray, depth: np.ndarray):
+def _circle(axis: np.ndarray, radius: float, n: int) -> np.ndarray:
+    """``n`` points (m) of the circle of ``radius`` round the origin, normal to ``axis``."""
+    first = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
+    first /= np.linalg.norm(first)
+    second = np.cross(axis, first)
+    angle = np.linspace(0.0, 2 * np.pi, n, endpoint=False)[:, None]
+    return radius * (np.cos(angle) * first + np.sin(angle) * second)
+
+
+def _cells(faces: np.ndarray) -> np.ndarray:
+    """VTK's legacy cell array of ``faces`` ((m, k) point indices)."""
+    faces = np.asarray(faces)
+    return np.column_stack([np.full(len(faces), faces.shape[1]), faces]).ravel()
+
+
+def _slab(corners: np.ndarray, depth: np.ndarray) -> Surface:
     """The closed box whose top face is the quadrilateral ``corners`` (4, 3) and whose
     bottom face is that face moved by ``depth`` (m)."""
     points = np.vstack([corners, corners + depth])
     faces = [[0, 1, 2, 3], [7, 6, 5, 4], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]]
-    return pyvista.PolyData(points, faces=np.hstack([[4, *f] for f in faces]))
+    return Surface(points, _cells(np.array(faces)))
 
 
 def _horizontal_axes(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
