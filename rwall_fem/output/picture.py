@@ -129,7 +129,7 @@ class Picture:
         self._actor(self._loose, LOOSE_COLOR).GetProperty().SetPointSize(3.0)
         self._walls: list = []
         self._surfaces: dict = {}  # the walls' surfaces drawn, by the id of theirs
-        self._time = self._text(" ", 12, self.size[1] - 32, 12)
+        self._time = self._text(" ", 12, self.size[1] - 32, 12)  # in view.TIME_CORNER
         self._colour_bar()
         view.apply(self.renderer)
         self._view = view

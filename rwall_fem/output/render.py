@@ -34,7 +34,7 @@ import numpy as np
 from rwall_fem import interrupts
 from rwall_fem.output.atomic import whole
 from rwall_fem.output.coloring import COLORS, coloring, fixed_range
-from rwall_fem.output.view import choose_view, up_direction, wall_surface
+from rwall_fem.output.view import TIME_CORNER, choose_view, up_direction, wall_surface
 from rwall_fem.scene.view import ViewSpec, parse_view_text, view_from_json
 from rwall_fem.scene.keys import SceneError
 from rwall_fem.walls.shapes import shape_from_parameters
@@ -86,6 +86,7 @@ def render_frames(
         points + frames[0]["u"], [body], walls, up, window[0] / window[1],
         azimuth=view.azimuth, elevation=view.elevation, zoom=view.zoom,
         cut_normal=None if cut is None else cut[1], focus=_focus(view.focus, mesh, frames, parts),
+        corner=(TIME_CORNER[0] / window[0], TIME_CORNER[1] / window[1]),
     )  # fmt: skip
     if cut is not None and isinstance(view.cut, str) and cut[1] @ camera.direction < 0:
         cut = (cut[0], -cut[1])  # an axis cut removes the half nearer the camera

@@ -16,8 +16,10 @@ behind the body: lower elevations are tried until they are (a body between a
 floor and a press is seen level). ``[output.view]`` turns that camera (azimuth,
 elevation), turns it to a cut face, zooms and centres it on a point. The view is
 fitted to the body's deformed extent in every frame (not the walls', which are
-context) with a margin, between the time at the top and the colour bar at the
-bottom. The body is drawn at true scale by the renderer.
+context) with a margin, above the colour bar and up to the top of the picture, or
+below the time when the body would reach into its corner (a Taylor rod's last frame,
+two thirds as long as its first, fills more than half of the height). The body is
+drawn at true scale by the renderer.
 """
 
 from __future__ import annotations
@@ -37,8 +39,11 @@ MARGIN = 0.15  # walls reach this fraction of the scene's size beyond the body (
 SLAB = 0.02  # thickness of a flat wall as a fraction of the scene's size
 ROUND = 96  # points round a cylinder or a sphere's circles
 # The band of the picture that the scene fills (fractions of the height from the bottom):
-# the time is written above it, the colour bar drawn below.
-BAND = (0.16, 0.90)
+# the colour bar is drawn below it; the time is written above it at the top left, in a
+# corner of TIME_CORNER pixels (width, height). A body clear of that corner may reach TOP.
+BAND = (0.15, 0.90)
+TOP = 0.985
+TIME_CORNER = (180, 40)
 FIT_MARGIN = 0.04  # the body's extent and this fraction of it fill the band
 # A cut by a vertical plane is seen from this many degrees round up from its normal and
 # this high; a cut by a horizontal plane from this far off the vertical.
@@ -102,6 +107,7 @@ def choose_view(
     cut_normal=None,
     zoom: float = 1.0,
     focus=None,
+    corner=(TIME_CORNER[0] / 800, TIME_CORNER[1] / 600),
 ) -> View:
     """The view of a run whose body starts at the points ``start`` ((n, 3), m) and whose
     drawn points are ``clouds`` ((n, 3) arrays, m: the body in every frame), for a picture
@@ -112,7 +118,9 @@ def choose_view(
     ``elevation`` (degrees) sets its height above the horizontal plane; ``cut_normal``
     (unit, toward the removed half of a cut) turns it toward the cut face, unless the
     angles are given. ``zoom`` magnifies the fitted view; ``focus`` (m) is the point at
-    the centre of the picture (else the centre of the clouds)."""
+    the centre of the picture (else the centre of the clouds). ``corner``: the time's
+    corner (fractions of the width and height), which the body reaches up beside, not
+    into."""
     points = np.concatenate(clouds)
     up = np.asarray(up, float)
     across, along = _horizontal_axes(points, up)
@@ -148,17 +156,39 @@ def choose_view(
     view_up /= np.linalg.norm(view_up)
     right = np.cross(view_up, direction)
     x, y = points @ right, points @ view_up
-    band = BAND[1] - BAND[0]
-    scale = (1.0 + FIT_MARGIN) * max(np.ptp(y) / (2 * band), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
-    scale /= zoom
+    depth = float((points @ direction).mean())
+    fit = [x, y, right, view_up, direction, depth, aspect, zoom, focus]
+    view = _framed(*fit, band=(BAND[0], TOP))
+    if _in_corner(view, points, aspect, corner):  # under the time, not beside it
+        view = _framed(*fit, band=BAND)
+    return view
+
+
+def _framed(x, y, right, up, direction, depth, aspect, zoom, focus, *, band) -> View:
+    """The view along ``direction`` whose band (``band``: its bottom and top, fractions of
+    the height) holds the points at ``x`` along ``right`` and ``y`` along ``up`` (m), with
+    a margin, magnified by ``zoom``, centred on ``focus`` (or on them)."""
+    low, high = band
+    fit = max(np.ptp(y) / (2 * (high - low)), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
+    scale = (1.0 + FIT_MARGIN) * fit / zoom
     if focus is None:
-        centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * view_up
-        centre += (points @ direction).mean() * direction
+        centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * up
+        centre += depth * direction
     else:
         centre = np.asarray(focus, float)
     # The middle of the band is above the middle of the picture by this much (m).
-    lift = (0.5 * (BAND[0] + BAND[1]) - 0.5) * 2 * scale
-    return View(centre - lift * view_up, direction, view_up, scale)
+    lift = (0.5 * (low + high) - 0.5) * 2 * scale
+    return View(centre - lift * up, direction, up, scale)
+
+
+def _in_corner(view: View, points: np.ndarray, aspect: float, corner) -> bool:
+    """Whether some of ``points`` (m) lie in the picture's top left ``corner`` (fractions of
+    the width and height) seen by ``view``."""
+    right = np.cross(view.up, view.direction)
+    across = ((points - view.focal) @ right / view.scale + aspect) / (2 * aspect)
+    height = 0.5 * ((points - view.focal) @ view.up / view.scale + 1.0)
+    inside = (across >= 0.0) & (across < corner[0]) & (height > 1.0 - corner[1]) & (height <= 1.0)
+    return bool(inside.any())
 
 
 def _horizontal(vector: np.ndarray, up: np.ndarray, fallback: np.ndarray) -> np.ndarray:

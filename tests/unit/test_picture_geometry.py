@@ -170,14 +170,36 @@ def test_walls_are_drawn_where_the_body_is():
 
 def _fits(view, clouds, aspect):
     """Whether every point of ``clouds`` is in the picture, between the text and the bar."""
-    from rwall_fem.output.view import BAND
+    from rwall_fem.output.view import BAND, TIME_CORNER, TOP
 
     points = np.concatenate(clouds) - view.focal
     right = np.cross(view.up, view.direction)
     x, y = points @ right / view.scale, points @ view.up / view.scale
-    return np.all(np.abs(x) <= aspect) and np.all(
-        (y >= 2 * BAND[0] - 1 - 1e-9) & (y <= 2 * BAND[1] - 1 + 1e-9)
+    corner = (x < -aspect + 2 * aspect * TIME_CORNER[0] / 800) & (y > 1 - 2 * TIME_CORNER[1] / 600)
+    return np.all(np.abs(x) <= aspect) and not corner.any() and np.all(
+        (y >= 2 * BAND[0] - 1 - 1e-9) & (y <= 2 * TOP - 1 + 1e-9)
     )
+
+
+def _rod(length, radius, foot=0.0, n=40):
+    """Points (m) of the surface of a rod along z from 0 to ``length`` whose radius
+    swells to ``foot`` (m) at z = 0 over its first fifth (a Taylor rod's mushroom)."""
+    z, angle = np.meshgrid(np.linspace(0, length, n), np.linspace(0, 2 * np.pi, n))
+    r = radius + max(foot - radius, 0.0) * np.clip(1 - z / (0.2 * length), 0, 1) ** 2
+    return np.column_stack([(r * np.cos(angle)).ravel(), (r * np.sin(angle)).ravel(), z.ravel()])
+
+
+@pytest.mark.parametrize("cut", [None, [1.0, 0.0, 0.0]])
+def test_a_taylor_rods_last_frame_fills_half_of_the_picture(cut):
+    """A copper rod 32.4 mm long that ends 21.5 mm long with a foot 7.15 mm in radius (the
+    Taylor demo), seen in one view for every frame: the last frame is more than half of
+    the picture's height (it is beside the time's corner, not under it), and every frame
+    is in the picture."""
+    first, last = _rod(32.4e-3, 3.2e-3), _rod(21.5e-3, 3.2e-3, foot=7.15e-3)
+    walls = [PlaneWall([0, 0, 0], [0, 0, 1])]
+    view = choose_view(first, [first, last], walls, UP, 4 / 3, cut_normal=cut)
+    assert np.ptp(last @ view.up) / (2 * view.scale) > 0.5
+    assert _fits(view, [first, last], 4 / 3)
 
 
 def test_camera_between_a_floor_and_a_press_looks_level():
