@@ -112,7 +112,8 @@ def main() -> None:
         "the loop (`RWALL_FEM_RENDER=worker`: it imports and reads the frames while the loop "
         "runs) and started after it (`inline`).",
         "",
-        "| renderer | the time loop (s) | outputs after the loop (s) | each run, loop / after (s) |",
+        "| renderer | the time loop (s) | outputs after the loop (s) "
+        "| each run, loop / after (s) |",
         "|---|---|---|---|",
     ]
     for mode, times in runs.items():

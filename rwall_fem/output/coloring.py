@@ -9,8 +9,9 @@ saturate, the bulk of the motion spans the range), velocities at least the
 initial speed; a cell field spans its maximum (plastic strain is often zero
 but in a few cells, which are the point), up to its physical bound (damage
 ends at 1: :data:`BOUNDS`). The range is rounded up to a round number, in a
-unit with a prefix that keeps the labels short (``µm``, ``MPa``), and its labels fall on round values written with one format. This module
-needs neither DOLFINx nor VTK.
+unit with a prefix that keeps the labels short (``µm``, ``MPa``), and its labels
+fall on round values written with one format. This module needs neither DOLFINx nor
+VTK; its colour maps (:data:`MAPS`) are matplotlib's, without importing it.
 """
 
 from __future__ import annotations

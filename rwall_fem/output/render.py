@@ -13,7 +13,9 @@ them from their allowed side, behind the body), curved walls translucent with
 their outline, seen as the run's ``[output.view]`` (or ``--view``) says
 (:mod:`rwall_fem.scene.view`: a cut, the camera, the size, the colour range). The camera
 and the colour range are fixed once for all frames, which one scene
-(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
+(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see
+:mod:`rwall_fem.output.frames`). With ``--follow PID`` it is the renderer beside a running
+run (:mod:`rwall_fem.output.worker`).
 """
 
 from __future__ import annotations
