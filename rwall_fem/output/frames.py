@@ -17,6 +17,7 @@ stopped or failed run). Either way every frame written is drawn.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import subprocess
 import sys
@@ -70,6 +71,7 @@ class Frames:
         self._count = 0
         self._failed = False  # a frame could not be written (rank 0): no more are
         self._worker: RenderWorker | None = None  # the renderer beside the loop (rank 0)
+        self._beside = self.comm.rank == 0 and wanted(self.comm.size)  # it is to be started
         topology, cell_types, points = _compat.vtk_mesh(V)
         mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
         self._mesh = mesh
@@ -144,8 +146,10 @@ class Frames:
                 offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
                 name = f"frame_{self._count:04d}.npz"
                 self._save(name, t=s.t, u=u, v=v, offsets=offsets, **cells)
-                if self._worker is None and wanted(self.comm.size):
-                    self._worker = RenderWorker(self.directory, self.color)
+                if self._worker is None and self._beside:
+                    self._beside = False  # one try: a renderer started after the loop else
+                    with contextlib.suppress(OSError):  # no process to be had
+                        self._worker = RenderWorker(self.directory, self.color)
                 if self._worker is not None:
                     self._worker.send(name)
             except OutputError as err:  # the history ends the run on every rank

@@ -54,6 +54,8 @@ def wanted(ranks: int) -> bool:
     default) this process may run on more cores than the ``ranks`` of the run take."""
     mode = os.environ.get("RWALL_FEM_RENDER", "auto").strip().lower() or "auto"
     if mode not in MODES:
+        print(f"rwall-fem: warning: RWALL_FEM_RENDER={mode!r} is not one of {', '.join(MODES)}; "
+              "auto", file=sys.stderr)  # fmt: skip
         mode = "auto"
     if mode != "auto":
         return mode == "worker"
