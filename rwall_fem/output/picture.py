@@ -130,6 +130,9 @@ class Picture:
         self._walls: list = []
         self._surfaces: dict = {}  # the walls' surfaces drawn, by the id of theirs
         self._time = self._text(" ", 12, self.size[1] - 32, 12)  # in view.TIME_CORNER
+        backing = self._time.GetTextProperty()  # legible over a body that fills the picture
+        backing.SetBackgroundColor(*rgb(BACKGROUND))
+        backing.SetBackgroundOpacity(0.8)
         self._colour_bar()
         view.apply(self.renderer)
         self._view = view
