@@ -36,7 +36,8 @@ def solid_keys_on_shells(scene, cell: str) -> None:
     volume mesh (a scene mixes no shells and solids in one mesh)."""
     for where, element in _element_tables(scene):
         given = {name: getattr(element, name) for name in
-                 (*_SOLID_VALUES, "thickness", "formulation")}  # fmt: skip
+                 (*_SOLID_VALUES, "thickness", "formulation", "failed_share",
+                  "thickness_change")}  # fmt: skip
         given = {name: value for name, value in given.items() if value is not None}
         wrong = element_fits_the_surface(where, given, cell)
         if wrong:
@@ -66,13 +67,6 @@ def _unsupported(scene) -> None:
             raise SceneError(
                 f"{scene.source}: {table}: is for solids; a body of shells has no "
                 f"{table.replace('_', ' ')} yet (leave it out)"
-            )
-    for i, spec in enumerate(scene.body_parts):
-        where = f"part[{i}].material" if scene.parts else "material"
-        if getattr(spec.material, "failure", None) is not None:
-            raise SceneError(
-                f"{scene.source}: {where}.failure: shells do not fail and erode yet; leave "
-                "it out"
             )
 
 
@@ -104,7 +98,9 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
         said = str(err)
         said = where + said[len("element") :] if said.startswith("element.") else f"{where}: {said}"
         raise SceneError(f"{scene.source}: {said}") from None
-    return ShellSection(technology, formulation, thickness, points)
+    failed_share = 1.0 if element.failed_share is None else element.failed_share
+    return ShellSection(technology, formulation, thickness, points, failed_share,
+                        bool(element.thickness_change))  # fmt: skip
 
 
 # The sides of DOLFINx's triangle and quadrilateral, by local node index.
