@@ -198,6 +198,22 @@ class ShellBody:
         if self._free is not None:
             self.alpha *= self._free
 
+    def scale_rotations(self, nodes: np.ndarray, ratio: np.ndarray) -> float:
+        """Mass scaling gave the owned ``nodes`` ``ratio`` times their mass: their
+        rotational inertia grows as much (else their rotations, whose inertia holds them
+        at the membrane's step, would set a step below dt_min), their angular momentum is
+        kept, w' = w / ratio, and the kinetic energy this costs is returned (J, <= 0, this
+        rank; :mod:`rwall_fem.mass_scaling`)."""
+        before = self.inertia[nodes, 1].copy()
+        w = self.w.owned[nodes]
+        keep = (1.0 / ratio)[:, None]
+        work = 0.5 * float(np.sum(before[:, None] * w * w * (keep - 1.0)))
+        self.inertia[nodes] *= ratio[:, None]
+        self.inv_inertia[nodes] = 1.0 / self.inertia[nodes, 1]
+        self.w.owned[nodes] = w * keep
+        self.alpha[nodes] *= keep
+        return work
+
     def hold_rotations(self, nodes: np.ndarray, axes: str) -> None:
         """Hold the rotations of the owned ``nodes`` about the global ``axes`` (some of
         "xyz") fixed: their angular velocity stays 0, the reaction moment does no work (a
@@ -360,10 +376,12 @@ class ShellBody:
     # --- checkpoints -------------------------------------------------------------------
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The angular velocity w^{n+1/2}, the books of the work, the rotations' latest
-        kinetic energy and each part's kernel state."""
+        """The angular velocity w^{n+1/2}, the nodes' masses and rotational inertias (mass
+        scaling changes them), the books of the work, the rotations' latest kinetic energy
+        and each part's kernel state."""
         arrays = {
             "w": self.w.owned,
+            "inertia": self.inertia,
             "books": np.array([self._done, self._latest, self.rotational_kinetic]),
         }
         for k, force in enumerate(self.elements):
@@ -372,6 +390,9 @@ class ShellBody:
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self.w.owned[:] = arrays["w"]
+        if "inertia" in arrays:
+            self.inertia[...] = arrays["inertia"]
+            self.inv_inertia[:] = 1.0 / self.inertia[:, 1]
         self._done, self._latest, self.rotational_kinetic = arrays["books"].tolist()
         for k, force in enumerate(self.elements):
             prefix = f"part{k}_"

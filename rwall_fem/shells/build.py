@@ -54,12 +54,6 @@ def _element_tables(scene):
 
 def _unsupported(scene) -> None:
     """What shells do not do yet, refused in one line naming the key."""
-    run = scene.run
-    if run.dt_min_action in ("mass_scaling", "erode"):
-        raise SceneError(
-            f"{scene.source}: run.dt_min_action: {run.dt_min_action!r} is for solids; a body "
-            "of shells stops at run.dt_min ('stop')"
-        )
     for table, given in (("rigid_body", scene.rigid_bodies), ("load", scene.loads),
                          ("added_mass", scene.added_masses), ("damping", scene.damping),
                          ("contact", scene.contacts)):  # fmt: skip
