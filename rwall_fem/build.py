@@ -632,6 +632,10 @@ def _named_nodes(scene: Scene, where: str, names, V, body: BodyMesh, owned: int)
 
 def _loads(scene: Scene, solid: _Solid) -> list:
     """The ``[[load]]`` forces and pressures, then the ``[damping]``, in that order."""
+    if solid.shells:
+        from rwall_fem.shells.loads import shell_loads
+
+        return shell_loads(scene, solid)
     V, body, owned, comm = solid.V, solid.body, solid.owned, solid.comm
     forces = []
     for i, spec in enumerate(scene.loads):

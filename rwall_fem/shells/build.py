@@ -54,9 +54,13 @@ def _element_tables(scene):
 
 def _unsupported(scene) -> None:
     """What shells do not do yet, refused in one line naming the key."""
-    for table, given in (("rigid_body", scene.rigid_bodies), ("load", scene.loads),
-                         ("added_mass", scene.added_masses), ("damping", scene.damping),
-                         ("contact", scene.contacts)):  # fmt: skip
+    if scene.rigid_bodies:
+        raise SceneError(
+            f"{scene.source}: rigid_body: is for solids; a rigid body of shell nodes would "
+            "carry their rotations and rotational inertia, which rigid bodies do not have "
+            "yet (leave it out)"
+        )
+    for table, given in (("contact", scene.contacts),):  # fmt: skip
         if given:
             raise SceneError(
                 f"{scene.source}: {table}: is for solids; a body of shells has no "
@@ -142,6 +146,16 @@ def shell_solid(scene, comm: MPI.Comm, body):
     ]
     masses = np.column_stack([inertia[:, 0] for inertia in inertias])
     inertia = sum(inertias)
+    if scene.added_masses:  # point masses: no rotational inertia; shared as solids share them
+        from rwall_fem.build import _named_nodes
+        from rwall_fem.loads import added_masses
+
+        owned = len(X)
+        added = added_masses(scene.added_masses, lambda i, name: _named_nodes(
+            scene, f"added_mass[{i}]", name, V, body, owned), owned, comm)  # fmt: skip
+        total = masses.sum(axis=1)
+        masses = masses + added[:, None] * masses / np.where(total > 0, total, 1.0)[:, None]
+        inertia[:, 0] += added
     lowest = comm.allreduce(float(inertia[:, 0].min(initial=np.inf)), op=MPI.MIN)
     if not lowest > 0.0:
         raise SceneError(
