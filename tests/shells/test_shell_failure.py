@@ -181,3 +181,38 @@ def test_the_thickness_follows_plastic_incompressibility(cell, shared_dir):
     raw["run"]["end_time"] *= 0.2
     sim = run(raw, shared_dir / "constant")
     assert np.all(sim.internal.elements[0].kernel.thickness == THICK)
+
+
+def test_a_perforation_resumed_after_erosion_equals_the_uninterrupted_run(shared_dir, monkeypatch):
+    """Stopped while the plate is being perforated (cells eroded, more to come), with the
+    thickness changing, resumed from its checkpoint: the state, rotations, thicknesses
+    and energy.csv of the run that never stopped, bit for bit."""
+    import rwall_fem.output.history
+    from conftest import StopAt
+
+    raw = perforation_scene()
+    raw["element"]["thickness_change"] = True
+    raw["output"] |= {"checkpoint_steps": 7}
+    whole = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm,
+                             shared_dir / "whole")  # fmt: skip
+    assert whole.run() == "done"
+    out = shared_dir / "stopped"
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, out)
+    sim.recorders.append(StopAt(200))
+    monkeypatch.setattr(rwall_fem.output.history, "POLL_SECONDS", 1e9)
+    assert sim.run().startswith("stopped: step ")
+    stopped_eroded = comm.allreduce(sim.internal.erosion.count)
+    comm.Barrier()
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, out)
+    sim.checkpoints.resume(sim)
+    assert sim.run() == "done"
+    comm.Barrier()
+    assert 0 < stopped_eroded < comm.allreduce(sim.internal.erosion.count)
+    assert np.array_equal(sim.state.u, whole.state.u)
+    assert np.array_equal(sim.state.v, whole.state.v)
+    assert np.array_equal(sim.internal.w.owned, whole.internal.w.owned)
+    mine, theirs = sim.internal.elements[0], whole.internal.elements[0]
+    assert np.array_equal(mine.kernel.thickness, theirs.kernel.thickness)
+    assert np.array_equal(mine.erosion.alive, theirs.erosion.alive)
+    if comm.rank == 0:
+        assert (out / "energy.csv").read_text() == (shared_dir / "whole" / "energy.csv").read_text()
