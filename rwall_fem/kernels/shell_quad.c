@@ -59,7 +59,9 @@
  * criterion the damage of point k at row p->damage_slot + k.  A point whose damage reaches 1
  * carries no stress from then on (its elastic energy is booked as dissipated), and a cell
  * fails when the share s->fail_fraction of its points has failed; erosion as failure.h
- * (the nodal moments and rotations count in the energy the cell leaves with).
+ * (the nodal moments and rotations count in the energy the cell leaves with).  With
+ * s->new_thickness (Radioss's Ithick = 1) the cell's thickness follows its membrane strain
+ * increment after the update (shell.h, shell_thickness_change).
  *
  * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
  * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable

@@ -61,9 +61,11 @@ class ShellSection:
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilateral shells, 5 points through 0.002 m'."""
-        change = ", changing" if self.thickness_change else ""
+        change = " (changing with the membrane strain)" if self.thickness_change else ""
+        share = (f", a cell failing when {100 * self.failed_share:.3g} % of its points have"
+                 if self.failed_share < 1.0 else "")  # fmt: skip
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
-                f"{self.thickness:g} m{change}")  # fmt: skip
+                f"{self.thickness:g} m{change}{share}")  # fmt: skip
 
 
 @dataclass
