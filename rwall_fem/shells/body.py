@@ -138,6 +138,7 @@ class ShellBody:
         self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
         self._name_energies()
         self._free = None  # (owned nodes, 3): 0 where a rotation is held, else 1
+        self.turning = None  # (owned nodes,): 0 at a rigid body's nodes (their energy is its)
         self._acceleration = None
 
     def _name_energies(self) -> None:

@@ -54,12 +54,6 @@ def _element_tables(scene):
 
 def _unsupported(scene) -> None:
     """What shells do not do yet, refused in one line naming the key."""
-    if scene.rigid_bodies:
-        raise SceneError(
-            f"{scene.source}: rigid_body: is for solids; a rigid body of shell nodes would "
-            "carry their rotations and rotational inertia, which rigid bodies do not have "
-            "yet (leave it out)"
-        )
     for table, given in (("contact", scene.contacts),):  # fmt: skip
         if given:
             raise SceneError(

@@ -35,6 +35,8 @@ class ShellUpdate(CentralDifference):
         self._w_old[:] = w
         first = float(np.einsum("ij,ij->", moments, w))
         w += state.dt_velocity * alpha
+        if body.turning is not None:  # a rigid body's nodes: their energy is the body's
+            inertia = inertia * body.turning
         body.rotational_kinetic = 0.5 * float(
             np.einsum("i,ij,ij->", inertia, self._w_old, w)
         )
