@@ -163,6 +163,7 @@ BEYOND = {
     "295_tube_trigger_longer_than_the_tube",
     "296_rotations_held_on_a_solid",
     "297_shells_beside_solids_in_one_mesh_file",
+    "298_shell_pressure_on_an_edge",
     "299_shell_stiffness_damping",
     # The flow-stress cap lies above the initial yield stress: two values compared.
     "320_flow_stress_cap_below_yield",
