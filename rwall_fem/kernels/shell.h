@@ -45,6 +45,8 @@ typedef struct
   int hourglass_slot;      /* the state's first row of the 5 elastic hourglass forces */
   double kd;               /* drilling stiffness coefficient (quadrilaterals; 0: none) */
   int drill_slot;          /* the state's first row of the 4 nodal drilling moments */
+  double *new_thickness;   /* Radioss's Ithick = 1: the thicknesses to update (the array
+                              `thickness` points to); NULL: constant */
 } shell_params;
 
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
@@ -364,6 +366,34 @@ INLINE void shell_update(int plastic, const element_params *p, const shell_param
   *elastic_out = elastic;
   *dissipated_out = dissipated;
   *damage_out = damage;
+}
+
+/* The mean over the thickness of sxx + syy (Pa) of a batch's cells of thickness t, from the
+ * state before shell_update: sum w_k (sxx + syy)_k, or (Nxx + Nyy) / t of elastic cells. */
+INLINE vec shell_mean_stress(int plastic, const shell_params *s, const batch_t *b,
+                             const double *restrict state, int64_t stride, vec t)
+{
+  if (!plastic)
+    return (load_slot(state, stride, b, 0) + load_slot(state, stride, b, 1)) / t;
+  vec sum = VZERO;
+  for (int pt = 0; pt < s->points; ++pt)
+  {
+    const int base = 2 + SHELL_POINT_SLOTS * pt;
+    sum += s->weight[pt] * (load_slot(state, stride, b, base) + load_slot(state, stride, b, base + 1));
+  }
+  return sum;
+}
+
+/* Ithick = 1: store the thickness of a batch's cells after the membrane strain increment d
+ * (xx, yy, gamma_xy) over which their mean sxx + syy went from `before` to `after` (Pa):
+ * ln(t'/t) = -(dxx + dyy) + (1 - 2 nu) / E (after - before), the plastic strain keeping the
+ * volume and the elastic one changing it by (1 - 2 nu) / E times the sum of the stresses
+ * (szz = 0), so that an elastic cell thins by nu / (1 - nu) (dxx + dyy). */
+INLINE void shell_thickness_change(const shell_params *s, const batch_t *b, vec t, const vec d[3],
+                                   vec before, vec after)
+{
+  const double bulk = (1.0 - 2.0 * s->poisson) / s->young;
+  set_cell_values(s->new_thickness, b, t * vexp(bulk * (after - before) - (d[0] + d[1])));
 }
 
 #endif

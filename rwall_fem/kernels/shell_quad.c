@@ -60,7 +60,9 @@
  * criterion the damage of point k at row p->damage_slot + k.  A point whose damage reaches 1
  * carries no stress from then on (its elastic energy is booked as dissipated), and a cell
  * fails when the share s->fail_fraction of its points has failed; erosion as failure.h
- * (the nodal moments and rotations count in the energy the cell leaves with).
+ * (the nodal moments and rotations count in the energy the cell leaves with).  With
+ * s->new_thickness (Radioss's Ithick = 1) the cell's thickness follows its membrane strain
+ * increment after the update (shell.h, shell_thickness_change).
  *
  * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
  * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable
@@ -433,8 +435,12 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
                                  &b, fe);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
+    const vec before =
+        s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
                  &damage);
+    if (s->new_thickness)
+      shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
     quad_frame(x, &g);
     if (warping)
       rigid_inverse(&g, Ji);

@@ -802,7 +802,8 @@ def _cap_above_yield(v, raw, fail):
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 # The cells of a body of shells, and the keys of [element] for shells and for solids.
 SURFACE_CELLS = ("quadrilateral", "triangle")
-SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor")
+SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor",
+              "failed_share", "thickness_change")  # fmt: skip
 SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
@@ -867,6 +868,21 @@ class Element:
         None,
         doc="shells: the transverse shear factor",
         default_doc="5/6",
+    )
+    failed_share: float | None = key(
+        Real(low=0.0, high=1.0),
+        None,
+        doc="shells with [material.failure]: the share of a cell's points through the "
+        "thickness that must have failed for the cell to fail and erode (Radioss's "
+        "P_thickfail)",
+        default_doc="1 (every point)",
+    )
+    thickness_change: bool | None = key(
+        Flag(),
+        None,
+        doc="shells: the thickness follows the membrane strain, plastic flow keeping the "
+        "volume (Radioss's Ithick = 1); false: constant",
+        default_doc="false",
     )
 
 
