@@ -24,6 +24,10 @@
 
 #include "failure.h"
 
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
+
 #define SHELL_MAX_POINTS 10
 #define SHELL_POINT_SLOTS 5 /* sxx, syy, sxy (Pa), eps_p, temperature (K) */
 
@@ -44,6 +48,17 @@ typedef struct
   double hk;               /* elastic hourglass stiffness coefficient (0: viscous only) */
   int hourglass_slot;      /* the state's first row of the 5 elastic hourglass forces */
 } shell_params;
+
+/* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one
+ * instruction where the host has AVX (batch.h's loop over the lanes elsewhere). */
+INLINE int shell_any(ivec m)
+{
+#if defined(__AVX__) && LANES == 4
+  return _mm256_movemask_pd((__m256d)m) != 0;
+#else
+  return any_lane(m);
+#endif
+}
 
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
 INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
@@ -133,19 +148,21 @@ INLINE vec near_flow_stress(const element_params *p, const double c[BINOMIAL_TER
   return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
 }
 
-/* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise). */
+/* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise) and 1 / e in
+ * *inverse (1 where e <= 0). */
 INLINE vec flow_stress_power(const element_params *p, vec e, vec factor,
-                             vec *slope, vec *power_out)
+                             vec *slope, vec *power_out, vec *inverse)
 {
+  const ivec positive = e > 0.0;
+  *inverse = 1.0 / vselect(positive, e, VZERO + 1.0);
   *power_out = VZERO + 1.0;
   if (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
   {
     const double B = p->hardening_coefficient, n = p->hardening_exponent;
-    const ivec positive = e > 0.0;
     const vec safe = vselect(positive, e, VZERO + 1.0);
     const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
     *power_out = power;
-    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300);
+    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power * *inverse, VZERO + 1e300);
     return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
   }
   return capped_flow_stress(p, e, factor, slope);
@@ -190,6 +207,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
   const int of_eps_p = p->hardening != JOHNSON_COOK
                        || (p->rate_coefficient == 0.0 && !p->thermal);
   const double cap = p->max_flow_stress > 0.0 ? p->max_flow_stress : INFINITY;
+  const double lowest = p->yield_stress < cap ? p->yield_stress : cap;
   /* the points that flow in some lane, and what their iterations need */
   int m = 0, which[SHELL_MAX_POINTS], near[SHELL_MAX_POINTS];
   vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
@@ -204,19 +222,19 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     ivec maybe = q2 == q2; /* every lane */
     if (p->hardening != HARDENING_TABLE)
     {
-      const vec floor = fmin(p->yield_stress, cap) * f;
+      const vec floor = lowest * f;
       maybe &= q2 > floor * floor;
     }
     if (of_eps_p)
       maybe &= q2 > q_old2[j];
-    if (!any_lane(maybe))
+    if (!shell_any(maybe))
       continue;
     const vec q_trial = vsqrt(q2);
-    vec slope, power;
-    const vec y = flow_stress_power(p, eps_p[j], f, &slope, &power);
+    vec slope, power, inverse;
+    const vec y = flow_stress_power(p, eps_p[j], f, &slope, &power, &inverse);
     flow[j] = y;
     const ivec flowing = maybe & (q_trial > y);
-    if (!any_lane(flowing))
+    if (!shell_any(flowing))
       continue;
     const int a = m++;
     which[a] = j;
@@ -229,21 +247,22 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     P1[a] = 0.25 * pp[a] * pp[a];
     P2[a] = 0.75 * dd[a] * dd[a] + 3.0 * sig[j][2] * sig[j][2];
     const ivec virgin = flowing & (eps_p[j] <= 0.0);
-    near[a] = power_law && !any_lane(virgin);
-    inv_e0[a] = 1.0 / vselect(eps_p[j] > 0.0, eps_p[j], VZERO + 1.0);
+    near[a] = power_law && !shell_any(virgin);
+    inv_e0[a] = inverse;
     const vec safe_q = vselect(flowing, q_trial, VZERO + 1.0);
     lo[a] = VZERO;
     hi[a] = (safe_q / vmax(y, VZERO + 1e-300) - 1.0) * (1.0 / k1);
     vec start = slope;
-    if (any_lane(virgin))
+    if (shell_any(virgin))
     {
       const vec d0 = vmax((safe_q - y) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
       vec unused;
       const vec secant = (capped_flow_stress(p, eps_p[j] + d0, f, &unused) - y) / d0;
       start = vselect(eps_p[j] <= 0.0, secant, slope);
     }
-    const vec c = (P1[a] * k1 + P2[a] * g2) / (safe_q * safe_q);
-    const vec g0 = (safe_q - y) / (c * y + (2.0 / 3.0) * vmax(start, VZERO) * safe_q);
+    const vec g0 = (safe_q - y) * (safe_q * safe_q)
+                   / ((P1[a] * k1 + P2[a] * g2) * y
+                      + (2.0 / 3.0) * vmax(start, VZERO) * (safe_q * safe_q * safe_q));
     g[a] = vselect(flowing, vmin(vmax(g0, VZERO), hi[a]), VZERO);
   }
   if (m == 0)
@@ -255,15 +274,17 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     int more = 0;
     for (int a = 0; a < m; ++a)
     {
-      const vec A1 = 1.0 + k1 * g[a], B1 = 1.0 + g2 * g[a];
-      const vec r = 1.0 / (A1 * B1), ra = B1 * r, rb = A1 * r;
-      const vec q2 = P1[a] * ra * ra + P2[a] * rb * rb;
-      const vec rq = 1.0 / vsqrt(q2), q = q2 * rq;
+      /* q = sqrt(W) / (A1 B1), W = P1 B1^2 + P2 A1^2: one division */
+      const vec A1 = 1.0 + k1 * g[a], B1 = 1.0 + g2 * g[a], AB = A1 * B1;
+      const vec root = vsqrt(P1[a] * B1 * B1 + P2[a] * A1 * A1);
+      const vec inv = 1.0 / (root * AB);
+      const vec r = root * inv, ra = B1 * r, rb = A1 * r; /* 1 / A1, 1 / B1 */
+      const vec rq = AB * AB * inv, q = root * r;
       const vec dq = -(P1[a] * k1 * ra * ra * ra + P2[a] * g2 * rb * rb * rb) * rq;
       const vec increment = (2.0 / 3.0) * g[a] * q;
       const int j = which[a];
       vec y, h;
-      if (near[a] && !any_lane(plastic[a] & (increment > 0.05 * eps_p[j])))
+      if (near[a] && !shell_any(plastic[a] & (increment > 0.05 * eps_p[j])))
         y = near_flow_stress(p, binomial, power0[a], inv_e0[a], increment * inv_e0[a],
                              factor[a], &h);
       else
@@ -276,7 +297,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       next = vselect((next <= lo[a]) | (next >= hi[a]), 0.5 * (lo[a] + hi[a]), next);
       const vec change = vabs(next - g[a]);
       g[a] = vselect(plastic[a], next, VZERO);
-      more |= any_lane(plastic[a] & (vabs(R) > 1e-7) & (change > 1e-15 * g[a] + 1e-300));
+      more |= shell_any(plastic[a] & (vabs(R) > 1e-7) & (change > 1e-15 * g[a] + 1e-300));
     }
     if (!more)
       break;
@@ -307,6 +328,8 @@ INLINE void shell_points_update(const element_params *p, const shell_params *s, 
 {
   vec rate[SHELL_MAX_POINTS], q_old2[SHELL_MAX_POINTS], d[SHELL_MAX_POINTS];
   vec flow[SHELL_MAX_POINTS];
+  /* the strain rate: of Johnson-Cook's flow stress and of the failure criteria */
+  const int uses_rate = p->hardening == JOHNSON_COOK || p->failure;
   for (int j = 0; j < n; ++j)
   {
     q_old2[j] = von_mises_squared(sig[j]);
@@ -315,7 +338,7 @@ INLINE void shell_points_update(const element_params *p, const shell_params *s, 
     const vec dz = -(de[j][0] + de[j][1]);
     const vec dd = de[j][0] * de[j][0] + de[j][1] * de[j][1] + dz * dz
                    + 0.5 * de[j][2] * de[j][2];
-    rate[j] = p->dt > 0.0 ? vsqrt((2.0 / 3.0) * dd) * (1.0 / p->dt) : VZERO;
+    rate[j] = p->dt > 0.0 && uses_rate ? vsqrt((2.0 / 3.0) * dd) * (1.0 / p->dt) : VZERO;
   }
   plane_stress_returns(p, s, n, sig, eps_p, rate, T, q_old2, d, flow);
   for (int j = 0; j < n; ++j)
