@@ -213,6 +213,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
   vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
   vec y0[SHELL_MAX_POINTS], power0[SHELL_MAX_POINTS], inv_e0[SHELL_MAX_POINTS];
   vec factor[SHELL_MAX_POINTS], g[SHELL_MAX_POINTS], lo[SHELL_MAX_POINTS], hi[SHELL_MAX_POINTS];
+  vec tolerance[SHELL_MAX_POINTS];
   ivec plastic[SHELL_MAX_POINTS];
   for (int j = 0; j < n; ++j)
   {
@@ -247,6 +248,9 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     P1[a] = 0.25 * pp[a] * pp[a];
     P2[a] = 0.75 * dd[a] * dd[a] + 3.0 * sig[j][2] * sig[j][2];
     const ivec virgin = flowing & (eps_p[j] <= 0.0);
+    /* from eps_p = 0 a power law's slope is infinite and the residual no guide to the next
+     * step's: iterate until it is itself at round-off */
+    tolerance[a] = vselect(virgin, VZERO + 1e-13, VZERO + 1e-7);
     near[a] = power_law && !shell_any(virgin);
     inv_e0[a] = inverse;
     const vec safe_q = vselect(flowing, q_trial, VZERO + 1.0);
@@ -294,10 +298,20 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       hi[a] = vselect(R > 0.0, g[a], hi[a]);
       const vec dR = rq * (vmax(h, VZERO) * (2.0 / 3.0) * (q + g[a] * dq) - y * rq * dq);
       vec next = g[a] - R / dR;
-      next = vselect((next <= lo[a]) | (next >= hi[a]), 0.5 * (lo[a] + hi[a]), next);
+      /* outside the bracket: its midpoint, geometric while it spans decades (the root of
+       * a power law's infinite slope at eps_p = 0 may be many decades below the start) */
+      const ivec outside = (next <= lo[a]) | (next >= hi[a]);
+      if (shell_any(outside))
+      {
+        const vec middle = vselect(lo[a] < 1e-3 * hi[a],
+                                   vsqrt(vmax(lo[a], 1e-30 * hi[a]) * hi[a]),
+                                   0.5 * (lo[a] + hi[a]));
+        next = vselect(outside, middle, next);
+      }
       const vec change = vabs(next - g[a]);
       g[a] = vselect(plastic[a], next, VZERO);
-      more |= shell_any(plastic[a] & (vabs(R) > 1e-7) & (change > 1e-15 * g[a] + 1e-300));
+      more |= shell_any(plastic[a] & (vabs(R) > tolerance[a])
+                        & (change > 1e-15 * g[a] + 1e-300));
     }
     if (!more)
       break;
