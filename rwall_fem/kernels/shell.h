@@ -12,9 +12,10 @@
  * k1 = E / (3 (1 - nu)), G = E / (2 (1 + nu)); its von Mises stress is
  *     q(g)^2 = p(g)^2 / 4 + 3 d(g)^2 / 4 + 3 sxy(g)^2
  * and the equivalent plastic strain grows by (2/3) g q(g).  g solves
- *     F(g) = q(g) - sigma_y(eps_p + (2/3) g q(g)) = 0,
- * F decreasing in g: Newton's method kept inside the bracket [0, (q_tr / sigma_y0 - 1) / k1]
- * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2).  The normal stress through
+ *     q(g) = sigma_y(eps_p + (2/3) g q(g)),
+ * by Newton's method on sigma_y / q - 1 kept inside the bracket [0, (q_tr / sigma_y0 - 1) / k1]
+ * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2; plane_stress_returns says how,
+ * for all the points of a cell at once).  The normal stress through
  * the thickness is zero at every step by construction, and the plastic flow of the 3-D J2
  * law with sigma_zz = 0 is reproduced exactly (the thickness strain follows from it).
  * The flow stress is capped at p->max_flow_stress (Radioss LAW2's SIG_max0; plasticity.h).
@@ -193,9 +194,12 @@ INLINE vec von_mises_squared(const vec sig[3])
  * the start of its linearisation at g = 0, g0 = (q_tr - y0) / (c y0 + (2/3) h q_tr),
  * c = (k1 P1 + 2 G P2) / q_tr^2 (P1 = p^2 / 4, P2 = 3 d^2 / 4 + 3 sxy^2), h the slope of the
  * law at eps_p (the secant over the perfectly plastic increment at eps_p = 0, where a power
- * law's is infinite); kept in the bracket [0, (q_tr / y0 - 1) / k1].  It stops once |R| at
- * the previous iterate is below 1e-7 (the step just taken leaves one of order 1e-14) or g
- * moves by round-off. */
+ * law's is infinite); kept in the bracket [0, (q_tr / y0 - 1) / k1], whose midpoint is
+ * geometric while it spans decades.  It stops once |R| at the previous iterate is below 1e-7
+ * (the step just taken leaves one of order 1e-14; 1e-13 from eps_p = 0, where the power
+ * law's infinite slope makes the residual no guide to the next one's) or g moves by
+ * round-off.  The power laws' flow stress in the iterations is near_flow_stress's series
+ * about eps_p while the increment is below eps_p / 20, else exp and log. */
 INLINE void plane_stress_returns(const element_params *p, const shell_params *s, int n,
                                  vec sig[][3], const vec eps_p[], const vec rate[],
                                  const vec T[], const vec q_old2[], vec d[], vec flow[])
