@@ -233,7 +233,8 @@ study: venv-0.5
 
 # The kernels against the old BAIJ product, whole steps, 2-rank efficiency, the 80k-hexahedron
 # scene, material costs, memory, start-up, the Taylor rod (bench/results.md, ~45 minutes), then
-# the cost of each effect (bench/effects.md) and of failure and erosion (bench/erosion.md).
+# the cost of each effect (bench/effects.md) and of failure and erosion (bench/erosion.md), and
+# the shell kernels against the J2 hexahedron's, 1 and 2 ranks (bench/shell_kernels.md).
 # OLD_TREE: a worktree of the old code (commit c11ba60, with its .venv) whose time loop on the
 # 80k scene is run alternately with the new. PRE_EROSION_TREE: a checkout of the code before
 # failure and erosion, whose kernels bench/erosion.py times beside the new ones.
@@ -255,6 +256,10 @@ bench: venv-0.5
 	    --before-tree $(PRE_CORNER_TREE))
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/openradioss_timing.py \
 	    $(if $(OPENRADIOSS),--openradioss $(OPENRADIOSS))
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/shell_kernels.py \
+	    --out bench/shell_kernels.md
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(MPIRUN_0.5) -n 2 $(VENV)/bin/python bench/shell_kernels.py \
+	    --out bench/shell_kernels.md
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

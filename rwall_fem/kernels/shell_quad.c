@@ -514,17 +514,18 @@ void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *
 double shell_point(const element_params *p, const shell_params *s, double sigma[3],
                    double *eps_p, double *T, const double de[3])
 {
-  vec sig[3], e = VZERO + *eps_p, temperature = VZERO + *T, d[3];
+  vec sig[1][3], e[1] = {VZERO + *eps_p}, temperature[1] = {VZERO + *T}, d[1][3];
   for (int i = 0; i < 3; ++i)
   {
-    sig[i] = VZERO + sigma[i];
-    d[i] = VZERO + de[i];
+    sig[0][i] = VZERO + sigma[i];
+    d[0][i] = VZERO + de[i];
   }
-  point_step done;
-  const vec dissipation = shell_point_update(p, s, sig, &e, &temperature, d, &done);
+  point_step done[1];
+  vec dissipation[1];
+  shell_points_update(p, s, 1, sig, e, temperature, d, done, dissipation);
   for (int i = 0; i < 3; ++i)
-    sigma[i] = sig[i][0];
-  *eps_p = e[0];
-  *T = temperature[0];
-  return dissipation[0];
+    sigma[i] = sig[0][i][0];
+  *eps_p = e[0][0];
+  *T = temperature[0][0];
+  return dissipation[0][0];
 }
