@@ -133,12 +133,44 @@ def test_two_bars_meeting_head_on_rebound_as_on_a_rigid_wall(shared_dir):
     assert summary["contacts"][0]["passes"] == 2
 
 
+def test_two_bars_meeting_without_damping_rebound_and_keep_their_energy(shared_dir):
+    """damping = 0: the penalty springs undamped, at the stated step. Each bar as on a
+    rigid wall (contact 2L/c within 2 steps + 2 %, rebound 2 %); nothing dissipated, so the
+    kinetic, strain and hourglass energies after separation give back the initial energy
+    to 1e-3 (6e-4 measured: what the step changes and the springs' on-off errors left,
+    booked in step_change_work and contact_energy, each below 5e-4); the books close.
+    (This run stopped at step 87 before: a node of one bar beside the other's edge was
+    taken as 2 gaps behind its side face, whose plane the face's ringing had tilted.)"""
+    raw = two_bars(shared_dir)
+    raw["contact"][0]["damping"] = 0.0
+    sim = run(raw, shared_dir)
+    cc = contact_columns(sim)
+    on = np.flatnonzero(cc["normal_force"] > 0)
+    duration = cc["time"][on[-1]] - cc["time"][on[0]]
+    assert abs(duration - 2 * L / C) <= 2 * sim.state.dt + 0.02 * 2 * L / C
+    mass = STEEL["density"] * A_SIDE**2 * L
+    assert -part_momentum(sim, "left")[2] == pytest.approx(mass * SPEED, rel=0.02)
+    assert -part_momentum(sim, "right")[2] == pytest.approx(-mass * SPEED, rel=0.02)
+    energy = sim.history.summary["energy"]
+    initial = energy["initial"]
+    assert energy["contact_friction"] == 0.0
+    assert cc["penalty_energy"][-1] == 0.0  # apart
+    kept = energy["kinetic"] + energy["internal"] + energy["hourglass"]
+    assert abs(kept - initial) <= 1e-3 * initial
+    assert abs(energy["step_change_work"]) <= 5e-4 * initial
+    assert abs(cc["contact_energy"][-1]) <= 5e-4 * initial
+    assert energy["max_balance_error"] <= 1e-12
+
+
 def test_two_bars_of_tetrahedra_meet_as_on_a_rigid_wall(shared_dir):
     """The same bars meshed in unstructured tetrahedra of 2 mm (triangular segments,
     nodes that do not face each other): within the rigid-wall bar test's bounds for N =
     L / h layers (tests/verification/test_bar_impact.py: duration 2 dt + 2 %, impulse
-    1/N + 1 %, rebound 2/N + 1 %); what the springs keep after separation below 2 % of
-    the energy (the on-off error of the penalty, 1.5 % here); the books close."""
+    1/N + 1 %, rebound 2/N + 1 %), the contact counted while the normal force exceeds
+    1 % of the plateau's (a last node ringing in and out of the gap with 0.6 % of it
+    after the faces parted lengthened the count by 5 steps); what the springs keep after
+    separation below 2 % of the energy (the on-off error of the penalty, 1.3 % here); the
+    books close."""
     geo = f"""SetFactory("OpenCASCADE");
 Box(1) = {{0, 0, 0, {A_SIDE}, {A_SIDE}, {L}}};
 Box(2) = {{0, 0, {L + SEPARATION}, {A_SIDE}, {A_SIDE}, {L}}};
@@ -152,7 +184,8 @@ Mesh.CharacteristicLengthMax = 0.002;
     sim = run(raw, shared_dir)
     assert sim.info["cell"] == "tetrahedron"
     cc = contact_columns(sim)
-    on = np.flatnonzero(cc["normal_force"] > 0)
+    plateau = STEEL["density"] * C * A_SIDE**2 * SPEED
+    on = np.flatnonzero(cc["normal_force"] > 0.01 * plateau)
     duration = cc["time"][on[-1]] - cc["time"][on[0]]
     layers = L / 0.002
     assert abs(duration - 2 * L / C) <= 2 * sim.state.dt + 0.02 * 2 * L / C
