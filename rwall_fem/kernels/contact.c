@@ -500,10 +500,59 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   return 1;
 }
 
+/* Nodes that start inside the gap (Radioss TYPE7 Inacti = 6): a node at distance d0 < gap
+ * from the surface at the start gets its own gap 0.95 d0 (Radioss: gap0 = Gap - P0 - 5 %
+ * of (Gap - P0), P0 = Gap - d0 the initial penetration), so that it is not pushed out at
+ * once; the gap grows back with the node's distance (0.95 d, up to the interface's gap)
+ * as it moves away, and never shrinks.  A node that starts behind the surface (d0 <= 0)
+ * gets gap 0: inactive until it comes out in front. */
+#define INITIAL_GAP 0.95
+
+/* The node's gap (m) at its signed distance d (m), grown from *node_gap toward `gap`. */
+INLINE double grown_gap(double *node_gap, double d, double gap)
+{
+  if (*node_gap < gap)
+  {
+    const double grown = INITIAL_GAP * d;
+    *node_gap = grown > *node_gap ? (grown < gap ? grown : gap) : *node_gap;
+  }
+  return *node_gap;
+}
+
+/* The gaps of the nsec secondary nodes at the start (node_gap, m), as above. out: [0] the
+ * number of nodes that start inside the gap, [1] of them behind the surface, [2] the
+ * largest initial penetration gap - d0 (m). */
+void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
+                          const int64_t *restrict offsets, const int64_t *restrict candidates,
+                          const int64_t *restrict segs, const double *restrict stiffness0,
+                          const double *restrict depth, const double *restrict x,
+                          const contact_params *prm, double *restrict node_gap, double out[3])
+{
+  out[0] = out[1] = out[2] = 0.0;
+  int64_t most = 1;
+  for (int64_t i = 0; i < nsec; ++i)
+    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
+  double *distance = (double *)malloc(most * sizeof(double));
+  surface_point pt;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    node_gap[i] = prm->gap;
+    if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
+                            segs, stiffness0, depth, x, prm->reach, distance, &pt) ||
+        !(pt.d < prm->gap && -pt.d < pt.depth))
+      continue;
+    node_gap[i] = pt.d > 0.0 ? INITIAL_GAP * pt.d : 0.0;
+    out[0] += 1.0;
+    out[1] += pt.d > 0.0 ? 0.0 : 1.0;
+    out[2] = prm->gap - pt.d > out[2] ? prm->gap - pt.d : out[2];
+  }
+  free(distance);
+}
+
 /* One pass: the nsec secondary nodes against their candidate segments.  `stiffness0` and
  * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
- * (N), updated.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
+ * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
  * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
  * tangential springs' energy (J), [9] what friction and damping dissipated over the step (J),
  * [10] the sum of the normal forces' sizes (N). */
@@ -513,12 +562,11 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const double *restrict depth, const double *restrict x,
                     const double *restrict v, const double *restrict mass,
                     const contact_params *prm,
-                    double *restrict tangential, double *restrict force,
-                    double *restrict stiffness, double out[11])
+                    double *restrict tangential, double *restrict node_gap,
+                    double *restrict force, double *restrict stiffness, double out[11])
 {
   for (int c = 0; c < 11; ++c)
     out[c] = 0.0;
-  const double g = prm->gap;
   int64_t most = 1;
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
@@ -533,10 +581,12 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                             depth, x, prm->reach, distance, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
+      node_gap[i] = prm->gap;
       continue;
     }
+    const double g = grown_gap(node_gap + i, pt.d, prm->gap);
     const double k0 = pt.k0;
-    if (!(pt.d < g && -pt.d < pt.depth))
+    if (!(g > 0.0 && pt.d < g && -pt.d < pt.depth))
     {
       /* Near but not in contact: its spring's stiffness counts in the step all the same,
        * so that the step does not jump as nodes come into and out of contact. */

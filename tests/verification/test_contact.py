@@ -72,19 +72,19 @@ L, A_SIDE, SPEED, H = 0.04, 0.004, 10.0, 0.001
 SEPARATION = 2e-4  # m between the bars at the start, twice the gap
 
 
-def two_bars(directory, end_time=3.2e-5):
+def two_bars(directory, end_time=3.2e-5, separation=SEPARATION, speed=SPEED):
     """Two 4 x 4 x 40 mm steel bars (nu = 0) along z, 0.2 mm apart, at +10 and -10 m/s,
     in contact through the default gap (0.1 x the 1 mm cells)."""
     geo = boxes_geo(
         [("left", (0, 0, 0), (A_SIDE, A_SIDE, L)),
-         ("right", (0, 0, L + SEPARATION), (A_SIDE, A_SIDE, L))], H)  # fmt: skip
+         ("right", (0, 0, L + separation), (A_SIDE, A_SIDE, L))], H)  # fmt: skip
     return {
         "run": {"end_time": end_time},
         "mesh": {"file": str(write_geo(directory, "two_bars.geo", geo))},
         "material": STEEL,
         "part": [
-            {"name": "left", "initial": {"velocity": [0, 0, SPEED]}},
-            {"name": "right", "initial": {"velocity": [0, 0, -SPEED]}},
+            {"name": "left", "initial": {"velocity": [0, 0, speed]}},
+            {"name": "right", "initial": {"velocity": [0, 0, -speed]}},
         ],
         "contact": [{"main": ["right"], "secondary": ["left"]}],
         "output": {"plot": False},
@@ -165,6 +165,38 @@ def test_two_bars_meeting_without_damping_rebound_and_keep_their_energy(shared_d
     assert energy["max_balance_error"] <= 1e-12
 
 
+def test_bars_that_start_inside_the_gap_are_not_pushed_apart(shared_dir):
+    """Radioss TYPE7 Inacti = 6: bars at rest 0.4 gap apart (inside the gap) stay at rest
+    (kinetic energy below 1e-12 of what the springs would have held, were the nodes pushed
+    out); run.log names the 50 nodes (25 of a face, in each pass) that start inside, 0.6
+    gap deep."""
+    gap = 0.1 * H
+    raw = two_bars(shared_dir, end_time=2e-6, separation=0.4 * gap, speed=0.0)
+    sim = run(raw, shared_dir)
+    k0 = STEEL["young"] / 3 * H  # B A^2 / V of the 1 mm cells (nu = 0)
+    x = 0.6
+    held = 50 * k0 * gap**2 * ((1 - x) * math.log1p(-x) + x)  # J, at most (corner nodes less)
+    assert sim.history.summary["energy"]["kinetic"] <= 1e-12 * held
+    assert contact_columns(sim)["normal_force"].max() == 0.0
+    line = sim.contacts[0].describe()
+    assert "50 node(s) start inside the gap (the deepest 6e-05 m in, 0 behind" in line
+    if MPI.COMM_WORLD.rank == 0:
+        assert line in (shared_dir / "run.log").read_text()
+
+
+def test_bars_that_start_inside_the_gap_rebound_as_on_a_rigid_wall(shared_dir):
+    """The bars meeting at +-10 m/s from 0.4 gap apart: their nodes' gaps are 0.95 of their
+    distance, and the contact works through them: the impulse 2 m v and the rebound within
+    2 %, the books close."""
+    raw = two_bars(shared_dir, separation=0.4 * 0.1 * H)
+    sim = run(raw, shared_dir)
+    cc = contact_columns(sim)
+    mass = STEEL["density"] * A_SIDE**2 * L
+    assert -cc["impulse_z"][-1] == pytest.approx(2 * mass * SPEED, rel=0.02)
+    assert part_momentum(sim, "left")[2] == pytest.approx(-mass * SPEED, rel=0.02)
+    assert sim.history.summary["energy"]["max_balance_error"] <= 1e-12
+
+
 def test_two_bars_of_tetrahedra_meet_as_on_a_rigid_wall(shared_dir):
     """The same bars meshed in unstructured tetrahedra of 2 mm (triangular segments,
     nodes that do not face each other): within the rigid-wall bar test's bounds for N =
@@ -209,15 +241,13 @@ NU = 0.3
 
 
 def block_on_plate(directory, gravity, velocity, end_time):
-    """A 4 mm steel cube resting on a 12 x 8 x 2 mm steel plate clamped at its bottom, in
-    contact with friction mu; the cube starts where its weight balances the springs (its
-    25 lower nodes share it) and at ``velocity``."""
-    bulk = STEEL["young"] / (3 * (1 - 2 * NU))
-    k0 = bulk * H  # B A^2 / V of the plate's 1 mm cells
+    """A 4 mm steel cube on a 12 x 8 x 2 mm steel plate clamped at its bottom, in contact
+    with friction mu; the cube starts at ``velocity``, its lower face just outside the gap
+    (by 1e-6 of it: nodes that start inside the gap get a gap of 0.95 of their distance,
+    Radioss Inacti = 6, and would drop by 5 % of it), and settles onto the springs (its
+    static deflection, 1.2e-8 m, is 1e-4 of the gap)."""
     gap = 0.1 * H
-    weight = STEEL["density"] * BLOCK**3 * abs(gravity[2])
-    nodes = (round(BLOCK / H) + 1) ** 2
-    rest = gap - (weight / nodes) / k0
+    rest = gap * (1 + 1e-6)
     geo = boxes_geo(
         [("plate", (0, 0, -PLATE[2]), PLATE),
          ("block", (0.002, 0.002, rest), (BLOCK, BLOCK, BLOCK))], H)  # fmt: skip
