@@ -52,9 +52,9 @@ def spring(d):
 
 def corner_of_a_block(tilt):
     """The corner region of a block's top face (z = 0 but for a warp of 1e-10 m, two 1 mm
-    quadrilaterals along x, outward +z) and its side face (y = 0, outward -y, tilted: its top edge is the top
-    face's, its lower edge 1 mm down sits at y = tilt x 1 mm), nodes 0..5 on the edge and
-    the top, 6..8 the side's lower edge."""
+    quadrilaterals along x, outward +z) and its side face (y = 0, outward -y, tilted: its
+    top edge is the top face's, its lower edge 1 mm down sits at y = tilt x 1 mm), nodes
+    0..5 on the edge and the top, 6..8 the side's lower edge."""
     h, w = 1e-3, 1e-10  # the top face warped by 1e-7 of its size, as a ringing one is
     x = [[0, 0, 0], [h, 0, w], [2 * h, 0, 0], [0, h, w], [h, h, 0], [2 * h, h, w],
          [0, tilt * h, -h], [h, tilt * h, -h], [2 * h, tilt * h, -h]]  # fmt: skip

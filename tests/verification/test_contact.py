@@ -312,7 +312,8 @@ def test_contact_does_not_depend_on_the_ranks(shared_dir, tmp_path):
     parallel = run(raw, shared_dir / "parallel")
     serial = run(raw, tmp_path, comm=MPI.COMM_SELF)
     compare_runs(parallel.history.energy, parallel.history.contact(0), serial.history.energy,
-                 serial.history.contact(0), serial.history.summary["energy"]["initial"])  # fmt: skip
+                 serial.history.contact(0),
+                 serial.history.summary["energy"]["initial"])  # fmt: skip
 
 
 def compare_runs(e_par, c_par, e_ser, c_ser, energy):
@@ -353,7 +354,8 @@ def test_contact_on_three_ranks_equals_the_serial_run(tmp_path, damping):
 
     contact = read("contacts.csv")
     compare_runs(read("energy.csv"), contact[contact[:, 1] == 0], serial.history.energy,
-                 serial.history.contact(0), serial.history.summary["energy"]["initial"])  # fmt: skip
+                 serial.history.contact(0),
+                 serial.history.summary["energy"]["initial"])  # fmt: skip
 
 
 def test_a_resumed_run_with_contact_equals_the_uninterrupted_one(shared_dir):
