@@ -9,10 +9,13 @@
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
  *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
  *   segment, whatever the grid.
+ * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
  * contact_forces: one pass of the secondary nodes against their candidates: the closest
- *   point of the closest segment (a quadrilateral as 4 triangles about its centre), the
- *   penalty force of the penetration p = gap - d (d the signed distance, < 0 behind the
- *   surface) stiffening toward p = gap (k0 g / (g - p), held beyond p = cap g), Coulomb
+ *   point on the surface (closest_on_surface: the segments within a band of the closest
+ *   distance blended, a quadrilateral as 4 triangles about its centre, the side from the
+ *   blended pseudo-normal), the penalty force of the penetration p = g - d (g the node's
+ *   gap, d the signed distance, < 0 behind the surface) stiffening toward p = g
+ *   (k0 g / (g - p), held beyond p = cap g), Coulomb
  *   friction on an elastic tangential spring of stiffness k0 (friction.h's law and filter),
  *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m): the
  *   tangent of the springs in contact, k0 for those within reach of a segment but not in
