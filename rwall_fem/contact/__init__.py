@@ -85,7 +85,7 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
             alpha=filter_alpha(spec.friction_filter, state.dt), margin=edge, state=state,
             comm=comm, owned_global=owned, damping=spec.damping,
         )  # fmt: skip
-        interface._gather(state)
+        interface.start(state)
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
                 ids = np.searchsorted(nodes, surfaces[name].nodes)
