@@ -1058,7 +1058,7 @@ class Motion:
     json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
 )
 def _table_without_mass(v, raw, fail):
-    """A velocity history prescribes the motion: no mass with it."""
+    """A velocity history prescribes the motion: no mass with it; `held` needs a mass."""
     if v["mass"] is not None and isinstance(v["velocity"][0], tuple):
         fail("mass", "a velocity table prescribes the motion: drop 'mass'")
     if v["mass"] is None and v["held"] is not None:
