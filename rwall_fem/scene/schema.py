@@ -1055,7 +1055,10 @@ class Motion:
 
 @rule(
     Motion,
-    json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
+    json=[
+        {"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}},
+        {"if": {"not": {"required": ["mass"]}}, "then": {"not": {"required": ["held"]}}},
+    ],
 )
 def _table_without_mass(v, raw, fail):
     """A velocity history prescribes the motion: no mass with it; `held` needs a mass."""
