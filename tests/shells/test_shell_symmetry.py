@@ -8,8 +8,8 @@ and must go to the symmetry planes: the sphere's main node lies on both, so its 
 velocity are held (``motion.held = "xy"``). Then the quarter (a quarter of the sphere's
 mass, u_x = 0 and rotations about y and z held on x = 0, likewise on y = 0) gives the
 whole plate's sphere velocity, plastic work and internal energy to round-off (1e-12),
-on any number of ranks. The sphere free in x and y drifts off the centre instead (about
--4 m/s sideways by 2 ms) and rebounds 10 % slower: the test sees that too.
+on any number of ranks. The sphere free in x and y drifts off the centre instead (-2.5 m/s
+in x and in y by 2 ms here) and rebounds at 0.67 m/s instead of 4.52: the test sees that too.
 """
 
 import pytest
