@@ -584,7 +584,7 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
         if spec.motion.prescribed:
             motion = PrescribedMotion(spec.motion.velocity)
         else:
-            motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity)
+            motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity, spec.motion.held or "")
     _filter_fits(spec, where, state.dt)
     return RigidWall(
         shape,

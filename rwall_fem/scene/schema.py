@@ -1040,6 +1040,13 @@ class Motion:
     velocity: tuple = key(
         Velocity(), unit="m/s", doc="initial (with mass) or prescribed, constant or a history"
     )
+    held: str | None = key(
+        Letters(),
+        None,
+        doc="with mass: the global components of the main node's velocity kept at their "
+        "initial value (the main node of a half or quarter model on its symmetry planes)",
+        default_doc="none: the main node moves freely",
+    )
 
     @property
     def prescribed(self) -> bool:
@@ -1048,12 +1055,17 @@ class Motion:
 
 @rule(
     Motion,
-    json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
+    json=[
+        {"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}},
+        {"if": {"not": {"required": ["mass"]}}, "then": {"not": {"required": ["held"]}}},
+    ],
 )
 def _table_without_mass(v, raw, fail):
-    """A velocity history prescribes the motion: no mass with it."""
+    """A velocity history prescribes the motion: no mass with it; `held` needs a mass."""
     if v["mass"] is not None and isinstance(v["velocity"][0], tuple):
         fail("mass", "a velocity table prescribes the motion: drop 'mass'")
+    if v["mass"] is None and v["held"] is not None:
+        fail("held", "a prescribed velocity holds every component: give 'mass' or drop 'held'")
 
 
 @table("The friction filter of Radioss: exactly one of its keys.", one_of=True)
