@@ -145,6 +145,17 @@ class ContactInterface:
                                         self._send, self._receive, self._owned_force)]  # fmt: skip
         self._passes = [self._pass_pointers(ps) for ps in passes]
 
+    def vary_gap(self, node_gap: np.ndarray) -> None:
+        """A variable gap (Radioss Igap 1): node s against a segment gets the larger of
+        :attr:`gap` (the floor) and ``node_gap[s]`` plus the segment's half thickness
+        (a shell's: -depth; 0 for a solid's face); ``node_gap`` (m) per surface node."""
+        self.node_gap = np.ascontiguousarray(node_gap, dtype=np.float64)
+        self._params.node_gap = self._pointer(self.node_gap)
+        shells = [-ps.depth.min(initial=0.0) for ps in self.passes]
+        self.gap_max = max(self.gap, float(self.node_gap.max(initial=0.0)) + max(shells))
+        self.reach = max(self.reach, self.gap_max)
+        self._params.reach = self.reach
+
     def _pointer(self, array, kind="double[]"):
         return self.ffi.from_buffer(kind, array)
 

@@ -33,6 +33,7 @@ typedef struct
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+  const double *node_gap; /* m per surface node, or NULL: a variable gap (see pair_gap) */
 } contact_params;
 
 INLINE double cdot(const double x[3], const double y[3])
@@ -361,6 +362,21 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
   }
 }
 
+/* A segment of negative depth is a shell's mid-surface, both sides active: a node's
+ * distance to it is unsigned and it is pushed out on the side it is on. */
+INLINE int two_sided(double depth) { return depth < 0.0; }
+
+/* The gap (m) of node s against a segment of depth `depth`: the interface's, or with
+ * node_gap (a variable gap, Radioss Igap 1) the larger of it (the floor, Gapmin) and the
+ * node's gap plus the segment's (half their shells' thicknesses: -depth for a shell). */
+INLINE double pair_gap(const contact_params *prm, int64_t s, double depth)
+{
+  if (!prm->node_gap)
+    return prm->gap;
+  const double pair = prm->node_gap[s] + (two_sided(depth) ? -depth : 0.0);
+  return pair > prm->gap ? pair : prm->gap;
+}
+
 /* The normal force (N) of penetration p (m) for stiffness k0 (N/m) and gap g (m), its
  * tangent stiffness (N/m, into *tangent) and stored energy (J, into *energy):
  * f = -k0 g ln(1 - p/g) up to p = cap g, then on along its tangent there. */
@@ -399,9 +415,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
 {
   for (int c = 0; c < 11; ++c)
     out[c] = 0.0;
-  const double g = prm->gap;
   for (int64_t i = 0; i < nsec; ++i)
   {
+    double g = prm->gap;
     const int64_t s = secondary[i];
     const double *xs = x + 3 * s;
     int64_t best = -1;
@@ -414,7 +430,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       csub(xs, q, r);
       const double distance = sqrt(cdot(r, r));
       const double along = cdot(r, n);
-      const double d = along >= 0.0 ? distance : -distance;
+      const double d = along >= 0.0 || two_sided(depth[j]) ? distance : -distance;
       /* The closest segment decides, in contact or not: a node just beyond the gap in
        * front of one face is not inside its neighbour at the edge. */
       if (!(distance < prm->reach)) /* out of reach (and NaN) */
@@ -435,7 +451,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
           best_n[c] = n[c];
     }
     double *ft = tangential + 3 * i;
-    if (best >= 0 && !(best_d < g && -best_d < depth[best]))
+    if (best >= 0)
+      g = pair_gap(prm, s, depth[best]);
+    if (best >= 0 && !(best_d < g && (two_sided(depth[best]) || -best_d < depth[best])))
     {
       /* Near but not in contact: its spring's stiffness counts in the step all the same,
        * so that the step does not jump as nodes come into and out of contact. */

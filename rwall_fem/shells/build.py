@@ -60,8 +60,7 @@ def _unsupported(scene) -> None:
             "of shells stops at run.dt_min ('stop')"
         )
     for table, given in (("rigid_body", scene.rigid_bodies), ("load", scene.loads),
-                         ("added_mass", scene.added_masses), ("damping", scene.damping),
-                         ("contact", scene.contacts)):  # fmt: skip
+                         ("added_mass", scene.added_masses), ("damping", scene.damping)):  # fmt: skip
         if given:
             raise SceneError(
                 f"{scene.source}: {table}: is for solids; a body of shells has no "
