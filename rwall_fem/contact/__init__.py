@@ -106,11 +106,14 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
                 extent = np.sort(x.max(axis=0) - x.min(axis=0))
                 # A flat sheet has no extent across: its width then
                 smallest = float(extent[1] if solid.shells else extent[0])
+                across, default = (("narrowest", "half the sum of the thicknesses")
+                                   if solid.shells else
+                                   ("thinnest", "0.1 x the shortest edge"))  # fmt: skip
                 if gap >= smallest:
                     raise SceneError(
                         f"{where}.gap: {gap:g} m is not smaller than part {name!r} "
-                        f"({smallest:g} m across at its thinnest): the gap must be a small "
-                        "fraction of the parts (default 0.1 x the shortest edge)"
+                        f"({smallest:g} m across at its {across}): the gap must be a small "
+                        f"fraction of the parts (default {default})"
                     )
         interfaces.append(interface)
     return interfaces
