@@ -18,6 +18,8 @@
  *   tangent of the springs in contact, k0 for those within reach of a segment but not in
  *   contact (so that the step does not jump as nodes come and go).
  * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
+ * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
+ * distance to it unsigned); with `node_gap` the gap is variable, per pair (pair_gap).
  */
 #include <stdlib.h>
 
