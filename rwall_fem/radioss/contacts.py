@@ -47,8 +47,9 @@ def contact_tables(deck: Deck, parts: list[DeckPart], named: bool,
             raise DeckError(f"{where}: grnd_IDs {inter.node_group} holds no node of an element")
         taken = np.concatenate([p.nodes for p in secondary])
         if not np.isin(taken, nodes).all():
-            deck.warnings.append(f"{where}: grnd_IDs {inter.node_group}: takes every node of "
-                                 f"{_names(secondary)} (a scene's contact names parts)")  # fmt: skip
+            deck.warnings.append(f"{where}: grnd_IDs {inter.node_group}: takes every node "
+                                 f"of {_names(secondary)} (a scene's contact names "
+                                 "parts)")  # fmt: skip
         common = [p for p in main if p in secondary]
         others = [p for p in secondary if p not in main]
         common_table = _common(deck, inter, main, where)

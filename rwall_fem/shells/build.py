@@ -60,7 +60,8 @@ def _unsupported(scene) -> None:
             "of shells stops at run.dt_min ('stop')"
         )
     for table, given in (("rigid_body", scene.rigid_bodies), ("load", scene.loads),
-                         ("added_mass", scene.added_masses), ("damping", scene.damping)):  # fmt: skip
+                         ("added_mass", scene.added_masses),
+                         ("damping", scene.damping)):  # fmt: skip
         if given:
             raise SceneError(
                 f"{scene.source}: {table}: is for solids; a body of shells has no "

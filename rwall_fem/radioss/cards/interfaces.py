@@ -66,7 +66,8 @@ def _type7(deck: Deck, card: Card) -> None:
                   "stiffness), 2 to 5 (main and secondary combined)", card.lines[1])  # fmt: skip
     if istf == 1:
         card.fail("Istf = 1: a stiffness given as a value (Stfac, N/m) is not supported; "
-                  "give Istf 0 and Stfac as a scale of the main side's stiffness", card.lines[1])  # fmt: skip
+                  "give Istf 0 and Stfac as a scale of the main side's stiffness",
+                  card.lines[1])  # fmt: skip
     if istf in (2, 3, 4, 5):
         deck.warn(card, f"Istf = {istf}: not honoured: the stiffness is the main side's "
                   "(Istf 1000)", card.lines[1])  # fmt: skip
@@ -84,7 +85,8 @@ def _type7(deck: Deck, card: Card) -> None:
     fscale, gapmax, fpenmax, itied, ists = card.read(
         2, "f:Fscalegap f:Gap_max f:Fpenmax -:blank:20 i:Itied i:Ists")
     _ignored(deck, card, card.lines[2], {"Fscalegap": fscale, "Gap_max": gapmax,
-                                         "Fpenmax": fpenmax, "Itied": itied, "Ists": ists})  # fmt: skip
+                                         "Fpenmax": fpenmax, "Itied": itied,
+                                         "Ists": ists})  # fmt: skip
     stmin, stmax, mesh, dtmin, irem_gap, irem_i2 = card.read(
         3, "f:Stmin f:Stmax f:Percent_mesh_size f:dtmin i:Irem_gap i:Irem_i2")
     _ignored(deck, card, card.lines[3], {"Stmin": stmin, "Stmax": stmax,
