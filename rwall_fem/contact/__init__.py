@@ -6,6 +6,13 @@ segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surf
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
 nodes against their own faces, each node kept off its own faces and their neighbours.
+
+On a body of shells the segments are the shells, both sides active
+(:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
+variable, as Radioss's Igap 1: a node against a segment gets half the thickness of the
+thickest shell at the node plus half the segment's (half the sum of the thicknesses),
+floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side). A given
+``gap`` is constant (Radioss Igap 0).
 """
 
 from __future__ import annotations
@@ -13,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, part_surface
+from rwall_fem.contact.surface import Surface, part_surface, shell_surface
 
 __all__ = ["build_contacts"]
 
@@ -28,6 +35,7 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
     from rwall_fem.walls.constraint import filter_alpha
 
     body, comm = solid.elastic, solid.comm
+    faces = shell_surface if solid.shells else part_surface
     failing = any(getattr(p.material, "failure", None) for p in scene.body_parts)
     if failing or scene.run.dt_min_action == "erode":
         raise SceneError(
@@ -51,7 +59,7 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
                     )
             for name in parts:
                 if name not in surfaces:
-                    surfaces[name] = part_surface(body, names.index(name), comm)
+                    surfaces[name] = faces(body, names.index(name), comm)
             found = [surfaces[name] for name in dict.fromkeys(parts)]
             total = found[0]
             for more in found[1:]:
@@ -69,7 +77,9 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
             sides = [(secondary, main, False)] + ([(main, secondary, False)] if spec.symmetric else [])
         nodes = np.unique(np.concatenate([s.nodes for pair in sides for s in pair[:2]]))
         edge = float(min(s.edge.min() for pair in sides for s in pair[:2]))
-        gap = spec.gap if spec.gap is not None else 0.1 * edge
+        half = float(max(-s.depth.min(initial=0.0) for pair in sides for s in pair[:2]))
+        node_gap = _node_gaps(nodes, [s for pair in sides for s in pair[:2]])
+        gap = spec.gap if spec.gap is not None else _gap_floor(sides, edge)
         passes = [
             Pass(
                 np.searchsorted(nodes, sec.nodes).astype(np.int64),
@@ -85,17 +95,45 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
             alpha=filter_alpha(spec.friction_filter, state.dt), margin=edge, state=state,
             comm=comm, owned_global=owned, damping=spec.damping,
         )  # fmt: skip
+        if spec.gap is None and half > 0.0:
+            interface.vary_gap(node_gap)
         interface.start(state)
+        gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
                 ids = np.searchsorted(nodes, surfaces[name].nodes)
                 x = interface.x[ids]
-                smallest = float((x.max(axis=0) - x.min(axis=0)).min())
+                extent = np.sort(x.max(axis=0) - x.min(axis=0))
+                # A flat sheet has no extent across: its width then
+                smallest = float(extent[1] if solid.shells else extent[0])
+                across, default = (("narrowest", "half the sum of the thicknesses")
+                                   if solid.shells else
+                                   ("thinnest", "0.1 x the shortest edge"))  # fmt: skip
                 if gap >= smallest:
                     raise SceneError(
                         f"{where}.gap: {gap:g} m is not smaller than part {name!r} "
-                        f"({smallest:g} m across at its thinnest): the gap must be a small "
-                        "fraction of the parts (default 0.1 x the shortest edge)"
+                        f"({smallest:g} m across at its {across}): the gap must be a small "
+                        f"fraction of the parts (default {default})"
                     )
         interfaces.append(interface)
     return interfaces
+
+
+def _gap_floor(sides, edge: float) -> float:
+    """The default (constant, or the floor of a variable) gap (m): Radioss's Gapmin,
+    min(thinnest shell, half the shortest side) with shells, 0.1 x the shortest edge of
+    solids' faces."""
+    thickness = [2.0 * -s.depth[s.depth < 0.0] for pair in sides for s in pair[:2]]
+    thickness = np.concatenate(thickness)
+    return min(float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
+
+
+def _node_gaps(nodes: np.ndarray, surfaces: list[Surface]) -> np.ndarray:
+    """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
+    solid's)."""
+    out = np.zeros(len(nodes))
+    for s in surfaces:
+        half = np.repeat(np.maximum(-s.depth, 0.0), 4)
+        ids = s.segments.ravel()
+        np.maximum.at(out, np.searchsorted(nodes, ids[ids >= 0]), half[ids >= 0])
+    return out

@@ -78,7 +78,8 @@ class Pass:
         self.offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
-        self.gaps = np.zeros(len(self.secondary))  # each node's gap, m (ContactInterface)
+        self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
+        # inside the gap, growing back (kernels/contact.c); inf for the others
         self.out = np.zeros(11)
 
 
@@ -145,8 +146,7 @@ class ContactInterface:
         self._surface = [p(x) for x in (self.x, self.v, self.mass, self.force, self.stiffness,
                                         self._send, self._receive, self._owned_force)]  # fmt: skip
         self._passes = [self._pass_pointers(ps) for ps in passes]
-        for ps in passes:
-            ps.gaps[:] = gap
+        self.gap_max = gap  # the largest pair gap (vary_gap)
         self.starting_inside = (0, 0, 0.0)  # nodes within the gap at the start, of them
         # behind the surface, and the deepest initial penetration (m)
 
@@ -168,6 +168,18 @@ class ContactInterface:
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
         self.starting_inside = (inside, behind, deepest)
+
+    def vary_gap(self, half_thickness: np.ndarray) -> None:
+        """A variable gap (Radioss Igap 1): node s against a segment gets the larger of
+        :attr:`gap` (the floor) and ``half_thickness[s]`` plus the segment's half thickness
+        (a shell's: -depth; 0 for a solid's face); ``half_thickness`` (m) per surface node
+        (half its thickest shell)."""
+        self.half_thickness = np.ascontiguousarray(half_thickness, dtype=np.float64)
+        self._params.half_thickness = self._pointer(self.half_thickness)
+        shells = [-ps.depth.min(initial=0.0) for ps in self.passes]
+        self.gap_max = max(self.gap, float(self.half_thickness.max(initial=0.0)) + max(shells))
+        self.reach = max(self.reach, self.gap_max)
+        self._params.reach = self.reach
 
     def _pointer(self, array, kind="double[]"):
         return self.ffi.from_buffer(kind, array)

@@ -21,6 +21,8 @@
  *   tangent of the springs in contact, k0 for those within reach of a segment but not in
  *   contact (so that the step does not jump as nodes come and go).
  * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
+ * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
+ * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
  */
 #include <stdlib.h>
 
@@ -36,6 +38,8 @@ typedef struct
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+  const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
+                                  a constant gap (see pair_gap) */
 } contact_params;
 
 INLINE double cdot(const double x[3], const double y[3])
@@ -374,6 +378,21 @@ static double closest_on_segment(const double p[3], const int64_t *seg, const do
   return nearest;
 }
 
+/* A segment of negative depth is a shell's mid-surface, both sides active: a node's
+ * distance to it is unsigned and it is pushed out on the side it is on. */
+INLINE int two_sided(double depth) { return depth < 0.0; }
+
+/* The gap (m) of node s against a segment of depth `depth`: the interface's, or with
+ * half_thickness (a variable gap, Radioss Igap 1) the larger of it (the floor, Gapmin) and
+ * the node's half thickness plus the segment's (-depth for a shell, 0 for a solid's face). */
+INLINE double pair_gap(const contact_params *prm, int64_t s, double depth)
+{
+  if (!prm->half_thickness)
+    return prm->gap;
+  const double pair = prm->half_thickness[s] + (two_sided(depth) ? -depth : 0.0);
+  return pair > prm->gap ? pair : prm->gap;
+}
+
 /* The normal force (N) of penetration p (m) for stiffness k0 (N/m) and gap g (m), its
  * tangent stiffness (N/m, into *tangent) and stored energy (J, into *energy):
  * f = -k0 g ln(1 - p/g) up to p = cap g, then on along its tangent there. */
@@ -485,7 +504,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
     pt->weight[m] /= weights;
   pt->k0 /= total;
   pt->depth /= total;
-  pt->d = along >= 0.0 ? best : -best;
+  pt->d = along >= 0.0 || two_sided(pt->depth) ? best : -best;
   double r[3];
   for (int c = 0; c < 3; ++c)
     r[c] = xs[c] - q_sum[c] / total;
@@ -511,15 +530,17 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
  * gets gap 0: inactive until it comes out in front. */
 #define INITIAL_GAP 0.95
 
-/* The node's gap (m) at its signed distance d (m), grown from *node_gap toward `gap`. */
+/* The node's gap (m) at its signed distance d (m), against the pair's gap `gap`: *node_gap
+ * (INFINITY for a node that did not start inside) grows with 0.95 d and is dropped
+ * (INFINITY) once it reaches `gap`; it never shrinks. */
 INLINE double grown_gap(double *node_gap, double d, double gap)
 {
   if (*node_gap < gap)
   {
     const double grown = INITIAL_GAP * d;
-    *node_gap = grown > *node_gap ? (grown < gap ? grown : gap) : *node_gap;
+    *node_gap = grown >= gap ? INFINITY : (grown > *node_gap ? grown : *node_gap);
   }
-  return *node_gap;
+  return *node_gap < gap ? *node_gap : gap;
 }
 
 /* The gaps of the nsec secondary nodes at the start (node_gap, m), as above. out: [0] the
@@ -539,15 +560,17 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
-    node_gap[i] = prm->gap;
+    node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, x, prm->reach, distance, &pt) ||
-        !(pt.d < prm->gap && -pt.d < pt.depth))
+                            segs, stiffness0, depth, x, prm->reach, distance, &pt))
+      continue;
+    const double g = pair_gap(prm, secondary[i], pt.depth);
+    if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
       continue;
     node_gap[i] = pt.d > 0.0 ? INITIAL_GAP * pt.d : 0.0;
     out[0] += 1.0;
     out[1] += pt.d > 0.0 ? 0.0 : 1.0;
-    out[2] = prm->gap - pt.d > out[2] ? prm->gap - pt.d : out[2];
+    out[2] = g - pt.d > out[2] ? g - pt.d : out[2];
   }
   free(distance);
 }
@@ -584,12 +607,12 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                             depth, x, prm->reach, distance, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
-      node_gap[i] = prm->gap;
+      node_gap[i] = INFINITY;
       continue;
     }
-    const double g = grown_gap(node_gap + i, pt.d, prm->gap);
+    const double g = grown_gap(node_gap + i, pt.d, pair_gap(prm, s, pt.depth));
     const double k0 = pt.k0;
-    if (!(g > 0.0 && pt.d < g && -pt.d < pt.depth))
+    if (!(g > 0.0 && pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
     {
       /* Near but not in contact: its spring's stiffness counts in the step all the same,
        * so that the step does not jump as nodes come into and out of contact. */

@@ -1192,15 +1192,16 @@ class ContactSpec:
         Real(low=0.0),
         None,
         unit="m",
-        doc="the contact distance (Radioss Gapmin): forces act below it and stiffen toward "
-        "it, k0 g / (g - p) at penetration p",
-        default_doc="0.1 x the shortest edge of the segments",
+        doc="the contact distance (Radioss Gapmin), constant: forces act below it and stiffen "
+        "toward it, k0 g / (g - p) at penetration p",
+        default_doc="0.1 x the shortest edge of the segments; on shells a variable gap, half "
+        "the sum of the thicknesses (Radioss Igap 1)",
     )
     stiffness_scale: float = key(
         Real(low=0.0),
         1.0,
         doc="Radioss Stfac: scales the penalty stiffness k0 = B A^2 / V of the cell under "
-        "each segment",
+        "each segment (E t of a shell segment)",
     )
     damping: float = key(
         Real(low=0.0, low_open=False, high=1.0),

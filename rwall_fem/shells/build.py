@@ -52,16 +52,6 @@ def _element_tables(scene):
     return tables
 
 
-def _unsupported(scene) -> None:
-    """What shells do not do yet, refused in one line naming the key."""
-    for table, given in (("contact", scene.contacts),):  # fmt: skip
-        if given:
-            raise SceneError(
-                f"{scene.source}: {table}: is for solids; a body of shells has no "
-                f"{table.replace('_', ' ')} yet (leave it out)"
-            )
-
-
 def _section(scene, i: int, spec, cell: str) -> ShellSection:
     """Part ``i``'s section from its [element] (the scene's when it gives none)."""
     element = spec.element
@@ -116,7 +106,6 @@ def shell_solid(scene, comm: MPI.Comm, body):
 
     cell = body.msh.topology.cell_type.name
     solid_keys_on_shells(scene, cell)
-    _unsupported(scene)
     specs = scene.body_parts
     sections = [_section(scene, i, spec, cell) for i, spec in enumerate(specs)]
     try:
