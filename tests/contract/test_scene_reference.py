@@ -42,7 +42,7 @@ def test_every_key_carries_a_doc_and_numbers_a_unit():
         "coefficient", "steps", "hardening_exponent", "strain_rate_coefficient",
         "softening_exponent", "taylor_quinney", "max_added_mass", "plastic_strain",
         "d1", "d2", "d3", "d4", "d5", "hourglass_coefficients", "shear_factor", "zoom",
-        "stiffness_scale", "damping", "failed_share",
+        "stiffness_scale", "damping", "failed_share", "hourglass_stiffness", "drilling_stiffness",
     }  # fmt: skip
     for where, _, cls in tables():
         assert cls.__table__.doc, where
