@@ -165,6 +165,8 @@ BEYOND = {
     "297_shells_beside_solids_in_one_mesh_file",
     "298_shell_pressure_on_an_edge",
     "299_shell_stiffness_damping",
+    "332_shell_drilling_stiffness_on_triangles",
+    "333_shell_drilling_stiffness_on_hexahedra",
     # The flow-stress cap lies above the initial yield stress: two values compared.
     "320_flow_stress_cap_below_yield",
     "322_johnson_cook_cap_below_yield",
