@@ -803,7 +803,10 @@ _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 # The cells of a body of shells, and the keys of [element] for shells and for solids.
 SURFACE_CELLS = ("quadrilateral", "triangle")
 SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor",
-              "failed_share", "thickness_change")  # fmt: skip
+              "failed_share", "thickness_change", "hourglass_stiffness",
+              "drilling_stiffness")  # fmt: skip
+# The shells' [element] keys of the quadrilateral's kernel only (shell_quad.c).
+QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness")
 SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
@@ -883,6 +886,23 @@ class Element:
         doc="shells: the thickness follows the membrane strain, plastic flow keeping the "
         "volume (Radioss's Ithick = 1); false: constant",
         default_doc="false",
+    )
+    hourglass_stiffness: float | None = key(
+        Real(low=0.0, low_open=False, high=1.0),
+        None,
+        doc="quadrilateral shells: an elastic hourglass stiffness beside the viscous one, as "
+        "a share of the fully integrated cell's (1: its in-plane bending, too stiff for "
+        "cells of aspect 2; 0.5 passes the twisted beam)",
+        default_doc="0 (viscous hourglass control only)",
+    )
+    drilling_stiffness: float | None = key(
+        Real(low=0.0, low_open=False, high=0.1),
+        None,
+        doc="quadrilateral shells: drilling springs of stiffness a G t A per node, between "
+        "each node's rotation about the cell's normal and the cell's in-plane spin (for "
+        "slow or static problems on twisted meshes; at most 0.1, so that they never set "
+        "the step)",
+        default_doc="0 (no drilling stiffness; Radioss's Idrill = 1 reads as 0.01)",
     )
 
 
@@ -1526,6 +1546,11 @@ def element_fits_the_surface(where: str, given, cell: str) -> str | None:
         if name in given:
             what = "solids (hexahedra, tetrahedra)" if shells else "shells (surface cells)"
             return f"{where}.{name}: is for {what}, and the mesh has {cell} cells: leave it out"
+    if cell == "triangle":
+        for name in QUADRILATERAL_KEYS:
+            if name in given:
+                return (f"{where}.{name}: is for quadrilateral shells (the triangle has no "
+                        "such term), and the mesh has triangle cells: leave it out")  # fmt: skip
     formulation = given.get("formulation")
     fits = {"quadrilateral": ("bt", "bwc"), "triangle": ("bsc",)}
     if shells and formulation is not None and formulation not in fits[cell]:
@@ -1536,9 +1561,10 @@ def element_fits_the_surface(where: str, given, cell: str) -> str | None:
 
 @rule(Scene)
 def _element_fits_shells_or_solids(v, raw, fail):
-    """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor) for
-    surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
-    volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles. (For a
+    """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor, ...)
+    for surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
+    volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles;
+    hourglass_stiffness and drilling_stiffness on quadrilaterals only. (For a
     mesh file the cells are known when the body is built.)"""
     mesh = v["mesh"]
     if mesh is None or mesh.shape is None:

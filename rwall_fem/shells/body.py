@@ -64,8 +64,13 @@ class ShellSection:
         change = " (changing with the membrane strain)" if self.thickness_change else ""
         share = (f", a cell failing when {100 * self.failed_share:.3g} % of its points have"
                  if self.failed_share < 1.0 else "")  # fmt: skip
+        t = self.technology
+        extra = (f", elastic hourglass stiffness {t.hourglass_stiffness:g}"
+                 if t.hourglass_stiffness > 0.0 else "")  # fmt: skip
+        extra += (f", drilling springs {t.drilling_stiffness:g} G t A"
+                  if t.drilling_stiffness > 0.0 else "")  # fmt: skip
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
-                f"{self.thickness:g} m{change}{share}")  # fmt: skip
+                f"{self.thickness:g} m{change}{share}{extra}")  # fmt: skip
 
 
 @dataclass

@@ -17,7 +17,7 @@ from rwall_fem import _compat
 from rwall_fem.body import PartError, parts_of
 from rwall_fem.elements import GhostedField
 from rwall_fem.scene import SceneError
-from rwall_fem.scene.schema import element_fits_the_surface
+from rwall_fem.scene.schema import SHELL_KEYS, element_fits_the_surface
 from rwall_fem.shells.body import ShellBody, ShellPart, ShellSection
 from rwall_fem.shells.inertia import lumped_inertia
 
@@ -36,8 +36,7 @@ def solid_keys_on_shells(scene, cell: str) -> None:
     volume mesh (a scene mixes no shells and solids in one mesh)."""
     for where, element in _element_tables(scene):
         given = {name: getattr(element, name) for name in
-                 (*_SOLID_VALUES, "thickness", "formulation", "failed_share",
-                  "thickness_change")}  # fmt: skip
+                 (*_SOLID_VALUES, *SHELL_KEYS)}  # fmt: skip
         given = {name: value for name, value in given.items() if value is not None}
         wrong = element_fits_the_surface(where, given, cell)
         if wrong:
@@ -75,6 +74,8 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             points=points,
             hourglass=element.hourglass_coefficients or HOURGLASS,
             shear_factor=element.shear_factor or SHEAR_FACTOR,
+            hourglass_stiffness=element.hourglass_stiffness or 0.0,
+            drilling_stiffness=element.drilling_stiffness or 0.0,
         )
     except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
         said = str(err)

@@ -42,7 +42,7 @@ def test_every_key_carries_a_doc_and_numbers_a_unit():
         "coefficient", "steps", "hardening_exponent", "strain_rate_coefficient",
         "softening_exponent", "taylor_quinney", "max_added_mass", "plastic_strain",
         "d1", "d2", "d3", "d4", "d5", "hourglass_coefficients", "shear_factor", "zoom",
-        "stiffness_scale", "damping", "failed_share",
+        "stiffness_scale", "damping", "failed_share", "hourglass_stiffness", "drilling_stiffness",
     }  # fmt: skip
     for where, _, cls in tables():
         assert cls.__table__.doc, where
@@ -166,6 +166,8 @@ BEYOND = {
     "297_shells_beside_solids_in_one_mesh_file",
     "298_shell_pressure_on_an_edge",
     "299_shell_stiffness_damping",
+    "332_shell_drilling_stiffness_on_triangles",
+    "333_shell_drilling_stiffness_on_hexahedra",
     # The flow-stress cap lies above the initial yield stress: two values compared.
     "320_flow_stress_cap_below_yield",
     "322_johnson_cook_cap_below_yield",

@@ -162,6 +162,35 @@ def test_ithick_and_p_thickfail_map_onto_the_element(shared_dir):
     assert load_deck(written(plate_deck(), shared_dir)).element.thickness_change is None
 
 
+@pytest.mark.parametrize("ishell, idrill", [(1, 1), (3, 0), (3, 2)])
+def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, shared_dir):
+    """Idrill 1: drilling springs of 0.01 G t A per node (2 or blank: none); Ishell 3 (the
+    elasto-plastic hourglass stiffness): the warping-corrected element with the elastic
+    hourglass stiffness 0.5. The values reach the compiled kernel of the deck's body."""
+
+    def edit(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, i10(ishell) + i10(0) * 2 + i10(idrill) + i10(0))
+
+    scene = load_deck(written(plate_deck(), shared_dir, edit))
+    drilling = 0.01 if idrill == 1 else None
+    hourglass = 0.5 if ishell == 3 else None
+    assert (scene.element.drilling_stiffness, scene.element.hourglass_stiffness) == (
+        drilling, hourglass)  # fmt: skip
+    assert scene.element.formulation == ("bwc" if ishell == 3 else "bt")
+    sim = build_simulation(scene, comm, shared_dir)
+    compiled = sim.internal.elements[0].kernel.shell
+    assert (compiled.kd, compiled.hk) == (drilling or 0.0, hourglass or 0.0)
+
+
+def test_idrill_other_than_1_and_2_is_refused(shared_dir):
+    def edit(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, i10(1) + i10(0) * 2 + i10(3) + i10(0))
+
+    with pytest.raises(DeckError, match="Idrill = 3: 1 .drilling springs. or 2") as caught:
+        load_deck(written(plate_deck(), shared_dir, edit))
+    assert "\n" not in str(caught.value) and "model_0000.rad:" in str(caught.value)
+
+
 def test_a_solid_property_on_shells_and_shells_beside_solids_are_refused(shared_dir):
     d = plate_deck()
     d.cards = [c.replace("/PROP/SHELL/1", "/PROP/SHELL/2") for c in d.cards]

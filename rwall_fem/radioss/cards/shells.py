@@ -1,12 +1,15 @@
 """Shell elements and their property: /SHELL, /SH3N and /PROP/SHELL (/PROP/TYPE1), whose
 blank fields take /DEF_SHELL's values (read at the end, wherever the cards are).
 
-Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): 1, 2, 3 and 4
-(Belytschko-Tsay with viscous hourglass control) to ``"bt"``; 24 (QEPH, Belytschko-Leviathan's
-physical stabilisation) and 12 to ``"bwc"`` (Belytschko-Lin-Tsay with the
-Belytschko-Wong-Chiang warping correction and viscous hourglass control), with a warning
-that QEPH's physical stabilisation is not there. Ish3n 1 and 2 (the C0 triangle) to
-``"bsc"``. N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
+Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): 1, 2 and 4
+(Belytschko-Tsay with viscous hourglass control) to ``"bt"``; 3 (the elasto-plastic
+hourglass stiffness, orthogonal to the rigid modes) to ``"bwc"`` with
+``hourglass_stiffness`` :data:`HOURGLASS_STIFFNESS` (elastic: a warning says so); 24
+(QEPH, Belytschko-Leviathan's physical stabilisation) and 12 to ``"bwc"``
+(Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and viscous
+hourglass control), with a warning that QEPH's physical stabilisation is not there. Ish3n
+1 and 2 (the C0 triangle) to ``"bsc"``. Idrill 1 gives the quadrilaterals drilling
+springs, ``drilling_stiffness`` :data:`DRILLING_STIFFNESS` (2 or blank: none). N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
 ``thickness``, ``shear_factor`` and ``hourglass_coefficients`` (Radioss's defaults where
 blank: N 5, Ashear 5/6, hm hf hr 0.01); P_thickfail becomes ``failed_share`` (blank: 1,
 every point) and Ithick = 1 ``thickness_change = true`` (2 or blank: constant).
@@ -20,12 +23,18 @@ from rwall_fem.radioss.cards.base import card_units, ident
 from rwall_fem.radioss.model import Body, Deck
 from rwall_fem.radioss.reader import Card, fixed_table, read_fields
 
-__all__ = ["ISHELL", "STARTER", "finish", "shell_element"]
+__all__ = ["DRILLING_STIFFNESS", "HOURGLASS_STIFFNESS", "ISHELL", "STARTER", "finish",
+           "shell_element"]
 
 # Ishell -> the scene's formulation of quadrilaterals.
-ISHELL = {1: "bt", 2: "bt", 3: "bt", 4: "bt", 12: "bwc", 24: "bwc"}
+ISHELL = {1: "bt", 2: "bt", 3: "bwc", 4: "bt", 12: "bwc", 24: "bwc"}
 _ISHELL_TEXT = "1, 2, 3, 4 (Belytschko-Tsay), 12 and 24 (read as Belytschko-Lin-Tsay with the " \
     "warping correction)"  # fmt: skip
+# Ishell 3's elastic hourglass stiffness and Idrill 1's drilling springs (a G t A per node):
+# the constants with which the twisted beam passes (docs/theory.md, "Warping").
+HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
+# The [element] keys of the quadrilaterals only, left out for triangles.
+_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness")
 
 
 def _elements(deck: Deck, card: Card) -> None:
@@ -108,12 +117,22 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     points = raw["n"] or 5
     if not 1 <= points <= 10:
         card.fail(f"N = {points}: 1 to 10 points through the thickness", third)
-    if value["idrill"]:
-        deck.warn(card, f"Idrill = {value['idrill']}: no drilling stiffness (the rotation "
-                  "about a shell's normal is held by its inertia only)", first)  # fmt: skip
+    if value["idrill"] not in (0, 1, 2):
+        card.fail(f"Idrill = {value['idrill']}: 1 (drilling springs) or 2 (none, as when "
+                  "blank)", first)  # fmt: skip
     hourglass = [h if h else 0.01 for h in raw["hourglass"]]
     element = {"thickness": raw["thick"], "points": points,
                "hourglass_coefficients": hourglass}  # fmt: skip
+    if value["idrill"] == 1:
+        element["drilling_stiffness"] = DRILLING_STIFFNESS
+        deck.warn(card, f"Idrill = 1: drilling springs of {DRILLING_STIFFNESS:g} G t A per "
+                  "node on quadrilaterals (Radioss's own drilling stiffness differs; "
+                  "triangles have none)", first)  # fmt: skip
+    if ishell == 3:
+        element["hourglass_stiffness"] = HOURGLASS_STIFFNESS
+        deck.warn(card, f"Ishell = 3: read as Belytschko-Lin-Tsay shells with the warping "
+                  f"correction, an elastic hourglass stiffness {HOURGLASS_STIFFNESS:g} (not "
+                  "elasto-plastic) and viscous hourglass control hm, hf, hr", first)  # fmt: skip
     if raw["ashear"]:
         element["shear_factor"] = raw["ashear"]
     if raw["thickfail"]:
@@ -134,6 +153,9 @@ def shell_element(deck: Deck, pid: int, cell: str) -> tuple[dict, str]:
     p = deck.properties[pid]
     element = dict(p["element"])
     element["formulation"] = "bsc" if cell == "triangle" else ISHELL[p["ishell"]]
+    if cell == "triangle":
+        for name in _QUADRILATERAL_KEYS:
+            element.pop(name, None)
     head = (f"property: /PROP/SHELL/{pid} Ishell {p['ishell']} Ish3n {p['ish3n']} "
             f"({p['where']})")  # fmt: skip
     text = ", ".join(f"{k} {v}" for k, v in element.items())
