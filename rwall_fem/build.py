@@ -165,7 +165,7 @@ def build_simulation(
     if scene.contacts:
         from rwall_fem.contact import build_contacts
 
-        sim.contacts = build_contacts(scene, solid, sim.state)
+        sim.contacts = build_contacts(scene, solid, sim.state, sim.internal)
         sim.step_size.contacts = sim.contacts
         if sim.step_size.varies and not sim.internal.books_work:
             # Contact makes the step vary: the stored energies take its correction.

@@ -42,6 +42,9 @@ class ErodedCells:
         self._nodal = la.vector(V.dofmap.index_map, 1)
         self.holding = self._count(np.arange(num_cells))  # live cells of each owned node
         self._pending: list[np.ndarray] = []  # eroded here since the last count
+        # The steps in which some rank eroded cells, so far: the same on every rank (the
+        # contact surfaces follow, rwall_fem.contact.erosion).
+        self.detachments = 0
 
     @property
     def count(self) -> int:
@@ -75,6 +78,7 @@ class ErodedCells:
         eroded = np.concatenate(self._pending) if self._pending else np.zeros(0, np.int32)
         self._pending.clear()
         self.holding -= self._count(eroded)
+        self.detachments += 1
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """Which cells are alive, their work so far and the live cells of each node."""

@@ -133,7 +133,6 @@ BEYOND = {
     "94_part_without_cells",
     "300_contact_unknown_part",  # the parts are the body's
     "302_contact_gap_larger_than_the_parts",
-    "305_contact_with_erosion",  # refused when the contact is built
     "95_part_density_1e-300",
     # Loads: what the mesh's groups and ordered rows tell, and keys tied together.
     "251_load_history_decreasing",
