@@ -76,9 +76,11 @@ class ErodingSurface:
         self.nodes = np.unique(_gather(comm, to_global(mine).astype(np.int64))[0])
 
     def _alive_now(self) -> np.ndarray:
-        """Per cell, whether it is alive now."""
+        """Per cell, whether it was alive when the ranks last counted the eroded cells
+        (not what the latest kernel pass eroded since: the same on every number of ranks
+        and after a resume)."""
         e = self.force.erosion
-        return self.alive if e is None else e.alive
+        return self.alive if e is None else e.settled
 
     def update(self) -> bool:
         """Follow the cells eroded since the latest update; whether the surface changed
@@ -161,10 +163,24 @@ class ErodingContact(ContactInterface):
             self._follow()
         super().accelerate(s)
 
+    def checkpoint_state(self) -> dict[str, np.ndarray]:
+        """The interface's, with each pass's friction forces over all its surface nodes
+        (zero off the secondary set), whose number erosion does not change."""
+        arrays = super().checkpoint_state()
+        for k, ps in enumerate(self.passes):
+            every = np.zeros((self.size, 3))
+            every[ps.secondary] = ps.tangential
+            arrays[f"tangential{k}"] = every
+        return arrays | {"updates": np.array([self.updates])}
+
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         """The surfaces of the cells alive at the checkpoint, then the interface's state."""
         self._follow(rebuild=True)
         self._seen = self._detachments()
+        self.updates = int(arrays["updates"][0])
+        arrays = dict(arrays)
+        for k, ps in enumerate(self.passes):
+            arrays[f"tangential{k}"] = arrays[f"tangential{k}"][ps.secondary]
         super().restore_state(arrays)
 
     def summary(self) -> dict:
