@@ -9,6 +9,8 @@ the reference page prints. The validation (:func:`~rwall_fem.scene.keys.read_tab
 
 from __future__ import annotations
 
+import dataclasses
+
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -605,27 +607,35 @@ PIECE_SHAPES = {
 }
 
 
-@table(
-    "A piece of the body: a built-in solid shape placed on its own (with the others of "
-    "[[piece]] instead of [mesh]); its region, named after it, is a part with [[part]].",
+def _piece_fields() -> list[tuple]:
+    """The fields of a piece: its name, then [mesh]'s keys of the piece shapes, in their
+    order there (a key's bounds refer to keys before it), the shape and cell its own."""
+    own = {
+        "shape": key(Choice(tuple(PIECE_SHAPES)), None, required=True,
+                     doc="the built-in solid shape"),
+        "cell": key(Choice(("hexahedron", "tetrahedron")), "hexahedron",
+                    doc="the cell type, the same in every piece"),
+    }  # fmt: skip
+    used = {"shape", *_REFINE_KEYS, *(n for names in PIECE_SHAPES.values() for n in names)}
+    fields = [("name", str, key(
+        Identifier("a piece name"),
+        doc="its region's name (a part's volumes; a [[part]] of that name takes it), and the "
+        "prefix of its other regions and face groups (rod_front, rod_top, ...)",
+    ))]  # fmt: skip
+    for f in dataclasses.fields(MeshSpec):
+        if f.name in used or f.name == "cell":
+            made = own.get(f.name) or dataclasses.field(default=f.default, metadata=f.metadata)
+            fields.append((f.name, f.type, made))
+    return fields
+
+
+PieceSpec = table(
+    "A piece of the body: a built-in solid shape placed on its own (the pieces of [[piece]] "
+    "stand instead of [mesh]); its region, named after it, is a part with [[part]].",
     variants=Variants("shape", PIECE_SHAPES, common=("name", "cell", *_REFINE_KEYS),
                       noun="a {} piece"),  # fmt: skip
-)
-@dataclass(frozen=True, kw_only=True)
-class PieceSpec(MeshSpec):
-    shape: str | None = key(
-        Choice(tuple(PIECE_SHAPES)), None, required=True, doc="the built-in solid shape"
-    )
-    cell: str = key(
-        Choice(("hexahedron", "tetrahedron")),
-        "hexahedron",
-        doc="the cell type, the same in every piece",
-    )
-    name: str = key(
-        Identifier("a piece name"),
-        doc="its region's name (a part's volumes; default: the part of that name), and the "
-        "prefix of its other regions and face groups (rod_front, rod_top, ...)",
-    )
+)(dataclasses.make_dataclass("PieceSpec", _piece_fields(), frozen=True, kw_only=True))
+PieceSpec.__module__ = __name__
 
 
 for _check in (_hole_fits, _refinement_comes_whole, _regions_fit, _refinement_is_meshable,
