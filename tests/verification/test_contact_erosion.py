@@ -3,8 +3,10 @@
 
 A 1.5 x 1.5 x 3 mm steel projectile (elasto-plastic, no failure) strikes a free 6 x 6 x 2
 mm plate (elasto-plastic, failing at a plastic strain of 0.3) at 900 m/s; 0.5 mm cells (4
-layers through the plate: 576 + 54 hexahedra), one [[contact]] between the two. References
-independent of the code:
+layers through the plate: 576 + 54 hexahedra), one [[contact]] between the two. The
+projectile's nodes lie off the centres and diagonals of the plate's faces (0.1 and 0.2 mm
+from their edges), where two segments would tie for a node (an open question of the
+contact itself, docs/theory.md "MPI"). References independent of the code:
 
 - the surface of the plate after the run is the boundary of its live cells, built from
   scratch (the faces of eroded cells left it, the faces they bared joined it): the same
@@ -37,7 +39,7 @@ from rwall_fem.contact.surface import boundary_faces
 H = 5e-4  # m, the cells
 SPEED = 900.0  # m/s
 PLATE = (0.0, 0.0, 0.0), (6e-3, 6e-3, 2e-3)
-PROJECTILE = (2.25e-3, 2.25e-3, 2.1e-3), (1.5e-3, 1.5e-3, 3e-3)
+PROJECTILE = (2.1e-3, 2.2e-3, 2.1e-3), (1.5e-3, 1.5e-3, 3e-3)
 STEEL = {"model": "elastic_plastic", "density": 7850.0, "young": 200e9, "poisson": 0.3,
          "hardening": "linear", "hardening_modulus": 1e9}  # fmt: skip
 
