@@ -37,7 +37,8 @@ __all__ = ["pieces_mesh"]
 
 
 def _piece(gmsh, piece) -> dict:
-    """Mesh ``piece`` (a :class:`~rwall_fem.scene.PieceSpec`) in a session of its own: its nodes (tags, coordinates in place) and, per named physical
+    """Mesh ``piece`` (a :class:`~rwall_fem.scene.PieceSpec`) in a session of its own: its
+    nodes (tags, coordinates in place) and, per named physical
     group, its dimension and cells by gmsh type."""
     geo, params = shape_geometry(piece)
     refine = None
@@ -50,7 +51,8 @@ def _piece(gmsh, piece) -> dict:
         argv += ["-setnumber", name, repr(float(value))]
     gmsh.initialize(argv, readConfigFiles=False)
     try:
-        with importlib.resources.as_file(importlib.resources.files("rwall_fem.meshes") / geo) as path:
+        shipped = importlib.resources.files("rwall_fem.meshes") / geo
+        with importlib.resources.as_file(shipped) as path:
             _gmsh_model(Path(path))
         tags, x, _ = gmsh.model.mesh.getNodes()
         x = turned(np.asarray(x).reshape(-1, 3), piece.origin, piece.axis)
@@ -100,7 +102,8 @@ def _model(gmsh, meshed: list[tuple[str, dict]]) -> tuple[dict[str, int], dict[s
                 nodes = np.concatenate(nodes) + node_offset
                 per = gmsh.model.mesh.getElementProperties(kind)[3]
                 count = len(nodes) // per
-                gmsh.model.mesh.addElementsByType(entity, kind, np.arange(cell_tag, cell_tag + count), nodes)
+                tags = np.arange(cell_tag, cell_tag + count)
+                gmsh.model.mesh.addElementsByType(entity, kind, tags, nodes)
                 cell_tag += count
                 cells += count if dim == 3 else 0
             tag = gmsh.model.addPhysicalGroup(dim, [entity])

@@ -6,6 +6,8 @@ segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surf
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
 nodes against their own faces, each node kept off its own faces and their neighbours.
+In a body whose cells may erode, the surfaces of the parts that may erode follow the
+erosion (:mod:`~rwall_fem.contact.erosion`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ __all__ = ["build_contacts"]
 def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]:
     """The contact interfaces of ``scene`` on the body of ``solid`` (``build._Solid``),
     acting on ``state``, whose cells erode as those of ``internal`` (the
-    :class:`~rwall_fem.body.Body` of the step; default: the solid's); :class:`~rwall_fem.scene.SceneError` (one line, on every rank)
+    :class:`~rwall_fem.body.Body` of the step; default: the solid's);
+    :class:`~rwall_fem.scene.SceneError` (one line, on every rank)
     for a part the body does not have, a side without faces, or a gap not smaller than a
     part."""
     from rwall_fem.scene import SceneError

@@ -1573,7 +1573,8 @@ def _pieces_instead_of_mesh(v, raw, fail):
     names: dict[str, int] = {}
     for i, piece in enumerate(pieces):
         if piece.name in names:
-            fail(f"piece[{i}].name", f"{piece.name!r} is also the name of piece[{names[piece.name]}]")
+            fail(f"piece[{i}].name",
+                 f"{piece.name!r} is also the name of piece[{names[piece.name]}]")  # fmt: skip
         names[piece.name] = i
         if piece.cell != pieces[0].cell:
             fail(f"piece[{i}].cell", f"{piece.cell!r}, and piece[0] is {pieces[0].cell!r}: a "
