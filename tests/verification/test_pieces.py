@@ -56,8 +56,8 @@ def part_nodes(sim, name):
 
 def box(sim, name):
     x = sim.state.X[part_nodes(sim, name)]
-    low = sim.comm.allreduce(x.min(axis=0, initial=np.inf), op=MPI.MIN)
-    high = sim.comm.allreduce(x.max(axis=0, initial=-np.inf), op=MPI.MAX)
+    low = np.min(sim.comm.allgather(x.min(axis=0, initial=np.inf)), axis=0)
+    high = np.max(sim.comm.allgather(x.max(axis=0, initial=-np.inf)), axis=0)
     return low, high
 
 
