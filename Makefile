@@ -222,25 +222,30 @@ docs: venv-0.5
 	$(RUN_ENV) $(VENV)/bin/python -m sphinx -W --keep-going -E -q -b html docs $(DOCS_OUT)
 	@echo "    open $(DOCS_OUT)/index.html"
 
-# The full study (four element technologies) takes 15-30 minutes; its table and plots are
-# copied into docs/ for the README.
+# The full study (four element technologies) takes 15-30 minutes, and shells against solids
+# (the struck plate) 10 more; their tables and plots are copied into docs/ for the README.
 study: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/rwall-fem study --out results/study
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/rwall-fem study --shells --out results/study-shells
 	mkdir -p docs
-	cp results/study/study.md docs/study.md
+	cat results/study/study.md results/study-shells/shells.md > docs/study.md
 	cp results/study/study_*.png docs/
 
 # The kernels against the old BAIJ product, whole steps, 2-rank efficiency, the 80k-hexahedron
 # scene, material costs, memory, start-up, the Taylor rod (bench/results.md, ~45 minutes), then
-# the cost of each effect (bench/effects.md) and of failure and erosion (bench/erosion.md).
+# the cost of each effect (bench/effects.md) and of failure and erosion (bench/erosion.md), and
+# the shell kernels against the J2 hexahedron's, 1 and 2 ranks (bench/shell_kernels.md).
 # OLD_TREE: a worktree of the old code (commit c11ba60, with its .venv) whose time loop on the
 # 80k scene is run alternately with the new. PRE_EROSION_TREE: a checkout of the code before
 # failure and erosion, whose kernels bench/erosion.py times beside the new ones.
 # PRE_CORNER_TREE: a checkout before the corner test of one-point hexahedra (864d876), for
-# bench/corners.py (bench/corners.md).
+# bench/corners.py (bench/corners.md). OPENRADIOSS: the folder of OpenRadioss's
+# starter_linux64_gf and engine_linux64_gf for bench/openradioss_timing.py (the peer shell
+# decks in both codes, CPU times; one SKIPPED line without them).
 OLD_TREE ?=
 PRE_EROSION_TREE ?=
 PRE_CORNER_TREE ?=
+OPENRADIOSS ?=
 bench: venv-0.5
 	$(RUN_ENV) OMP_NUM_THREADS=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
 	    $(VENV)/bin/python bench/bench.py --out bench/results.md $(if $(OLD_TREE),--old-tree $(OLD_TREE))
@@ -249,6 +254,12 @@ bench: venv-0.5
 	    $(if $(PRE_EROSION_TREE),--main-tree $(PRE_EROSION_TREE))
 	$(if $(PRE_CORNER_TREE),$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/corners.py \
 	    --before-tree $(PRE_CORNER_TREE))
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/openradioss_timing.py \
+	    $(if $(OPENRADIOSS),--openradioss $(OPENRADIOSS))
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/shell_kernels.py \
+	    --out bench/shell_kernels.md
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(MPIRUN_0.5) -n 2 $(VENV)/bin/python bench/shell_kernels.py \
+	    --out bench/shell_kernels.md
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

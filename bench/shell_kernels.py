@@ -1,21 +1,33 @@
 """ns per element-step of the shell kernels against the one-point J2 hexahedron kernel.
 
-    python bench/shell_kernels.py [cells ...]
+    python bench/shell_kernels.py [--out bench/shell_kernels.md] [cells ...]
+    mpirun -n 2 python bench/shell_kernels.py [--out ...] [cells ...]
 
 Each kernel runs over a structured grid of the given number of cells (default 10,000 and
-100,000) with small random velocities, as in a step of a run, on one core; the best of
-several repeats (processor time: the machine may be shared) is reported. The J2 cases
-(power-law hardening) flow plastically at every
-point once the first steps have brought the stresses to the yield surface (a steady
-plastic flow, increments of about 4e-5 per step), hexahedra alike; "elastic" is the same
-law below its yield stress.
+100,000; on N ranks each rank runs its own grid of 1/N of them, all ranks at once, as a
+partitioned mesh would) with small random velocities, as in a step of a run. The J2 cases
+(power-law hardening) flow plastically at every point once the first steps have brought
+the stresses to the yield surface (a steady plastic flow, increments of about 4e-5 per
+step), hexahedra alike; "below yield" is the same law with its yield stress out of reach
+(the elastic checks only); "elastic" the linear elastic law (resultants, no points).
+
+Times are each rank's processor time (not wall time: the machine is shared), per element-
+step of that rank's cells; every figure is the median over rounds in which the kernels
+alternate, so that they see the same machine, and the ratio of the 5-point J2
+quadrilateral to the one-point J2 hexahedron is taken in each round (median given). The
+load average is printed before and after; with --out the table is written as Markdown
+(bench/shell_kernels.md, included in docs/performance.md), for 1 rank and, appended by a
+run on 2 ranks, for 2.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
+import os
+import statistics
 import time
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -31,15 +43,16 @@ J2 = dict(model="elastic_plastic", plastic=True, young=E, poisson=NU, density=RH
 
 
 WARM_UP = 80  # steps of the same increments: the stresses reach the yield surface and flow
+ROUNDS = 7  # of the alternating kernels
+CALLS = 3  # kernel calls per kernel and round
 
 
-def best(call, repeats=7):
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
+def timed(call):
+    """Processor time (s) of CALLS calls, per call."""
+    start = time.process_time()
+    for _ in range(CALLS):
         call()
-        times.append(time.process_time() - start)
-    return min(times)
+    return (time.process_time() - start) / CALLS
 
 
 def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=300e6,
@@ -68,9 +81,8 @@ def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=3
     call = k.bind(len(cells), X, u, v, w, f, m, energy, step)
     for _ in range(WARM_UP):
         call()
-    if plastic and yield_stress < 1e9:
-        print(f"  points flowing: {np.mean(k.plastic_strains() > 0):.0%}")
-    return len(cells), call
+    flowing = np.mean(k.plastic_strains() > 0) if plastic and yield_stress < 1e9 else None
+    return len(cells), call, flowing
 
 
 def hex_case(cells_wanted: int):
@@ -111,32 +123,96 @@ def hex_case(cells_wanted: int):
 
     for _ in range(WARM_UP):
         call()
-    print(f"  hexahedra flowing: {np.mean(state[6] > 0):.0%}")
+    call.keep = volume0, state  # the kernel reads them through pointers
+    return len(cells), call, np.mean(state[6] > 0)
 
-    return len(cells), call, volume0
+
+CASES = (
+    ("quadrilateral, elastic", lambda n: shell_case(n, False)),
+    ("quadrilateral, J2, 5 points", lambda n: shell_case(n, True)),
+    ("quadrilateral, J2, 3 points", lambda n: shell_case(n, True, 3)),
+    ("quadrilateral, J2, 5 points, below yield", lambda n: shell_case(n, True, 5, 1e12)),
+    ("triangle, elastic", lambda n: shell_case(n, False, cell="triangle")),
+    ("triangle, J2, 5 points", lambda n: shell_case(n, True, cell="triangle")),
+    ("hexahedron, one point, J2 (viscous)", hex_case),
+)
+QUAD_J2, HEX_J2 = 1, len(CASES) - 1
 
 
-def main(sizes):
-    print(f"{'kernel':34s} {'cells':>8s} {'ns/element-step':>16s}")
-    for size in sizes:
-        rows = []
-        cases = (
-            ("shell quad elastic", lambda: shell_case(size, False)),
-            ("shell quad J2, 5 points", lambda: shell_case(size, True)),
-            ("shell quad J2, 3 points", lambda: shell_case(size, True, 3)),
-            ("shell quad J2, 5 points, elastic", lambda: shell_case(size, True, 5, 1e12)),
-            ("shell triangle elastic", lambda: shell_case(size, False, cell="triangle")),
-            ("shell triangle J2, 5 points", lambda: shell_case(size, True, cell="triangle")),
-        )
-        for name, case in cases:
-            cells, call = case()
-            rows.append((name, cells, best(call) / cells * 1e9))
-        cells, call, _keep = hex_case(size)
-        rows.append(("hexahedron 1-point J2 (viscous)", cells, best(call) / cells * 1e9))
-        for name, cells, ns in rows:
-            print(f"{name:34s} {cells:8d} {ns:16.1f}")
-        print(f"  J2 5-point quad / J2 hexahedron: {rows[1][2] / rows[-1][2]:.2f}")
+def load_average() -> str:
+    return " ".join(f"{x:.1f}" for x in os.getloadavg())
+
+
+def measure(size: int, comm) -> tuple[list, list, list]:
+    """Per case: cells (all ranks), median ns per element-step over rounds (the largest of
+    the ranks' in each round), share of points flowing; and the ratio's median."""
+    ranks = comm.size
+    built = [case(size // ranks) for _, case in CASES]
+    per_round = [[] for _ in CASES]
+    ratios = []
+    for _ in range(ROUNDS):
+        row = []
+        for i, (cells, call, _flowing) in enumerate(built):
+            comm.Barrier()
+            ns = comm.allreduce(timed(call) / cells * 1e9, op=max_op())
+            per_round[i].append(ns)
+            row.append(ns)
+        ratios.append(row[QUAD_J2] / row[HEX_J2])
+    cells = [comm.allreduce(c) for c, _, _ in built]
+    flowing = [f for _, _, f in built]
+    return cells, [statistics.median(t) for t in per_round], flowing, statistics.median(ratios)
+
+
+def max_op():
+    from mpi4py import MPI
+
+    return MPI.MAX
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("cells", nargs="*", type=int, default=[10_000, 100_000])
+    parser.add_argument("--out", type=Path, help="write (1 rank) or append (N ranks) Markdown")
+    args = parser.parse_args()
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    before = load_average()
+    results = {size: measure(size, comm) for size in args.cells}
+    after = load_average()
+    if comm.rank:
+        return
+    sizes = list(args.cells)
+    lines = [f"### {comm.size} rank{'s' if comm.size > 1 else ''}", "",
+             f"Load average (1, 5, 15 min) before {before}, after {after}; medians of "
+             f"{ROUNDS} alternating rounds of {CALLS} calls, processor time"
+             + (", each rank its share of the cells at once" if comm.size > 1 else "") + ".",
+             "", "| kernel | " + " | ".join(f"ns/element-step, {n:,} cells" for n in sizes)
+             + " |", "|---|" + "---:|" * len(sizes)]  # fmt: skip
+    for i, (name, _) in enumerate(CASES):
+        cells = [f"{results[n][1][i]:.0f}" for n in sizes]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines.append("| **J2 5-point quadrilateral / J2 hexahedron** | "
+                 + " | ".join(f"**{results[n][3]:.2f}**" for n in sizes) + " |")  # fmt: skip
+    flowing = ", ".join(f"{results[n][2][QUAD_J2]:.0%} of the quadrilaterals' points and "
+                        f"{results[n][2][HEX_J2]:.0%} of the hexahedra flowing at {n:,}"
+                        for n in sizes)  # fmt: skip
+    lines += ["", f"({flowing}; cells: " + ", ".join(
+        f"{results[n][0][QUAD_J2]:,} quadrilaterals, {results[n][0][4]:,} triangles, "
+        f"{results[n][0][HEX_J2]:,} hexahedra" for n in sizes) + ".)", ""]  # fmt: skip
+    text = "\n".join(lines)
+    print(text)
+    if args.out:
+        if comm.size == 1:
+            title = ("## Shell kernels\n\n`python bench/shell_kernels.py --out "
+                     "bench/shell_kernels.md` then `mpirun -n 2 python bench/shell_kernels.py "
+                     "--out bench/shell_kernels.md`: ns per element-step of each kernel "
+                     "(the docstring says how).\n\n")  # fmt: skip
+            args.out.write_text(title + text)
+        else:
+            with args.out.open("a") as out:
+                out.write("\n" + text)
 
 
 if __name__ == "__main__":
-    main([int(a) for a in sys.argv[1:]] or [10_000, 100_000])
+    main()

@@ -415,6 +415,10 @@ def _pipeline(scene: Scene, solid: _Solid, limits: bool) -> Simulation:
     walls = [_wall(scene, i, solid, state, comm) for i in range(len(scene.walls))]
     boundaries = [_boundary(scene, i, solid) for i in range(len(scene.boundaries))]
     rigid = _rigid_bodies(scene, solid, state, walls, boundaries)
+    if rigid and solid.shells:
+        from rwall_fem.shells.rigid import carry_rotations
+
+        carry_rotations(rigid, internal, comm)
     inactive = deactivate_rigid_cells(internal, rigid, solid.V, comm) if rigid else 0
     update = None
     if solid.shells:
@@ -587,7 +591,7 @@ def _wall(scene: Scene, i: int, solid: _Solid, state: State, comm: MPI.Comm) -> 
         if spec.motion.prescribed:
             motion = PrescribedMotion(spec.motion.velocity)
         else:
-            motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity)
+            motion = MainNodeMotion(spec.motion.mass, spec.motion.velocity, spec.motion.held or "")
     _filter_fits(spec, where, state.dt)
     return RigidWall(
         shape,
@@ -639,6 +643,10 @@ def _named_nodes(scene: Scene, where: str, names, V, body: BodyMesh, owned: int)
 
 def _loads(scene: Scene, solid: _Solid) -> list:
     """The ``[[load]]`` forces and pressures, then the ``[damping]``, in that order."""
+    if solid.shells:
+        from rwall_fem.shells.loads import shell_loads
+
+        return shell_loads(scene, solid)
     V, body, owned, comm = solid.V, solid.body, solid.owned, solid.comm
     forces = []
     for i, spec in enumerate(scene.loads):

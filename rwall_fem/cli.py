@@ -5,7 +5,8 @@
 - ``rwall-fem check SCENE [--set ...]``: validate it and print what would run;
 - ``rwall-fem render DIR [--color ...] [--view ...]``: draw the frames of a results folder
   again, in another colouring or view;
-- ``rwall-fem study [--quick] [--out DIR]``: what accuracy costs in time (:mod:`rwall_fem.study`);
+- ``rwall-fem study [--quick] [--shells] [--out DIR]``: what accuracy costs in time
+  (:mod:`rwall_fem.study`);
 - ``rwall-fem convert NAME_0000.rad DIR [--force]``: a Radioss deck as a scene and its
   mesh (:mod:`rwall_fem.radioss`; a scene of that name in DIR is replaced only with
   ``--force``); ``run`` and ``check`` also take a deck as they take a scene.
@@ -103,6 +104,8 @@ def _command(argv: list[str] | None) -> int:
     study = commands.add_parser("study", help="accuracy against wall time, on exact references")
     study.add_argument("--quick", action="store_true", help="coarse levels only (< 2 minutes)")
     study.add_argument("--out", default="results/study", help="results directory")
+    study.add_argument("--shells", action="store_true",
+                       help="only shells against solids: the struck plate (shells.md)")  # fmt: skip
     args = parser.parse_args(argv)
     if args.command == "render":
         return _render(args.directory, args.color, args.view)
@@ -123,7 +126,7 @@ def _command(argv: list[str] | None) -> int:
     with np.errstate(all="ignore"):
         try:
             if args.command == "study":
-                code = _study(args.out, args.quick, comm)
+                code = _study(args.out, args.quick, comm, args.shells)
             elif args.command == "convert":
                 code = _convert(args.deck, args.directory, comm, args.force)
             elif args.command == "check":
@@ -291,15 +294,15 @@ def _convert(deck: str, directory: str, comm, force: bool) -> int:
     return 0
 
 
-def _study(out: str, quick: bool, comm) -> int:
-    """``rwall-fem study``: its folder checked first, as a run's is."""
+def _study(out: str, quick: bool, comm, shells: bool = False) -> int:
+    """``rwall-fem study [--shells]``: its folder checked first, as a run's is."""
     from pathlib import Path
 
     from rwall_fem.output.folder import check_folder
-    from rwall_fem.study import run_study
+    from rwall_fem.study import run_shell_study, run_study
 
     check_folder(Path(out), "--out", comm)
-    run_study(out, quick=quick, comm=comm)
+    (run_shell_study if shells else run_study)(out, quick=quick, comm=comm)
     return 0
 
 

@@ -94,6 +94,9 @@ class MassScaling:
         s.v[changed] = v * keep
         s.a[changed] *= keep
         s.set_mass(changed, after)
+        rotations = getattr(self.body, "scale_rotations", None)
+        if rotations is not None:  # shells: the rotational inertia grows with the mass
+            self.work += rotations(changed, after / before)
         self.body.part_masses[changed] += added[changed]
         self.added += self.comm.allreduce(extra_total)
         self.cells += self.comm.allreduce(fresh)

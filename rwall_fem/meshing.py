@@ -427,18 +427,30 @@ def gmsh_module():
 @contextlib.contextmanager
 def _sigint_kept():
     """Keep the SIGINT handler of the main thread, which gmsh sets to end the process at
-    once and silently when it is imported (4.8) or initialised (4.15), putting back on
-    finalize what it found then; yields a function that puts it back now."""
+    once and silently when it is imported (4.8: before it loads its library, which takes
+    seconds on a loaded machine) or initialised (4.15), putting back on finalize what it
+    found then. In this block gmsh's calls to set it change nothing (they are answered with
+    the handler in place), so that no Ctrl-C finds it unset; yields a function that puts
+    the handler back now, whatever else changed it."""
     main = threading.current_thread() is threading.main_thread()
     handler = signal.getsignal(signal.SIGINT) if main else None
+    real = signal.signal
+
+    def unchanged(number, action):
+        if number == signal.SIGINT:
+            return signal.getsignal(signal.SIGINT)
+        return real(number, action)
 
     def keep():
         if handler is not None:
-            signal.signal(signal.SIGINT, handler)
+            real(signal.SIGINT, handler)
 
+    if main:
+        signal.signal = unchanged
     try:
         yield keep
     finally:
+        signal.signal = real
         keep()
 
 

@@ -109,6 +109,7 @@ class RigidBody:
         self._half = 0.0  # dt^{n-1}/2 of the latest step, s
         self._predicted = None  # c^{n+1}, R^{n+1} and the arms of the latest prediction
         self.node_velocity = np.zeros((len(self.nodes), 3))  # v^{n+1/2} it gave them, m/s
+        self.rotations = None  # shell nodes' rotations (rwall_fem.shells.rigid), if any
 
     # --- the step -----------------------------------------------------------------------
 
@@ -140,6 +141,8 @@ class RigidBody:
         S = self._arms.T @ forces  # sum (x - c) f^T: the moment is its antisymmetric part
         local = np.array([*forces.sum(axis=0), S[1, 2] - S[2, 1], S[2, 0] - S[0, 2],
                           S[0, 1] - S[1, 0]])  # fmt: skip
+        if self.rotations is not None:  # the moments on shell nodes
+            local[3:] += self.rotations.torque()
         if self.gravity is not None:  # the body applies gravity to all its mass below
             local[:3] -= self.node_mass.sum() * self.gravity
             local[3:] -= np.cross(self.R @ self._first_moment, self.gravity)
@@ -170,6 +173,8 @@ class RigidBody:
         velocity = (center + arms - self.positions0 - state.u[nodes]) / dt
         self.node_velocity = velocity  # before the walls, m/s
         state.a[nodes] = (velocity - self.nodes_before) / dt_v
+        if self.rotations is not None:
+            self.rotations.follow(self.omega, dt_v)
 
     def commit(self) -> None:
         """Take the motion of the step: c^{n+1} and R^{n+1} (after the walls)."""
@@ -232,7 +237,7 @@ class RigidBody:
                                       self.angular_momentum, self.omega, V0, L0, w0]),
             "nodes_before": self.nodes_before,
             "gravity": np.concatenate([self._gravity_integral, [self._half]]),
-        }  # fmt: skip
+        } | ({} if self.rotations is None else self.rotations.checkpoint_state())  # fmt: skip
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         motion = arrays["motion"]
@@ -245,6 +250,8 @@ class RigidBody:
         self.nodes_before = arrays["nodes_before"].copy()
         self._gravity_integral = arrays["gravity"][:3].copy()
         self._half = float(arrays["gravity"][3])
+        if self.rotations is not None:
+            self.rotations.restore_state(arrays)
 
 
 def _tensor(six) -> np.ndarray:
@@ -338,8 +345,8 @@ def deactivate_rigid_cells(internal, bodies: list[RigidBody], V, comm) -> int:
     which = tag.array[:, 0]
     count = 0
     for force in internal.elements:
-        if force.erosion is not None:
-            continue
+        if force.erosion is not None or not hasattr(force, "deactivate"):
+            continue  # (shells: a rigid motion strains them nothing, computed or not)
         mine = which[force.cells]
         rigid = (mine[:, 0] > 0) & (mine == mine[:, :1]).all(axis=1)
         if rigid.any():

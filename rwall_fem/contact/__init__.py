@@ -6,8 +6,15 @@ segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surf
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
 nodes against their own faces, each node kept off its own faces and their neighbours.
-In a body whose cells may erode, the surfaces of the parts that may erode follow the
-erosion (:mod:`~rwall_fem.contact.erosion`).
+In a body whose cells may erode, the surfaces of the solid parts that may erode follow
+the erosion (:mod:`~rwall_fem.contact.erosion`).
+
+On a body of shells the segments are the shells, both sides active
+(:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
+variable, as Radioss's Igap 1: a node against a segment gets half the thickness of the
+thickest shell at the node plus half the segment's (half the sum of the thicknesses),
+floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side). A given
+``gap`` is constant (Radioss Igap 0).
 """
 
 from __future__ import annotations
@@ -16,7 +23,7 @@ import numpy as np
 
 from rwall_fem.contact.erosion import ErodingContact, ErodingSurface, may_erode
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, part_surface
+from rwall_fem.contact.surface import Surface, part_surface, shell_surface
 
 __all__ = ["build_contacts"]
 
@@ -33,6 +40,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     from rwall_fem.walls.constraint import filter_alpha
 
     body, comm = solid.elastic, solid.comm
+    faces = shell_surface if solid.shells else part_surface
     names = [part.name for part in solid.parts]
     owned = solid.V.dofmap.index_map.local_to_global(np.arange(solid.owned, dtype=np.int32))
     surfaces: dict[str, Surface] = {}
@@ -61,10 +69,10 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 k = names.index(name)
                 if name in surfaces or name in eroding:
                     continue
-                if may_erode(scene, body.parts[k]):
+                if not solid.shells and may_erode(scene, body.parts[k]):
                     eroding[name] = ErodingSurface(body, k, comm, (internal or body).elements[k])
                 else:
-                    surfaces[name] = part_surface(body, k, comm)
+                    surfaces[name] = faces(body, k, comm)
             total = _total(parts)
             if not len(total.segments):
                 raise SceneError(f"{where}.{key}: the parts {', '.join(parts)} have no "
@@ -81,10 +89,13 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
             sides = [(secondary, main, False)] + ([(main, secondary, False)] if spec.symmetric else [])
         parts = {name: None for pair in sides for name in pair[0] + pair[1]}
         here = [eroding[name] for name in parts if name in eroding]
-        nodes = np.unique(np.concatenate([_total(sides[0][0]).nodes, _total(sides[0][1]).nodes]
+        start = [(_total(a), _total(b), exclude) for a, b, exclude in sides]
+        nodes = np.unique(np.concatenate([s.nodes for pair in start for s in pair[:2]]
                                          + [s.nodes for s in here]))  # fmt: skip
-        edge = float(min(_total(pair[k]).edge.min() for pair in sides for k in (0, 1)))
-        gap = spec.gap if spec.gap is not None else 0.1 * edge
+        edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
+        half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
+        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]])
+        gap = spec.gap if spec.gap is not None else _gap_floor(start, edge)
 
         def passes(sides=sides, nodes=nodes, scale=spec.stiffness_scale) -> list[Pass]:
             """The passes of the interface from its sides' surfaces as they are."""
@@ -106,17 +117,45 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
             interface = ErodingContact(f"contact[{i}]", nodes, here, passes, **common)
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
-        interface._gather(state)
+        if spec.gap is None and half > 0.0:
+            interface.vary_gap(node_gap)
+        interface.start(state)
+        gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
                 ids = np.searchsorted(nodes, _total((name,)).nodes)
                 x = interface.x[ids]
-                smallest = float((x.max(axis=0) - x.min(axis=0)).min())
+                extent = np.sort(x.max(axis=0) - x.min(axis=0))
+                # A flat sheet has no extent across: its width then
+                smallest = float(extent[1] if solid.shells else extent[0])
+                across, default = (("narrowest", "half the sum of the thicknesses")
+                                   if solid.shells else
+                                   ("thinnest", "0.1 x the shortest edge"))  # fmt: skip
                 if gap >= smallest:
                     raise SceneError(
                         f"{where}.gap: {gap:g} m is not smaller than part {name!r} "
-                        f"({smallest:g} m across at its thinnest): the gap must be a small "
-                        "fraction of the parts (default 0.1 x the shortest edge)"
+                        f"({smallest:g} m across at its {across}): the gap must be a small "
+                        f"fraction of the parts (default {default})"
                     )
         interfaces.append(interface)
     return interfaces
+
+
+def _gap_floor(sides, edge: float) -> float:
+    """The default (constant, or the floor of a variable) gap (m): Radioss's Gapmin,
+    min(thinnest shell, half the shortest side) with shells, 0.1 x the shortest edge of
+    solids' faces."""
+    thickness = [2.0 * -s.depth[s.depth < 0.0] for pair in sides for s in pair[:2]]
+    thickness = np.concatenate(thickness)
+    return min(float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
+
+
+def _node_gaps(nodes: np.ndarray, surfaces: list[Surface]) -> np.ndarray:
+    """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
+    solid's)."""
+    out = np.zeros(len(nodes))
+    for s in surfaces:
+        half = np.repeat(np.maximum(-s.depth, 0.0), 4)
+        ids = s.segments.ravel()
+        np.maximum.at(out, np.searchsorted(nodes, ids[ids >= 0]), half[ids >= 0])
+    return out

@@ -148,6 +148,7 @@ class ErodingContact(ContactInterface):
             at = np.minimum(at, max(len(old.secondary) - 1, 0))
             kept = old.secondary[at] == new.secondary if len(old.secondary) else at < 0
             new.tangential[kept] = old.tangential[at[kept]]
+            new.gaps[kept] = old.gaps[at[kept]]
         self.passes = passes
         self.reach = max([self.gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
         self._params.reach = self.reach
@@ -164,13 +165,17 @@ class ErodingContact(ContactInterface):
         super().accelerate(s)
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The interface's, with each pass's friction forces over all its surface nodes
-        (zero off the secondary set), whose number erosion does not change."""
+        """The interface's, with each pass's friction forces and own gaps over all its
+        surface nodes (zero and inf off the secondary set), whose number erosion does not
+        change."""
         arrays = super().checkpoint_state()
         for k, ps in enumerate(self.passes):
             every = np.zeros((self.size, 3))
             every[ps.secondary] = ps.tangential
             arrays[f"tangential{k}"] = every
+            gaps = np.full(self.size, np.inf)
+            gaps[ps.secondary] = ps.gaps
+            arrays[f"gaps{k}"] = gaps
         return arrays | {"updates": np.array([self.updates])}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
@@ -181,6 +186,7 @@ class ErodingContact(ContactInterface):
         arrays = dict(arrays)
         for k, ps in enumerate(self.passes):
             arrays[f"tangential{k}"] = arrays[f"tangential{k}"][ps.secondary]
+            arrays[f"gaps{k}"] = arrays[f"gaps{k}"][ps.secondary]
         super().restore_state(arrays)
 
     def summary(self) -> dict:

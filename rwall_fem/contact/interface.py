@@ -78,6 +78,8 @@ class Pass:
         self.offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
+        self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
+        # inside the gap, growing back (kernels/contact.c); inf for the others
         self.out = np.zeros(11)
 
 
@@ -144,6 +146,40 @@ class ContactInterface:
         self._surface = [p(x) for x in (self.x, self.v, self.mass, self.force, self.stiffness,
                                         self._send, self._receive, self._owned_force)]  # fmt: skip
         self._passes = [self._pass_pointers(ps) for ps in passes]
+        self.gap_max = gap  # the largest pair gap (vary_gap)
+        self.starting_inside = (0, 0, 0.0)  # nodes within the gap at the start, of them
+        # behind the surface, and the deepest initial penetration (m)
+
+    def start(self, s) -> None:
+        """The gaps of the nodes that start inside the gap (Radioss TYPE7 Inacti = 6,
+        ``kernels/contact.c``): each such node's gap is 0.95 of its distance, and grows
+        back as it moves away; from the state ``s`` at the start."""
+        self._gather(s)
+        self._sort()
+        out = np.zeros(3)
+        inside, behind, deepest = 0, 0, 0.0
+        for ps in self.passes:
+            p = self._pointer
+            self.lib.contact_initial_gaps(
+                len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
+                p(ps.depth), self._surface[0], self._params, p(ps.gaps), p(out),
+            )  # fmt: skip
+            inside, behind = inside + int(out[0]), behind + int(out[1])
+            deepest = max(deepest, float(out[2]))
+        self.starting_inside = (inside, behind, deepest)
+
+    def vary_gap(self, half_thickness: np.ndarray) -> None:
+        """A variable gap (Radioss Igap 1): node s against a segment gets the larger of
+        :attr:`gap` (the floor) and ``half_thickness[s]`` plus the segment's half thickness
+        (a shell's: -depth; 0 for a solid's face); ``half_thickness`` (m) per surface node
+        (half its thickest shell)."""
+        self.half_thickness = np.ascontiguousarray(half_thickness, dtype=np.float64)
+        self._params.half_thickness = self._pointer(self.half_thickness)
+        shells = [-ps.depth.min(initial=0.0) for ps in self.passes]
+        self.gap_max = max(self.gap, float(self.half_thickness.max(initial=0.0)) + max(shells))
+        self.reach = max(self.reach, self.gap_max)
+        self._params.reach = self.reach
 
     def _pointer(self, array, kind="double[]"):
         return self.ffi.from_buffer(kind, array)
@@ -155,8 +191,8 @@ class ContactInterface:
         return (
             p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
             p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-            p(ps.depth), x, v, mass, self._params, p(ps.tangential), force, stiffness,
-            p(ps.out),
+            p(ps.depth), x, v, mass, self._params, p(ps.tangential), p(ps.gaps), force,
+            stiffness, p(ps.out),
         )  # fmt: skip
 
     def _gather(self, s) -> None:
@@ -268,11 +304,18 @@ class ContactInterface:
     def describe(self) -> str:
         """One line for ``run.log``: the surface, the gap, the stiffness and the friction."""
         k0 = np.concatenate([ps.stiffness for ps in self.passes])
+        inside, behind, deepest = self.starting_inside
+        start = (
+            f"; {inside} node(s) start inside the gap (the deepest {deepest:.3g} m in, "
+            f"{behind} behind the surface): their gap is 0.95 of their distance, growing back "
+            "as they leave, those behind inactive until they come out (Radioss Inacti = 6)"
+            if inside else ""
+        )  # fmt: skip
         return (
             f"{self.name}: {len(self.passes)} pass(es), {self.size} surface nodes, "
             f"{sum(len(ps.segments) for ps in self.passes)} segments; gap {self.gap:.4g} m, "
             f"k0 {k0.min(initial=np.inf):.4g} to {k0.max(initial=0.0):.4g} N/m, damping "
-            f"{self.damping:g}, friction {self.friction:g}"
+            f"{self.damping:g}, friction {self.friction:g}{start}"
         )
 
     def summary(self) -> dict:
@@ -296,6 +339,7 @@ class ContactInterface:
         (booked now: its velocity step is known after the update)."""
         self._book_pending(self.state.dt_velocity, self.state.v)
         arrays = {f"tangential{k}": ps.tangential for k, ps in enumerate(self.passes)}
+        arrays |= {f"gaps{k}": ps.gaps for k, ps in enumerate(self.passes)}
         books = [self.dissipated, *self.impulse, *self.latest, self.normal_force,
                  self.contacts, self.energy, self.work]  # fmt: skip
         return arrays | {"books": np.array(books)}
@@ -303,6 +347,7 @@ class ContactInterface:
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         for k, ps in enumerate(self.passes):
             ps.tangential[:] = arrays[f"tangential{k}"]
+            ps.gaps[:] = arrays[f"gaps{k}"]
         books = arrays["books"].tolist()
         self.dissipated = books[0]
         self.impulse[:] = books[1:4]

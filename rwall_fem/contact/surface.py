@@ -1,4 +1,5 @@
-"""The main surface of a contact interface: the boundary faces of solid parts as segments.
+"""The main surface of a contact interface: the boundary faces of solid parts, or the
+shells of shell parts, as segments.
 
 A face of a part's cells is on the part's boundary when no other cell of the part holds
 it (faces between two parts bonded by shared nodes belong to both parts' surfaces). Each
@@ -12,6 +13,12 @@ p0)`` for a triangle, points away from its cell) and carries, from that cell at 
   face a node is still pushed out (deeper, it is taken for a node of the other side);
 - its shortest edge (m): the default gap is 0.1 x the shortest of them (Radioss Gapmin).
 
+A shell is a segment with both sides active (:func:`shell_surface`): its depth is
+``-t / 2`` (negative: the kernel takes the distance to it unsigned; its magnitude is the
+segment's share of a variable gap), its stiffness Radioss's for a shell main segment,
+``k0 = stiffness_scale x E t`` (N/m: E Young's modulus of the shell's material, t its
+thickness), its shortest edge the shortest side.
+
 Every rank gets every segment of the interface, in global node numbers, sorted by their
 nodes: every rank of a run computes the contact alike (:mod:`rwall_fem.contact.interface`;
 the global numbers, hence the order, depend on the partition).
@@ -23,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface"]
+__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface", "shell_surface"]
 
 # The faces of DOLFINx's reference cells as cycles of their vertices.
 _FACES = {
@@ -129,3 +136,36 @@ def boundary_faces(ids: np.ndarray, key: np.ndarray, values: np.ndarray, comm) -
     _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
     keep = first[counts == 1]  # np.unique sorts by key: the same order on every rank
     return Surface(ids[keep], *values[keep].T.copy())
+
+
+def _once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:
+    """The segments ``ids`` (global numbers) with their stiffness, depth and edge
+    (``values``, rows of 3) of every rank, in the order of their sorted nodes."""
+    gathered = comm.allgather((ids, values))
+    ids = np.concatenate([g[0] for g in gathered]).reshape(-1, 4)
+    values = np.concatenate([g[1] for g in gathered]).reshape(-1, 3)
+    key = np.sort(ids, axis=1)
+    _, first = np.unique(key, axis=0, return_index=True)
+    return Surface(ids[first], *values[first].T.copy())
+
+
+def shell_surface(body, k: int, comm) -> Surface:
+    """The shells of part ``k`` of ``body`` (a :class:`~rwall_fem.shells.body.ShellBody`)
+    as two-sided segments, the same on every rank of ``comm`` (collective)."""
+    force = body.elements[k]
+    cells, X = force.cells, force.X
+    thickness = force.kernel.thickness
+    material = body.parts[k].material
+    local = np.full((len(cells), 4), -1, dtype=np.int64)
+    local[:, : cells.shape[1]] = cells  # quadrilaterals counter-clockwise (the kernels')
+    corners = X[np.where(local >= 0, local, local[:, :1])]
+    triangle = local[:, 3] < 0
+    sides = [np.linalg.norm(corners[:, (c + 1) % 4] - corners[:, c], axis=1) for c in range(4)]
+    closing = np.linalg.norm(corners[:, 0] - corners[:, 2], axis=1)  # a triangle's third side
+    edge = np.minimum.reduce([sides[0], sides[1], np.where(triangle, closing, sides[2]),
+                              np.where(triangle, np.inf, sides[3])])  # fmt: skip
+    to_global = body.V.dofmap.index_map.local_to_global
+    ids = np.where(local >= 0, to_global(np.where(local >= 0, local, 0).ravel().astype(np.int32))
+                   .reshape(-1, 4), -1)  # fmt: skip
+    values = np.column_stack([float(material.young) * thickness, -0.5 * thickness, edge])
+    return _once(ids, values, comm)

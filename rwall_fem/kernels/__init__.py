@@ -150,6 +150,7 @@ void largest_components(int64_t n, const int64_t *nodes, const double *v, const 
                         double out[2]);
 typedef struct {
   double gap, cap, friction, damping, alpha, dt, reach;
+  const double *half_thickness;
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
@@ -159,8 +160,12 @@ int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                     const int64_t *candidates, const int64_t *segs, const double *stiffness0,
                     const double *depth, const double *x, const double *v,
-                    const double *mass, const contact_params *prm, double *tangential, double *force,
-                    double *stiffness, double out[11]);
+                    const double *mass, const contact_params *prm, double *tangential,
+                    double *node_gap, double *force, double *stiffness, double out[11]);
+void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
+                          const int64_t *candidates, const int64_t *segs,
+                          const double *stiffness0, const double *depth, const double *x,
+                          const contact_params *prm, double *node_gap, double out[3]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
 void contact_pack(int64_t n, const int64_t *rows, const double *X, const double *u,
                   const double *v, const double *mass, double *packed);

@@ -9,15 +9,20 @@
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
  *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
  *   segment, whatever the grid.
+ * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
  * contact_forces: one pass of the secondary nodes against their candidates: the closest
- *   point of the closest segment (a quadrilateral as 4 triangles about its centre), the
- *   penalty force of the penetration p = gap - d (d the signed distance, < 0 behind the
- *   surface) stiffening toward p = gap (k0 g / (g - p), held beyond p = cap g), Coulomb
+ *   point on the surface (closest_on_surface: the segments within a band of the closest
+ *   distance blended, a quadrilateral as 4 triangles about its centre, the side from the
+ *   blended pseudo-normal), the penalty force of the penetration p = g - d (g the node's
+ *   gap, d the signed distance, < 0 behind the surface) stiffening toward p = g
+ *   (k0 g / (g - p), held beyond p = cap g), Coulomb
  *   friction on an elastic tangential spring of stiffness k0 (friction.h's law and filter),
  *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m): the
  *   tangent of the springs in contact, k0 for those within reach of a segment but not in
  *   contact (so that the step does not jump as nodes come and go).
  * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
+ * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
+ * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
  */
 #include <stdlib.h>
 
@@ -33,6 +38,8 @@ typedef struct
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+  const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
+                                  a constant gap (see pair_gap) */
 } contact_params;
 
 INLINE double cdot(const double x[3], const double y[3])
@@ -281,9 +288,10 @@ static void closest_on_triangle(const double p[3], const double a[3], const doub
 }
 
 /* The closest point q of segment `seg` to p, its weights on the segment's nodes (4), and
- * the segment's unit normal (outward). */
-static void closest_on_segment(const double p[3], const int64_t *seg, const double *x,
-                               double q[3], double weights[4], double normal[3])
+ * the segment's unit normal (outward); returns the distance of p to the segment (m: the
+ * closest triangle's, a continuous function of p, which the blend below does not move). */
+static double closest_on_segment(const double p[3], const int64_t *seg, const double *x,
+                                 double q[3], double weights[4], double normal[3])
 {
   const int corners = seg[3] >= 0 ? 4 : 3;
   const double *y[4];
@@ -306,6 +314,7 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
     normal[c] = length > 0.0 ? normal[c] / length : 0.0;
   for (int k = 0; k < 4; ++k)
     weights[k] = 0.0;
+  double nearest = 0.0;
   if (corners == 3)
   {
     closest_on_triangle(p, y[0], y[1], y[2], weights);
@@ -352,6 +361,7 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
     }
     for (int m = 0; m < 4; ++m)
       weights[m] /= total;
+    nearest = best;
   }
   for (int c = 0; c < 3; ++c)
   {
@@ -359,6 +369,28 @@ static void closest_on_segment(const double p[3], const int64_t *seg, const doub
     for (int k = 0; k < corners; ++k)
       q[c] += weights[k] * y[k][c];
   }
+  if (corners == 3)
+  {
+    double r[3];
+    csub(p, q, r);
+    return sqrt(cdot(r, r));
+  }
+  return nearest;
+}
+
+/* A segment of negative depth is a shell's mid-surface, both sides active: a node's
+ * distance to it is unsigned and it is pushed out on the side it is on. */
+INLINE int two_sided(double depth) { return depth < 0.0; }
+
+/* The gap (m) of node s against a segment of depth `depth`: the interface's, or with
+ * half_thickness (a variable gap, Radioss Igap 1) the larger of it (the floor, Gapmin) and
+ * the node's half thickness plus the segment's (-depth for a shell, 0 for a solid's face). */
+INLINE double pair_gap(const contact_params *prm, int64_t s, double depth)
+{
+  if (!prm->half_thickness)
+    return prm->gap;
+  const double pair = prm->half_thickness[s] + (two_sided(depth) ? -depth : 0.0);
+  return pair > prm->gap ? pair : prm->gap;
 }
 
 /* The normal force (N) of penetration p (m) for stiffness k0 (N/m) and gap g (m), its
@@ -381,10 +413,172 @@ static double penalty(double p, double k0, double g, double cap, double *tangent
   return -k0 * g * l + kc * beyond;
 }
 
+/* The closest point of a node on the surface: the segments within BAND of the closest
+ * distance blended, their weights merged over their nodes. */
+#define BAND 1e-7
+#define BLEND_NODES 64
+typedef struct
+{
+  int n;                        /* nodes in the blend */
+  int64_t node[BLEND_NODES];    /* surface nodes */
+  double weight[BLEND_NODES];   /* their shares of the point (sum 1) */
+  double d;                     /* signed distance, m (< 0 behind the surface) */
+  double normal[3];             /* unit, from the surface toward the node's side */
+  double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
+} surface_point;
+
+/* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
+ * 0 if none is within reach.  `distance` holds to - from values (scratch).
+ *
+ * The segments whose distance is within BAND of the closest one's share the point, in
+ * shares falling linearly from 1 to 0 over that band, as the triangles of a quadrilateral
+ * do (closest_on_segment): a node facing the common edge or corner of several segments
+ * is then a continuous function of its position, which round-off cannot decide (the
+ * forces do not depend on the order of the segments, hence on the partition).  The side
+ * of the surface the node is on is the sign of the blended r . n (r from each segment's
+ * closest point to the node, n its normal): at an edge or a corner, where the tied
+ * segments' closest points meet, that is r . (n_1 + n_2 + ...), the pseudo-normal test
+ * (Baerentzen and Aanaes 2005), so that a node beside a face, beyond the edge it shares
+ * with the face the node is in front of, is not taken as behind the first one's plane.
+ * The distance is the closest one's (continuous); the direction is from the blended point. */
+static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
+                              const int64_t *restrict candidates, const int64_t *restrict segs,
+                              const double *restrict stiffness0, const double *restrict depth,
+                              const double *restrict x, double reach, double *restrict distance,
+                              surface_point *pt)
+{
+  double best = INFINITY;
+  for (int64_t k = from; k < to; ++k)
+  {
+    double q[3], w[4], n[3];
+    const double dk = closest_on_segment(xs, segs + 4 * candidates[k], x, q, w, n);
+    distance[k - from] = dk;
+    best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
+  }
+  if (!(best < reach))
+    return 0;
+  const double band = BAND * best;
+  double total = 0.0, along = 0.0, q_sum[3] = {0.0, 0.0, 0.0}, n_sum[3] = {0.0, 0.0, 0.0};
+  pt->n = 0;
+  pt->k0 = pt->depth = 0.0;
+  for (int64_t k = from; k < to; ++k)
+  {
+    const double dk = distance[k - from];
+    const double share = band > 0.0 ? 1.0 - (dk - best) / band : (dk == best ? 1.0 : 0.0);
+    if (!(share > 0.0))
+      continue;
+    const int64_t j = candidates[k], *seg = segs + 4 * j;
+    double q[3], w[4], n[3], r[3];
+    closest_on_segment(xs, seg, x, q, w, n);
+    csub(xs, q, r);
+    along += share * cdot(r, n);
+    for (int c = 0; c < 3; ++c)
+    {
+      q_sum[c] += share * q[c];
+      n_sum[c] += share * n[c];
+    }
+    pt->k0 += share * stiffness0[j];
+    pt->depth += share * depth[j];
+    total += share;
+    for (int m = 0; m < 4; ++m)
+    {
+      if (seg[m] < 0 || w[m] == 0.0)
+        continue;
+      int at = 0;
+      while (at < pt->n && pt->node[at] != seg[m])
+        ++at;
+      if (at == pt->n)
+      {
+        if (pt->n == BLEND_NODES) /* not met on a surface mesh: the rest is left out */
+          continue;
+        pt->node[pt->n] = seg[m];
+        pt->weight[pt->n++] = 0.0;
+      }
+      pt->weight[at] += share * w[m];
+    }
+  }
+  double weights = 0.0;
+  for (int m = 0; m < pt->n; ++m)
+    weights += pt->weight[m];
+  for (int m = 0; m < pt->n; ++m)
+    pt->weight[m] /= weights;
+  pt->k0 /= total;
+  pt->depth /= total;
+  pt->d = along >= 0.0 || two_sided(pt->depth) ? best : -best;
+  double r[3];
+  for (int c = 0; c < 3; ++c)
+    r[c] = xs[c] - q_sum[c] / total;
+  const double length = sqrt(cdot(r, r));
+  const double side = pt->d >= 0.0 ? 1.0 : -1.0;
+  if (length > 1e-9 * reach)
+    for (int c = 0; c < 3; ++c)
+      pt->normal[c] = side * r[c] / length;
+  else /* on the surface: the segments' normal */
+  {
+    const double size = sqrt(cdot(n_sum, n_sum));
+    for (int c = 0; c < 3; ++c)
+      pt->normal[c] = size > 0.0 ? n_sum[c] / size : 0.0;
+  }
+  return 1;
+}
+
+/* Nodes that start inside the gap (Radioss TYPE7 Inacti = 6): a node at distance d0 < gap
+ * from the surface at the start gets its own gap 0.95 d0 (Radioss: gap0 = Gap - P0 - 5 %
+ * of (Gap - P0), P0 = Gap - d0 the initial penetration), so that it is not pushed out at
+ * once; the gap grows back with the node's distance (0.95 d, up to the interface's gap)
+ * as it moves away, and never shrinks.  A node that starts behind the surface (d0 <= 0)
+ * gets gap 0: inactive until it comes out in front. */
+#define INITIAL_GAP 0.95
+
+/* The node's gap (m) at its signed distance d (m), against the pair's gap `gap`: *node_gap
+ * (INFINITY for a node that did not start inside) grows with 0.95 d and is dropped
+ * (INFINITY) once it reaches `gap`; it never shrinks. */
+INLINE double grown_gap(double *node_gap, double d, double gap)
+{
+  if (*node_gap < gap)
+  {
+    const double grown = INITIAL_GAP * d;
+    *node_gap = grown >= gap ? INFINITY : (grown > *node_gap ? grown : *node_gap);
+  }
+  return *node_gap < gap ? *node_gap : gap;
+}
+
+/* The gaps of the nsec secondary nodes at the start (node_gap, m), as above. out: [0] the
+ * number of nodes that start inside the gap, [1] of them behind the surface, [2] the
+ * largest initial penetration gap - d0 (m). */
+void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
+                          const int64_t *restrict offsets, const int64_t *restrict candidates,
+                          const int64_t *restrict segs, const double *restrict stiffness0,
+                          const double *restrict depth, const double *restrict x,
+                          const contact_params *prm, double *restrict node_gap, double out[3])
+{
+  out[0] = out[1] = out[2] = 0.0;
+  int64_t most = 1;
+  for (int64_t i = 0; i < nsec; ++i)
+    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
+  double *distance = (double *)malloc(most * sizeof(double));
+  surface_point pt;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    node_gap[i] = INFINITY;
+    if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
+                            segs, stiffness0, depth, x, prm->reach, distance, &pt))
+      continue;
+    const double g = pair_gap(prm, secondary[i], pt.depth);
+    if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
+      continue;
+    node_gap[i] = pt.d > 0.0 ? INITIAL_GAP * pt.d : 0.0;
+    out[0] += 1.0;
+    out[1] += pt.d > 0.0 ? 0.0 : 1.0;
+    out[2] = g - pt.d > out[2] ? g - pt.d : out[2];
+  }
+  free(distance);
+}
+
 /* One pass: the nsec secondary nodes against their candidate segments.  `stiffness0` and
  * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
- * (N), updated.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
+ * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
  * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
  * tangential springs' energy (J), [9] what friction and damping dissipated over the step (J),
  * [10] the sum of the normal forces' sizes (N). */
@@ -394,67 +588,42 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const double *restrict depth, const double *restrict x,
                     const double *restrict v, const double *restrict mass,
                     const contact_params *prm,
-                    double *restrict tangential, double *restrict force,
-                    double *restrict stiffness, double out[11])
+                    double *restrict tangential, double *restrict node_gap,
+                    double *restrict force, double *restrict stiffness, double out[11])
 {
   for (int c = 0; c < 11; ++c)
     out[c] = 0.0;
-  const double g = prm->gap;
+  int64_t most = 1;
+  for (int64_t i = 0; i < nsec; ++i)
+    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
+  double *distance = (double *)malloc(most * sizeof(double));
+  surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
     const int64_t s = secondary[i];
     const double *xs = x + 3 * s;
-    int64_t best = -1;
-    double best_distance = INFINITY, best_cos = 0.0, best_weights[4] = {0.0}, best_n[3] = {0.0}, best_d = 0.0;
-    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
-    {
-      const int64_t j = candidates[k];
-      double q[3], w[4], n[3], r[3];
-      closest_on_segment(xs, segs + 4 * j, x, q, w, n);
-      csub(xs, q, r);
-      const double distance = sqrt(cdot(r, r));
-      const double along = cdot(r, n);
-      const double d = along >= 0.0 ? distance : -distance;
-      /* The closest segment decides, in contact or not: a node just beyond the gap in
-       * front of one face is not inside its neighbour at the edge. */
-      if (!(distance < prm->reach)) /* out of reach (and NaN) */
-        continue;
-      const double cosine = distance > 0.0 ? fabs(along) / distance : 1.0;
-      const double tie = 1e-9 * (distance + best_distance);
-      if (best >= 0 && (distance > best_distance + tie ||
-                        (distance >= best_distance - tie && cosine <= best_cos)))
-        continue;
-      best = j, best_distance = distance, best_cos = cosine, best_d = d;
-      for (int m = 0; m < 4; ++m)
-        best_weights[m] = w[m];
-      if (distance > 1e-12 * g)
-        for (int c = 0; c < 3; ++c)
-          best_n[c] = (d >= 0.0 ? r[c] : -r[c]) / distance;
-      else
-        for (int c = 0; c < 3; ++c)
-          best_n[c] = n[c];
-    }
     double *ft = tangential + 3 * i;
-    if (best >= 0 && !(best_d < g && -best_d < depth[best]))
+    if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
+                            depth, x, prm->reach, distance, &pt))
+    {
+      ft[0] = ft[1] = ft[2] = 0.0;
+      node_gap[i] = INFINITY;
+      continue;
+    }
+    const double g = grown_gap(node_gap + i, pt.d, pair_gap(prm, s, pt.depth));
+    const double k0 = pt.k0;
+    if (!(g > 0.0 && pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
     {
       /* Near but not in contact: its spring's stiffness counts in the step all the same,
        * so that the step does not jump as nodes come into and out of contact. */
-      const int64_t *seg = segs + 4 * best;
-      stiffness[s] += stiffness0[best];
-      for (int m = 0; m < 4; ++m)
-        if (seg[m] >= 0)
-          stiffness[seg[m]] += best_weights[m] * stiffness0[best];
-      best = -1;
-    }
-    if (best < 0)
-    {
+      stiffness[s] += k0;
+      for (int m = 0; m < pt.n; ++m)
+        stiffness[pt.node[m]] += pt.weight[m] * k0;
       ft[0] = ft[1] = ft[2] = 0.0;
       continue;
     }
-    const int64_t *seg = segs + 4 * best;
-    const double k0 = stiffness0[best];
     double kt, energy;
-    const double spring = penalty(g - best_d, k0, g, prm->cap, &kt, &energy);
+    const double spring = penalty(g - pt.d, k0, g, prm->cap, &kt, &energy);
     /* The velocity relative to the segment's point, and the normal damping of the pair
      * (masses m_s and sum w_i m_i): c = 2 damping sqrt(kt m_s m_main / (m_s + m_main)),
      * its force bounded by the spring's: the normal force starts at 0 as a node comes
@@ -463,14 +632,14 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     double main_mass = 0.0;
     for (int c = 0; c < 3; ++c)
       w[c] = v[3 * s + c];
-    for (int m = 0; m < 4; ++m)
-      if (seg[m] >= 0)
-      {
-        main_mass += best_weights[m] * mass[seg[m]];
-        for (int c = 0; c < 3; ++c)
-          w[c] -= best_weights[m] * v[3 * seg[m] + c];
-      }
-    const double wn = cdot(w, best_n);
+    for (int m = 0; m < pt.n; ++m)
+    {
+      main_mass += pt.weight[m] * mass[pt.node[m]];
+      for (int c = 0; c < 3; ++c)
+        w[c] -= pt.weight[m] * v[3 * pt.node[m] + c];
+    }
+    const double *normal = pt.normal;
+    const double wn = cdot(w, normal);
     const double reduced = mass[s] * main_mass / (mass[s] + main_mass);
     const double viscous = 2.0 * prm->damping * sqrt(kt * reduced);
     double damper = -viscous * wn;
@@ -479,16 +648,16 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     out[9] += (spring - fn) * wn * prm->dt; /* what the damping took over the step */
     double f[3];
     for (int c = 0; c < 3; ++c)
-      f[c] = fn * best_n[c];
+      f[c] = fn * normal[c];
     if (prm->friction > 0.0)
     {
       /* The tangential relative velocity, and the elastic trial force. */
       double old[3], trial[3];
-      const double on = cdot(ft, best_n);
+      const double on = cdot(ft, normal);
       for (int c = 0; c < 3; ++c)
       {
-        w[c] -= wn * best_n[c];
-        old[c] = ft[c] - on * best_n[c];
+        w[c] -= wn * normal[c];
+        old[c] = ft[c] - on * normal[c];
         trial[c] = old[c] - k0 * prm->dt * w[c];
       }
       coulomb_law(trial, prm->alpha < 1.0 ? old : NULL, prm->alpha, prm->friction * fn);
@@ -509,18 +678,17 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       out[c] += f[c];
     }
     stiffness[s] += kt;
-    for (int m = 0; m < 4; ++m)
+    for (int m = 0; m < pt.n; ++m)
     {
-      if (seg[m] < 0)
-        continue;
       for (int c = 0; c < 3; ++c)
-        force[3 * seg[m] + c] -= best_weights[m] * f[c];
-      stiffness[seg[m]] += best_weights[m] * kt;
+        force[3 * pt.node[m] + c] -= pt.weight[m] * f[c];
+      stiffness[pt.node[m]] += pt.weight[m] * kt;
     }
     out[6] += 1.0;
     out[7] += energy;
     out[10] += fn;
   }
+  free(distance);
 }
 
 double contact_step(int64_t n, const double *restrict mass, double *restrict stiffness)

@@ -12,9 +12,10 @@
  * k1 = E / (3 (1 - nu)), G = E / (2 (1 + nu)); its von Mises stress is
  *     q(g)^2 = p(g)^2 / 4 + 3 d(g)^2 / 4 + 3 sxy(g)^2
  * and the equivalent plastic strain grows by (2/3) g q(g).  g solves
- *     F(g) = q(g) - sigma_y(eps_p + (2/3) g q(g)) = 0,
- * F decreasing in g: Newton's method kept inside the bracket [0, (q_tr / sigma_y0 - 1) / k1]
- * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2).  The normal stress through
+ *     q(g) = sigma_y(eps_p + (2/3) g q(g)),
+ * by Newton's method on sigma_y / q - 1 kept inside the bracket [0, (q_tr / sigma_y0 - 1) / k1]
+ * (q(g) <= q_tr / (1 + k1 g) since k1 <= 2 G for nu <= 1/2; plane_stress_returns says how,
+ * for all the points of a cell at once).  The normal stress through
  * the thickness is zero at every step by construction, and the plastic flow of the 3-D J2
  * law with sigma_zz = 0 is reproduced exactly (the thickness strain follows from it).
  * The flow stress is capped at p->max_flow_stress (Radioss LAW2's SIG_max0; plasticity.h).
@@ -23,6 +24,10 @@
 #define RWALL_SHELL_H
 
 #include "failure.h"
+
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #define SHELL_MAX_POINTS 10
 #define SHELL_POINT_SLOTS 5 /* sxx, syy, sxy (Pa), eps_p, temperature (K) */
@@ -36,14 +41,29 @@ typedef struct
   double weight[SHELL_MAX_POINTS]; /* their weights, summing to 1 */
   double young, poisson;   /* E (Pa), nu */
   double shear_factor;     /* of the transverse shear, 5/6 */
-  double bar_speed;        /* sqrt(E / (rho (1 - nu^2))), m/s */
+  double bar_speed;        /* sqrt(E / rho), m/s (Radioss's shell sound speed) */
   double hm, hf, hr;       /* viscous hourglass coefficients: membrane, out-of-plane, rotation */
   double fail_fraction;    /* a cell fails when this share of its points has failed */
   int warping;             /* 1: project out the rigid motion (warped cells), 0: plain BT */
   int omit_energy;         /* 1: skip the stored-energy sum (0 by default) */
   double hk;               /* elastic hourglass stiffness coefficient (0: viscous only) */
   int hourglass_slot;      /* the state's first row of the 5 elastic hourglass forces */
+  double kd;               /* drilling stiffness coefficient (quadrilaterals; 0: none) */
+  int drill_slot;          /* the state's first row of the 4 nodal drilling moments */
+  double *new_thickness;   /* Radioss's Ithick = 1: the thicknesses to update (the array
+                              `thickness` points to); NULL: constant */
 } shell_params;
+
+/* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one
+ * instruction where the host has AVX (batch.h's loop over the lanes elsewhere). */
+INLINE int shell_any(ivec m)
+{
+#if defined(__AVX__) && LANES == 4
+  return _mm256_movemask_pd((__m256d)m) != 0;
+#else
+  return any_lane(m);
+#endif
+}
 
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
 INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
@@ -103,157 +123,258 @@ INLINE vec capped_flow_stress(const element_params *p, vec e, vec factor,
   return flow_stress(p, e, VZERO, VZERO, slope); /* capped; factor 1 */
 }
 
+/* Terms of the binomial series of (1 + x)^n used by near_flow_stress. */
+#define BINOMIAL_TERMS 13
+
+/* The binomial coefficients c[k] = n (n - 1) ... (n - k + 1) / k! of (1 + x)^n. */
+INLINE void binomial_coefficients(double n, double c[BINOMIAL_TERMS])
+{
+  c[0] = 1.0;
+  for (int k = 1; k < BINOMIAL_TERMS; ++k)
+    c[k] = c[k - 1] * (n - (k - 1)) * (1.0 / k);
+}
+
 /* The flow stress and slope of capped_flow_stress at e = e0 (1 + x), 0 <= x <= 1/20, of a
- * power law (Johnson-Cook) whose power e0^n = power0 is known: e^n = power0 (1 + x)^n with
- * log(1 + x) = 2 atanh(x / (2 + x)) and the exponential by their series (to about one ulp),
- * a third of the cost of exp(n log e) in the Newton iterations of a return. */
-INLINE vec near_flow_stress(const element_params *p, vec e0, vec power0,
-                            vec e, vec factor, vec *slope)
+ * power law (Johnson-Cook) whose power e0^n = power0 is known, inv_e0 = 1 / e0:
+ * e^n = power0 (1 + x)^n by the binomial series c (binomial_coefficients) to x^12 (the
+ * rest is below 1e-17 of the sum), no division and no exp/log in the Newton iterations
+ * of a return.  The slope takes 1 / (1 + x) to x^5 (6e-9 at the bound): it only steers
+ * Newton's steps, whose residual is that of the flow stress itself. */
+INLINE vec near_flow_stress(const element_params *p, const double c[BINOMIAL_TERMS],
+                            vec power0, vec inv_e0, vec x, vec factor, vec *slope)
 {
   const double B = p->hardening_coefficient, n = p->hardening_exponent;
-  const vec x = (e - e0) / e0, w = x / (2.0 + x), w2 = w * w;
-  /* log(1 + x) = 2 (w + w^3/3 + ... + w^13/13), w <= 1/41 */
-  vec series = VZERO + 1.0 / 13.0;
-  for (int k = 5; k >= 0; --k)
-    series = series * w2 + 1.0 / (2 * k + 1);
-  const vec t = (2.0 * n) * w * series; /* n log(1 + x) <= 0.049 */
-  vec ex = VZERO + 1.0 / 3628800.0;
-  double factorial = 3628800.0;
-  for (int k = 9; k >= 0; --k)
-  {
-    factorial /= (k + 1);
-    ex = ex * t + 1.0 / factorial;
-  }
-  const vec power = power0 * ex;
-  *slope = (B * n) * power / e;
+  vec series = VZERO + c[BINOMIAL_TERMS - 1];
+  for (int k = BINOMIAL_TERMS - 2; k >= 0; --k)
+    series = series * x + c[k];
+  const vec power = power0 * series;
+  const vec inverse = 1.0 - x * (1.0 - x * (1.0 - x * (1.0 - x * (1.0 - x))));
+  *slope = (B * n) * power * inv_e0 * inverse;
   return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
 }
 
-/* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise). */
+/* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise) and 1 / e in
+ * *inverse (1 where e <= 0). */
 INLINE vec flow_stress_power(const element_params *p, vec e, vec factor,
-                             vec *slope, vec *power_out)
+                             vec *slope, vec *power_out, vec *inverse)
 {
+  const ivec positive = e > 0.0;
+  *inverse = 1.0 / vselect(positive, e, VZERO + 1.0);
   *power_out = VZERO + 1.0;
   if (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
   {
     const double B = p->hardening_coefficient, n = p->hardening_exponent;
-    const ivec positive = e > 0.0;
     const vec safe = vselect(positive, e, VZERO + 1.0);
     const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
     *power_out = power;
-    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power / safe, VZERO + 1e300);
+    *slope = n == 0.0 ? VZERO : vselect(positive, (B * n) * power * *inverse, VZERO + 1e300);
     return cap_flow_stress(p, p->yield_stress + B * power, slope, factor);
   }
   return capped_flow_stress(p, e, factor, slope);
 }
 
-/* The exact plane-stress J2 return of the trial stress sig[3] (xx, yy, xy; Pa, in/out) at
- * plastic strain eps_p, strain rate `rate` (1/s) and temperature T (K): returns the plastic
- * strain increment (0 in elastic lanes); *flow = the flow stress after the step where it
- * flowed (the von Mises stress of the returned stress, equal to it to about 1e-14; not set to the
- * law's value in lanes that stay elastic). */
-INLINE vec plane_stress_return(const element_params *p, const shell_params *s, vec sig[3],
-                               vec eps_p, vec rate, vec T, vec *flow)
+/* The square of the von Mises stress of a plane stress (xx, yy, xy; Pa^2). */
+INLINE vec von_mises_squared(const vec sig[3])
 {
-  const vec factor = flow_factor(p, rate, T);
-  const double E = s->young, nu = s->poisson;
-  const double k1 = E / (3.0 * (1.0 - nu)), g2 = E / (1.0 + nu);
-  const vec pp = sig[0] + sig[1], dd = sig[1] - sig[0], xy = sig[2];
-  const vec P1 = 0.25 * pp * pp, P2 = 0.75 * dd * dd + 3.0 * xy * xy;
-  const vec q_trial = vsqrt(P1 + P2);
-  /* below A factor (and the cap) every lane is elastic for the laws whose flow stress never
-   * falls below it (linear and power hardening, Johnson-Cook): no evaluation of the law */
-  if (p->hardening != HARDENING_TABLE)
-  {
-    const double cap = p->max_flow_stress > 0.0 ? p->max_flow_stress : INFINITY;
-    const vec floor = fmin(p->yield_stress, cap) * factor;
-    if (!any_lane(q_trial > floor))
-    {
-      *flow = VZERO;
-      return VZERO;
-    }
-  }
-  vec slope, power0;
-  const vec y0 = flow_stress_power(p, eps_p, factor, &slope, &power0);
-  const int power_law = (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
-                        && p->hardening_exponent != 0.0;
-  const ivec plastic = q_trial > y0;
-  *flow = y0;
-  if (!any_lane(plastic))
-    return VZERO;
-  /* F(0) = q_tr - y0 > 0; first guess from the linearisation at g = 0 with the secant
-   * slope of the flow stress over the perfectly plastic increment (q_tr - y0) / 3G (the
-   * tangent of a power law is infinite at eps_p = 0) */
-  const vec safe_q = vselect(plastic, q_trial, VZERO + 1.0);
-  vec lo = VZERO, hi = (safe_q / vmax(y0, VZERO + 1e-300) - 1.0) * (1.0 / k1);
-  vec start = slope;
-  if (any_lane(plastic & (eps_p <= 0.0)))
-  {
-    const vec d0 = vmax((safe_q - y0) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
-    vec unused;
-    const vec secant = (capped_flow_stress(p, eps_p + d0, factor, &unused) - y0) / d0;
-    start = vselect(eps_p <= 0.0, secant, slope);
-  }
-  vec g = (safe_q - y0)
-          / ((P1 * k1 + P2 * g2) / safe_q + (2.0 / 3.0) * vmax(start, VZERO) * safe_q);
-  g = vselect(plastic, vmin(vmax(g, VZERO), hi), VZERO);
-  vec q = safe_q;
-  for (int iteration = 0; iteration < 50; ++iteration)
-  {
-    const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
-    q = vsqrt(P1 * a * a + P2 * b * b);
-    const vec dq = -(P1 * k1 * a * a * a + P2 * g2 * b * b * b) / q;
-    const vec e = eps_p + (2.0 / 3.0) * g * q;
-    vec h;
-    /* near eps_p (a step's increment, once flowing): the series about it */
-    const int near = power_law && !any_lane(plastic & ((eps_p <= 0.0) | (e > 1.05 * eps_p)));
-    const vec F = q - (near ? near_flow_stress(p, vmax(eps_p, VZERO + 1e-300), power0, e,
-                                               factor, &h)
-                            : capped_flow_stress(p, e, factor, &h));
-    lo = vselect(F > 0.0, g, lo);
-    hi = vselect(F < 0.0, g, hi);
-    const vec dF = dq - vmax(h, VZERO) * (2.0 / 3.0) * (q + g * dq);
-    vec next = g - F / dF;
-    next = vselect((next <= lo) | (next >= hi), 0.5 * (lo + hi), next);
-    const vec change = vabs(next - g);
-    g = vselect(plastic, next, VZERO);
-    /* converged: the residual at the previous g was below 1e-7 q, so that the Newton step
-     * just taken (quadratic convergence) leaves one of order 1e-14 q; or g moves by round-off */
-    if (!any_lane(plastic & (vabs(F) > 1e-7 * q) & (change > 1e-15 * g + 1e-300)))
-      break;
-  }
-  const vec a = 1.0 / (1.0 + k1 * g), b = 1.0 / (1.0 + g2 * g);
-  q = vsqrt(P1 * a * a + P2 * b * b);
-  const vec p_new = pp * a, d_new = dd * b;
-  sig[0] = 0.5 * (p_new - d_new);
-  sig[1] = 0.5 * (p_new + d_new);
-  sig[2] = xy * b;
-  const vec d = vselect(plastic, (2.0 / 3.0) * g * q, VZERO);
-  *flow = vselect(plastic, q, y0); /* on the yield surface after the return */
-  return d;
+  const vec pp = sig[0] + sig[1], dd = sig[1] - sig[0];
+  return 0.25 * pp * pp + 0.75 * dd * dd + 3.0 * sig[2] * sig[2];
 }
 
-/* One step at a through-thickness point: the stress sig[3] (in/out), eps_p and T (in/out)
- * from the strain increment de[3] (xx, yy, gamma_xy) over p->dt; what the step did in
- * *done (for the failure criteria).  Returns the plastic dissipation density (J/m^3). */
-INLINE vec shell_point_update(const element_params *p, const shell_params *s, vec sig[3],
-                              vec *eps_p, vec *T, const vec de[3], point_step *done)
+/* The exact plane-stress J2 return of the trial stresses sig[j][3] (xx, yy, xy; Pa, in/out)
+ * of n points at once (a cell batch's points through the thickness: their Newton iterations
+ * are independent chains the processor overlaps), at plastic strains eps_p[j], strain rates
+ * rate[j] (1/s) and temperatures T[j] (K); q_old2[j] is the squared von Mises stress before
+ * the step's increment.  Out: d[j] the plastic strain increment (0 in elastic lanes) and
+ * flow[j] the flow stress after the step where it flowed (the von Mises stress of the
+ * returned stress, equal to the law's value to about 1e-14; in elastic lanes the law's value
+ * where it was needed, else 0).
+ *
+ * Elastic checks before any evaluation of the law: below A times the rate and temperature
+ * factor (and the cap) for the laws whose flow stress never falls below it, and, for the
+ * laws of eps_p alone, a trial stress not above the stress before the step (which was
+ * admissible at the same eps_p).  Then g solves R(g) = sigma_y(e(g)) / q(g) - 1 = 0,
+ * e(g) = eps_p + (2/3) g q(g): 1 / q(g) is linear in g for a deviatoric plane stress
+ * (q = q_tr / (1 + 2 G g)), so that Newton's method on R converges in about two steps from
+ * the start of its linearisation at g = 0, g0 = (q_tr - y0) / (c y0 + (2/3) h q_tr),
+ * c = (k1 P1 + 2 G P2) / q_tr^2 (P1 = p^2 / 4, P2 = 3 d^2 / 4 + 3 sxy^2), h the slope of the
+ * law at eps_p (the secant over the perfectly plastic increment at eps_p = 0, where a power
+ * law's is infinite); kept in the bracket [0, (q_tr / y0 - 1) / k1], whose midpoint is
+ * geometric while it spans decades.  It stops once |R| at the previous iterate is below 1e-7
+ * (the step just taken leaves one of order 1e-14; 1e-13 from eps_p = 0, where the power
+ * law's infinite slope makes the residual no guide to the next one's) or g moves by
+ * round-off.  The power laws' flow stress in the iterations is near_flow_stress's series
+ * about eps_p while the increment is below eps_p / 20, else exp and log. */
+INLINE void plane_stress_returns(const element_params *p, const shell_params *s, int n,
+                                 vec sig[][3], const vec eps_p[], const vec rate[],
+                                 const vec T[], const vec q_old2[], vec d[], vec flow[])
 {
-  hooke_add(s, VZERO + 1.0, de, sig);
-  /* equivalent deviatoric strain rate with the incompressible thickness strain */
-  const vec dz = -(de[0] + de[1]);
-  const vec dd = de[0] * de[0] + de[1] * de[1] + dz * dz + 0.5 * de[2] * de[2];
-  const vec rate = p->dt > 0.0 ? vsqrt((2.0 / 3.0) * dd) * (1.0 / p->dt) : VZERO;
-  vec flow;
-  const vec d = plane_stress_return(p, s, sig, *eps_p, rate, *T, &flow);
-  *eps_p += d;
-  const vec dissipation = flow * d;
-  done->increment = d;
-  done->rate = rate;
-  done->triaxiality = vselect(d > 0.0, ((1.0 / 3.0) * (sig[0] + sig[1])) / flow, VZERO);
-  if (p->thermal)
-    *T += (p->taylor_quinney / (p->density * p->specific_heat)) * dissipation;
-  return dissipation;
+  const double E = s->young, nu = s->poisson;
+  const double k1 = E / (3.0 * (1.0 - nu)), g2 = E / (1.0 + nu);
+  const int power_law = (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
+                        && p->hardening_exponent != 0.0;
+  const int of_eps_p = p->hardening != JOHNSON_COOK
+                       || (p->rate_coefficient == 0.0 && !p->thermal);
+  const double cap = p->max_flow_stress > 0.0 ? p->max_flow_stress : INFINITY;
+  const double lowest = p->yield_stress < cap ? p->yield_stress : cap;
+  /* the points that flow in some lane, and what their iterations need */
+  int m = 0, which[SHELL_MAX_POINTS], near[SHELL_MAX_POINTS];
+  vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
+  vec y0[SHELL_MAX_POINTS], power0[SHELL_MAX_POINTS], inv_e0[SHELL_MAX_POINTS];
+  vec factor[SHELL_MAX_POINTS], g[SHELL_MAX_POINTS], lo[SHELL_MAX_POINTS], hi[SHELL_MAX_POINTS];
+  vec tolerance[SHELL_MAX_POINTS];
+  ivec plastic[SHELL_MAX_POINTS];
+  for (int j = 0; j < n; ++j)
+  {
+    d[j] = flow[j] = VZERO;
+    const vec q2 = von_mises_squared(sig[j]);
+    const vec f = flow_factor(p, rate[j], T[j]);
+    ivec maybe = q2 == q2; /* every lane */
+    if (p->hardening != HARDENING_TABLE)
+    {
+      const vec floor = lowest * f;
+      maybe &= q2 > floor * floor;
+    }
+    if (of_eps_p)
+      maybe &= q2 > q_old2[j];
+    if (!shell_any(maybe))
+      continue;
+    const vec q_trial = vsqrt(q2);
+    vec slope, power, inverse;
+    const vec y = flow_stress_power(p, eps_p[j], f, &slope, &power, &inverse);
+    flow[j] = y;
+    const ivec flowing = maybe & (q_trial > y);
+    if (!shell_any(flowing))
+      continue;
+    const int a = m++;
+    which[a] = j;
+    plastic[a] = flowing;
+    factor[a] = f;
+    y0[a] = y;
+    power0[a] = power;
+    pp[a] = sig[j][0] + sig[j][1];
+    dd[a] = sig[j][1] - sig[j][0];
+    P1[a] = 0.25 * pp[a] * pp[a];
+    P2[a] = 0.75 * dd[a] * dd[a] + 3.0 * sig[j][2] * sig[j][2];
+    const ivec virgin = flowing & (eps_p[j] <= 0.0);
+    /* from eps_p = 0 a power law's slope is infinite and the residual no guide to the next
+     * step's: iterate until it is itself at round-off */
+    tolerance[a] = vselect(virgin, VZERO + 1e-13, VZERO + 1e-7);
+    near[a] = power_law && !shell_any(virgin);
+    inv_e0[a] = inverse;
+    const vec safe_q = vselect(flowing, q_trial, VZERO + 1.0);
+    lo[a] = VZERO;
+    hi[a] = (safe_q / vmax(y, VZERO + 1e-300) - 1.0) * (1.0 / k1);
+    vec start = slope;
+    if (shell_any(virgin))
+    {
+      const vec d0 = vmax((safe_q - y) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
+      vec unused;
+      const vec secant = (capped_flow_stress(p, eps_p[j] + d0, f, &unused) - y) / d0;
+      start = vselect(eps_p[j] <= 0.0, secant, slope);
+    }
+    const vec g0 = (safe_q - y) * (safe_q * safe_q)
+                   / ((P1[a] * k1 + P2[a] * g2) * y
+                      + (2.0 / 3.0) * vmax(start, VZERO) * (safe_q * safe_q * safe_q));
+    g[a] = vselect(flowing, vmin(vmax(g0, VZERO), hi[a]), VZERO);
+  }
+  if (m == 0)
+    return;
+  double binomial[BINOMIAL_TERMS];
+  binomial_coefficients(p->hardening_exponent, binomial);
+  for (int iteration = 0; iteration < 50; ++iteration)
+  {
+    int more = 0;
+    for (int a = 0; a < m; ++a)
+    {
+      /* q = sqrt(W) / (A1 B1), W = P1 B1^2 + P2 A1^2: one division */
+      const vec A1 = 1.0 + k1 * g[a], B1 = 1.0 + g2 * g[a], AB = A1 * B1;
+      const vec root = vsqrt(P1[a] * B1 * B1 + P2[a] * A1 * A1);
+      const vec inv = 1.0 / (root * AB);
+      const vec r = root * inv, ra = B1 * r, rb = A1 * r; /* 1 / A1, 1 / B1 */
+      const vec rq = AB * AB * inv, q = root * r;
+      const vec dq = -(P1[a] * k1 * ra * ra * ra + P2[a] * g2 * rb * rb * rb) * rq;
+      const vec increment = (2.0 / 3.0) * g[a] * q;
+      const int j = which[a];
+      vec y, h;
+      if (near[a] && !shell_any(plastic[a] & (increment > 0.05 * eps_p[j])))
+        y = near_flow_stress(p, binomial, power0[a], inv_e0[a], increment * inv_e0[a],
+                             factor[a], &h);
+      else
+        y = capped_flow_stress(p, eps_p[j] + increment, factor[a], &h);
+      const vec R = y * rq - 1.0;
+      lo[a] = vselect(R < 0.0, g[a], lo[a]);
+      hi[a] = vselect(R > 0.0, g[a], hi[a]);
+      const vec dR = rq * (vmax(h, VZERO) * (2.0 / 3.0) * (q + g[a] * dq) - y * rq * dq);
+      vec next = g[a] - R / dR;
+      /* outside the bracket: its midpoint, geometric while it spans decades (the root of
+       * a power law's infinite slope at eps_p = 0 may be many decades below the start) */
+      const ivec outside = (next <= lo[a]) | (next >= hi[a]);
+      if (shell_any(outside))
+      {
+        const vec middle = vselect(lo[a] < 1e-3 * hi[a],
+                                   vsqrt(vmax(lo[a], 1e-30 * hi[a]) * hi[a]),
+                                   0.5 * (lo[a] + hi[a]));
+        next = vselect(outside, middle, next);
+      }
+      const vec change = vabs(next - g[a]);
+      g[a] = vselect(plastic[a], next, VZERO);
+      more |= shell_any(plastic[a] & (vabs(R) > tolerance[a])
+                        & (change > 1e-15 * g[a] + 1e-300));
+    }
+    if (!more)
+      break;
+  }
+  for (int a = 0; a < m; ++a)
+  {
+    const int j = which[a];
+    const vec A1 = 1.0 + k1 * g[a], B1 = 1.0 + g2 * g[a];
+    const vec r = 1.0 / (A1 * B1), ra = B1 * r, rb = A1 * r;
+    const vec q = vsqrt(P1[a] * ra * ra + P2[a] * rb * rb);
+    const vec p_new = pp[a] * ra, d_new = dd[a] * rb;
+    const ivec on = plastic[a];
+    sig[j][0] = vselect(on, 0.5 * (p_new - d_new), sig[j][0]);
+    sig[j][1] = vselect(on, 0.5 * (p_new + d_new), sig[j][1]);
+    sig[j][2] = vselect(on, sig[j][2] * rb, sig[j][2]);
+    d[j] = vselect(on, (2.0 / 3.0) * g[a] * q, VZERO);
+    flow[j] = vselect(on, q, y0[a]); /* on the yield surface after the return */
+  }
+}
+
+/* One step at n through-thickness points: the stresses sig[j][3] (in/out), eps_p[j] and
+ * T[j] (in/out) from the strain increments de[j][3] (xx, yy, gamma_xy) over p->dt; what the
+ * step did in done[j] (for the failure criteria) and the plastic dissipation density
+ * (J/m^3) in dissipation[j]. */
+INLINE void shell_points_update(const element_params *p, const shell_params *s, int n,
+                                vec sig[][3], vec eps_p[], vec T[], const vec de[][3],
+                                point_step done[], vec dissipation[])
+{
+  vec rate[SHELL_MAX_POINTS], q_old2[SHELL_MAX_POINTS], d[SHELL_MAX_POINTS];
+  vec flow[SHELL_MAX_POINTS];
+  /* the strain rate: of Johnson-Cook's flow stress and of the failure criteria */
+  const int uses_rate = p->hardening == JOHNSON_COOK || p->failure;
+  for (int j = 0; j < n; ++j)
+  {
+    q_old2[j] = von_mises_squared(sig[j]);
+    hooke_add(s, VZERO + 1.0, de[j], sig[j]);
+    /* equivalent deviatoric strain rate with the incompressible thickness strain */
+    const vec dz = -(de[j][0] + de[j][1]);
+    const vec dd = de[j][0] * de[j][0] + de[j][1] * de[j][1] + dz * dz
+                   + 0.5 * de[j][2] * de[j][2];
+    rate[j] = p->dt > 0.0 && uses_rate ? vsqrt((2.0 / 3.0) * dd) * (1.0 / p->dt) : VZERO;
+  }
+  plane_stress_returns(p, s, n, sig, eps_p, rate, T, q_old2, d, flow);
+  for (int j = 0; j < n; ++j)
+  {
+    eps_p[j] += d[j];
+    dissipation[j] = flow[j] * d[j];
+    done[j].increment = d[j];
+    done[j].rate = rate[j];
+    done[j].triaxiality = vselect(d[j] > 0.0, ((1.0 / 3.0) * (sig[j][0] + sig[j][1]))
+                                                  / vselect(d[j] > 0.0, flow[j], VZERO + 1.0),
+                                  VZERO);
+    if (p->thermal)
+      T[j] += (p->taylor_quinney / (p->density * p->specific_heat)) * dissipation[j];
+  }
 }
 
 /* The update of a batch's stress resultants over a step: from the membrane strain rates d,
@@ -311,48 +432,54 @@ INLINE void shell_update(int plastic, const element_params *p, const shell_param
     store_slot(state, stride, &b, 0, Q[0]);
     store_slot(state, stride, &b, 1, Q[1]);
     vec failed_points = VZERO;
+    vec sig[SHELL_MAX_POINTS][3], eps_p[SHELL_MAX_POINTS], T[SHELL_MAX_POINTS];
+    vec de[SHELL_MAX_POINTS][3], dissipation[SHELL_MAX_POINTS];
+    point_step done[SHELL_MAX_POINTS];
+    for (int pt = 0; pt < npt; ++pt)
+    {
+      const int base = 2 + SHELL_POINT_SLOTS * pt;
+      const vec z = s->zeta[pt] * t;
+      for (int i = 0; i < 3; ++i)
+      {
+        sig[pt][i] = load_slot(state, stride, &b, base + i);
+        de[pt][i] = d[i] + z * k[i];
+      }
+      eps_p[pt] = load_slot(state, stride, &b, base + 3);
+      /* the temperature changes, and matters, only with heating */
+      T[pt] = p->thermal ? load_slot(state, stride, &b, base + 4) : VZERO;
+    }
+    shell_points_update(p, s, npt, sig, eps_p, T, de, done, dissipation);
     for (int pt = 0; pt < npt; ++pt)
     {
       const int base = 2 + SHELL_POINT_SLOTS * pt;
       const vec z = s->zeta[pt] * t, wt = s->weight[pt] * t;
-      vec sig[3], eps_p, T, de[3];
-      for (int i = 0; i < 3; ++i)
-      {
-        sig[i] = load_slot(state, stride, &b, base + i);
-        de[i] = d[i] + z * k[i];
-      }
-      eps_p = load_slot(state, stride, &b, base + 3);
-      T = load_slot(state, stride, &b, base + 4);
-      vec D = VZERO;
-      if (p->failure)
-        D = load_slot(state, stride, &b, p->damage_slot + pt);
-      const ivec dead = D >= 1.0;
-      point_step done;
-      vec dissipation = shell_point_update(p, s, sig, &eps_p, &T, de, &done);
       if (p->failure)
       {
-        done.increment = vselect(dead, VZERO, done.increment);
+        const vec D = load_slot(state, stride, &b, p->damage_slot + pt);
+        const ivec dead = D >= 1.0;
+        done[pt].increment = vselect(dead, VZERO, done[pt].increment);
         const vec D_new = vmax(D, accumulate_damage(p, state, stride, &b,
-                                                    p->damage_slot + pt, &done, T));
+                                                    p->damage_slot + pt, &done[pt], T[pt]));
         const ivec gone = D_new >= 1.0;
         /* a point failing now gives up its elastic energy as dissipation */
-        const vec held = 0.5 * compliance_product(s, sig[0], sig[1], sig[2]);
-        dissipation = vselect(dead, VZERO, dissipation + vselect(gone, held, VZERO));
+        const vec held = 0.5 * compliance_product(s, sig[pt][0], sig[pt][1], sig[pt][2]);
+        dissipation[pt] = vselect(dead, VZERO, dissipation[pt] + vselect(gone, held, VZERO));
         for (int i = 0; i < 3; ++i)
-          sig[i] = vselect(gone, VZERO, sig[i]);
+          sig[pt][i] = vselect(gone, VZERO, sig[pt][i]);
         failed_points += vselect(gone, VZERO + 1.0, VZERO);
       }
       for (int i = 0; i < 3; ++i)
       {
-        store_slot(state, stride, &b, base + i, sig[i]);
-        N[i] += wt * sig[i];
-        M[i] += (wt * z) * sig[i];
+        store_slot(state, stride, &b, base + i, sig[pt][i]);
+        N[i] += wt * sig[pt][i];
+        M[i] += (wt * z) * sig[pt][i];
       }
-      store_slot(state, stride, &b, base + 3, eps_p);
-      store_slot(state, stride, &b, base + 4, T);
+      store_slot(state, stride, &b, base + 3, eps_p[pt]);
+      if (p->thermal)
+        store_slot(state, stride, &b, base + 4, T[pt]);
       if (!s->omit_energy)
-        elastic += (0.5 * wt) * compliance_product(s, sig[0], sig[1], sig[2]);
-      dissipated += wt * dissipation;
+        elastic += (0.5 * wt) * compliance_product(s, sig[pt][0], sig[pt][1], sig[pt][2]);
+      dissipated += wt * dissipation[pt];
     }
     if (p->failure)
       damage = vselect(failed_points >= s->fail_fraction * npt - 1e-9, VZERO + 1.0, VZERO);
@@ -362,6 +489,34 @@ INLINE void shell_update(int plastic, const element_params *p, const shell_param
   *elastic_out = elastic;
   *dissipated_out = dissipated;
   *damage_out = damage;
+}
+
+/* The mean over the thickness of sxx + syy (Pa) of a batch's cells of thickness t, from the
+ * state before shell_update: sum w_k (sxx + syy)_k, or (Nxx + Nyy) / t of elastic cells. */
+INLINE vec shell_mean_stress(int plastic, const shell_params *s, const batch_t *b,
+                             const double *restrict state, int64_t stride, vec t)
+{
+  if (!plastic)
+    return (load_slot(state, stride, b, 0) + load_slot(state, stride, b, 1)) / t;
+  vec sum = VZERO;
+  for (int pt = 0; pt < s->points; ++pt)
+  {
+    const int base = 2 + SHELL_POINT_SLOTS * pt;
+    sum += s->weight[pt] * (load_slot(state, stride, b, base) + load_slot(state, stride, b, base + 1));
+  }
+  return sum;
+}
+
+/* Ithick = 1: store the thickness of a batch's cells after the membrane strain increment d
+ * (xx, yy, gamma_xy) over which their mean sxx + syy went from `before` to `after` (Pa):
+ * ln(t'/t) = -(dxx + dyy) + (1 - 2 nu) / E (after - before), the plastic strain keeping the
+ * volume and the elastic one changing it by (1 - 2 nu) / E times the sum of the stresses
+ * (szz = 0), so that an elastic cell thins by nu / (1 - nu) (dxx + dyy). */
+INLINE void shell_thickness_change(const shell_params *s, const batch_t *b, vec t, const vec d[3],
+                                   vec before, vec after)
+{
+  const double bulk = (1.0 - 2.0 * s->poisson) / s->young;
+  set_cell_values(s->new_thickness, b, t * vexp(bulk * (after - before) - (d[0] + d[1])));
 }
 
 #endif

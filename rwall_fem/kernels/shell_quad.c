@@ -16,7 +16,8 @@
  * and the strain at height z is d + z k.  Stress resultants N (membrane), M (moments) and
  * Q (transverse shear, shear factor 5/6, elastic) act back through the transposed relations
  * (the power A (N.d + M.k + Q.g) equals f.v + m.theta).  The element has no drilling
- * stiffness: its moment about e3 is zero.
+ * stiffness (its moment about e3 is zero) unless s->kd > 0: drilling springs, see
+ * quad_drill_update.
  *
  * Warping (s->warping, Belytschko-Wong-Chiang's correction by the rigid-body projection of
  * Belytschko and Leviathan): a rigid rotation (Ox, Oy) about the in-plane axes gives the
@@ -59,7 +60,9 @@
  * criterion the damage of point k at row p->damage_slot + k.  A point whose damage reaches 1
  * carries no stress from then on (its elastic energy is booked as dissipated), and a cell
  * fails when the share s->fail_fraction of its points has failed; erosion as failure.h
- * (the nodal moments and rotations count in the energy the cell leaves with).
+ * (the nodal moments and rotations count in the energy the cell leaves with).  With
+ * s->new_thickness (Radioss's Ithick = 1) the cell's thickness follows its membrane strain
+ * increment after the update (shell.h, shell_thickness_change).
  *
  * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
  * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable
@@ -323,6 +326,48 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   return work;
 }
 
+/* Drilling (s->kd > 0): the nodes' rotation rates about e3 less the cell's in-plane spin at
+ * the centre, spin = (b1.vy - b2.vx) / 2 of the local velocities vl (not projected: a rigid
+ * motion has exactly spin = its rotation rate about e3), are resisted by elastic springs,
+ * incremental in the state rows s->drill_slot + I: mz_I += kd G t A dt (wz_I - spin).
+ * Writes mz (N m) and returns their stored energy sum mz_I^2 / (2 k) (J). */
+INLINE vec quad_drill_update(const quad_frame_t *g, const shell_params *s, double dt,
+                             vec thickness, const vec vl[4][3], const vec wl[4][3],
+                             double *restrict state, int64_t stride, const batch_t *b,
+                             vec mz[4])
+{
+  vec spin = VZERO;
+  for (int I = 0; I < 4; ++I)
+    spin += g->b1[I] * vl[I][1] - g->b2[I] * vl[I][0];
+  spin *= 0.5;
+  const double G = 0.5 * s->young / (1.0 + s->poisson);
+  const vec k = (s->kd * G) * thickness * g->area;
+  vec energy = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    mz[I] = load_slot(state, stride, b, s->drill_slot + I) + k * dt * (wl[I][2] - spin);
+    store_slot(state, stride, b, s->drill_slot + I, mz[I]);
+    energy += 0.5 * mz[I] * mz[I] / k;
+  }
+  return energy;
+}
+
+/* The nodal moments mz (about e3) of the drilling springs and the in-plane forces of their
+ * spin term (the transpose: f_I = (sum mz) (b2_I, -b1_I) / 2), added to fe (global). */
+INLINE void quad_drill_forces(const quad_frame_t *g, const vec mz[4], vec *restrict fe)
+{
+  const vec half = 0.5 * (mz[0] + mz[1] + mz[2] + mz[3]);
+  for (int I = 0; I < 4; ++I)
+  {
+    const vec fx = half * g->b2[I], fy = -half * g->b1[I];
+    for (int i = 0; i < 3; ++i)
+    {
+      fe[3 * I + i] += fx * g->e[0][i] + fy * g->e[1][i];
+      fe[12 + 3 * I + i] += mz[I] * g->e[2][i];
+    }
+  }
+}
+
 /* Radioss's characteristic length (m) of the cells of frame g. */
 INLINE vec quad_length(const quad_frame_t *g)
 {
@@ -375,7 +420,9 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
     to_local(&g, ve, vl);
     to_local(&g, we, wl);
-    vec Ji[9];
+    vec Ji[9], mz[4], drill = VZERO;
+    if (s->kd > 0.0)
+      drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
     if (warping)
     {
       rigid_inverse(&g, Ji);
@@ -388,13 +435,19 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
                                  &b, fe);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
+    const vec before =
+        s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
                  &damage);
+    if (s->new_thickness)
+      shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
     quad_frame(x, &g);
     if (warping)
       rigid_inverse(&g, Ji);
     quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
-    elastic *= g.area;
+    if (s->kd > 0.0)
+      quad_drill_forces(&g, mz, fe);
+    elastic = elastic * g.area + drill;
     const vec plastic_work = dissipated * mid_area;
     const ivec inverted = ~(g.area > 0.0);
     vec dte = VZERO + INFINITY;
@@ -461,17 +514,18 @@ void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *
 double shell_point(const element_params *p, const shell_params *s, double sigma[3],
                    double *eps_p, double *T, const double de[3])
 {
-  vec sig[3], e = VZERO + *eps_p, temperature = VZERO + *T, d[3];
+  vec sig[1][3], e[1] = {VZERO + *eps_p}, temperature[1] = {VZERO + *T}, d[1][3];
   for (int i = 0; i < 3; ++i)
   {
-    sig[i] = VZERO + sigma[i];
-    d[i] = VZERO + de[i];
+    sig[0][i] = VZERO + sigma[i];
+    d[0][i] = VZERO + de[i];
   }
-  point_step done;
-  const vec dissipation = shell_point_update(p, s, sig, &e, &temperature, d, &done);
+  point_step done[1];
+  vec dissipation[1];
+  shell_points_update(p, s, 1, sig, e, temperature, d, done, dissipation);
   for (int i = 0; i < 3; ++i)
-    sigma[i] = sig[i][0];
-  *eps_p = e[0];
-  *T = temperature[0];
-  return dissipation[0];
+    sigma[i] = sig[0][i][0];
+  *eps_p = e[0][0];
+  *T = temperature[0][0];
+  return dissipation[0][0];
 }

@@ -200,8 +200,12 @@ INLINE void shell_tria(int plastic, int64_t num_cells, const int32_t *restrict c
     tria_strain_rates(&g, vl, wl, d, k, gs);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
+    const vec before =
+        s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
                  &damage);
+    if (s->new_thickness)
+      shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
     tria_frame(x, &g);
     tria_resultant_forces(&g, N, M, Q, fe);
     elastic *= g.area;

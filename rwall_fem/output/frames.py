@@ -6,16 +6,19 @@ rank 0 stores them in ``frames/data``: ``mesh.npz`` once, then
 ``frame_NNNN.npz`` per frame (``t``, ``u``, ``v``, the walls' ``offsets`` and
 ``cell_<name>`` for each cell field; when cells can erode, ``cell_eroded`` and
 ``detached``, 1 at the nodes no live cell holds).
-Pictures are drawn at the end of the run (or of a stopped run) by a separate
-process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
-VTK's wheels crash when they render in a process that holds DOLFINx's C++
-libraries (a libstdc++ ABI clash, seen with vtk 9.7 and DOLFINx 0.5).
+Each file is written whole (:mod:`rwall_fem.output.atomic`). Pictures are drawn by a
+separate process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
+VTK's wheels crash when they render in a process that holds DOLFINx's C++ libraries (a
+libstdc++ ABI clash, seen with vtk 9.7 and DOLFINx 0.5). With a free core that process
+starts at the first frame and is fed each frame as it is written
+(:mod:`rwall_fem.output.worker`); otherwise it starts at the end of the run (or of a
+stopped or failed run). Either way every frame written is drawn.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -25,7 +28,9 @@ from dolfinx import fem
 
 from rwall_fem import _compat
 from rwall_fem.output import OutputError
+from rwall_fem.output.atomic import whole
 from rwall_fem.output.schedule import Times
+from rwall_fem.output.worker import RenderWorker, renderer_command, renderer_env, wanted
 from rwall_fem.scene.view import view_to_json
 
 __all__ = ["Frames"]
@@ -65,6 +70,8 @@ class Frames:
         self._field = fem.Function(V)
         self._count = 0
         self._failed = False  # a frame could not be written (rank 0): no more are
+        self._worker: RenderWorker | None = None  # the renderer beside the loop (rank 0)
+        self._beside = self.comm.rank == 0 and wanted(self.comm.size)  # it is to be started
         topology, cell_types, points = _compat.vtk_mesh(V)
         mesh = self._gather((np.asarray(topology), np.asarray(cell_types), np.asarray(points)))
         self._mesh = mesh
@@ -139,6 +146,12 @@ class Frames:
                 offsets = np.array([w.motion.offset for w in self.walls]).reshape(-1, 3)
                 name = f"frame_{self._count:04d}.npz"
                 self._save(name, t=s.t, u=u, v=v, offsets=offsets, **cells)
+                if self._worker is None and self._beside:
+                    self._beside = False  # one try: a renderer started after the loop else
+                    with contextlib.suppress(OSError):  # no process to be had
+                        self._worker = RenderWorker(self.directory, self.color)
+                if self._worker is not None:
+                    self._worker.send(name)
             except OutputError as err:  # the history ends the run on every rank
                 self._failed = True
                 sim.history.write_failed(err)
@@ -149,9 +162,9 @@ class Frames:
         it cannot be written (a full disk)."""
         path = self.data / name
         try:
-            np.savez(path, **arrays)
+            with whole(path) as partial:
+                np.savez(partial, **arrays)
         except OSError as err:
-            path.unlink(missing_ok=True)
             raise OutputError(f"{path}: cannot be written ({err.strerror})") from None
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
@@ -173,15 +186,25 @@ class Frames:
             raise ValueError(error)
 
     def close(self, sim) -> None:
-        """Render the stored frames into PNGs and ``animation.gif`` (rank 0)."""
-        if self.comm.rank != 0 or not self._count or self._failed:
+        """Draw the stored frames into PNGs and ``animation.gif`` (rank 0): the worker draws
+        them if there is one and it is well, else a renderer started now."""
+        if self.comm.rank != 0:
             return
-        env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
-        env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        worker, self._worker = self._worker, None
+        if not self._count or self._failed:
+            if worker is not None:
+                worker.abandon()
+            return
+        if worker is not None:
+            code, messages = worker.finish()
+            if code == 0:
+                return
+            last = (messages.strip().splitlines() or [f"exit code {code}"])[-1]
+            print(f"rwall-fem: warning: the renderer beside the run failed ({last}); drawing "
+                  "the frames again", file=sys.stderr)  # fmt: skip
         result = subprocess.run(
-            [sys.executable, "-m", "rwall_fem.output.render", str(self.directory)]
-            + ["--color", self.color],
-            env=env,
+            renderer_command(self.directory, self.color),
+            env=renderer_env(),
             capture_output=True,
             text=True,
         )

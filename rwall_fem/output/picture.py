@@ -13,32 +13,59 @@ nothing but its loose nodes. This module must not import DOLFINx (see
 
 from __future__ import annotations
 
-from types import SimpleNamespace
+import os
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")  # before VTK's window
 
 import numpy as np
-from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-from vtkmodules.vtkCommonCore import vtkPoints
-from vtkmodules.vtkCommonDataModel import vtkPlane, vtkPolyData
+import vtkmodules.vtkRenderingFreeType  # noqa: F401  (the text)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the window and mappers that draw)
+from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkLookupTable, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPlane, vtkPolyData, vtkUnstructuredGrid
 from vtkmodules.vtkFiltersCore import vtkThreshold
 from vtkmodules.vtkFiltersGeneral import vtkTableBasedClipDataSet
 from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
 from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor
-from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkWindowToImageFilter
+from vtkmodules.vtkRenderingCore import (
+    vtkActor,
+    vtkLightKit,
+    vtkPolyDataMapper,
+    vtkRenderer,
+    vtkRenderWindow,
+    vtkTextActor,
+    vtkWindowToImageFilter,
+)
 
-__all__ = ["Picture"]
+from rwall_fem.output.coloring import colour_table, rgb
 
-# The VTK classes used, imported one module each (``import vtk`` loads every module: 1 s).
-VTK = SimpleNamespace(
-    vtkActor=vtkActor, vtkGeometryFilter=vtkGeometryFilter, vtkPlane=vtkPlane,
-    vtkPoints=vtkPoints, vtkPolyData=vtkPolyData, vtkPolyDataMapper=vtkPolyDataMapper,
-    vtkScalarBarActor=vtkScalarBarActor, vtkTableBasedClipDataSet=vtkTableBasedClipDataSet,
-    vtkThreshold=vtkThreshold, vtkWindowToImageFilter=vtkWindowToImageFilter,
-)  # fmt: skip
+__all__ = ["Picture", "polydata"]
 
+# VTK's classes are imported one module each (``import vtk`` loads every module: 1 s), and
+# pyvista not at all: its plotting imports matplotlib's pyplot (0.5 s of a 2 s drawing).
 BAR = (0.2, 0.06, 0.6, 0.04)  # the colour bar's box: x, y, width, height (of the window)
 WALL_COLOR = "#a9b4c2"  # a cool grey that no colour map uses
 LOOSE_COLOR = "#404040"
+BACKGROUND = "#ffffff"
 GHOST_OPACITY = 0.12
+
+
+def polydata(points: np.ndarray, faces: np.ndarray | None = None) -> vtkPolyData:
+    """VTK's surface of ``points`` ((n, 3), m) and ``faces`` (VTK's legacy cell array
+    ``[k, i0, .., ik-1, k, ...]``), or of the points alone as vertices."""
+    points = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
+    data = vtkPolyData()
+    vertices = vtkPoints()
+    vertices.SetData(numpy_to_vtk(points, deep=True))
+    data.SetPoints(vertices)
+    if faces is None:
+        faces = np.column_stack([np.ones(len(points), int), np.arange(len(points))]).ravel()
+        cells, setter = vtkCellArray(), data.SetVerts
+    else:
+        cells, setter = vtkCellArray(), data.SetPolys
+    cells.ImportLegacyFormat(numpy_to_vtkIdTypeArray(np.asarray(faces, np.int64), deep=True))
+    setter(cells)
+    return data
 
 
 class Picture:
@@ -49,17 +76,28 @@ class Picture:
     whose normal side is removed, or None; ``ghost``: that side drawn translucent;
     ``edges``: the cell edges are drawn."""
 
-    def __init__(self, pyvista, mesh, paint, view, size, *, erodes, cut, ghost, edges):
-        vtk = VTK
-        self.pyvista, self.vtk, self.size = pyvista, VTK, tuple(size)
+    def __init__(self, mesh, paint, view, size, *, erodes, cut, ghost, edges):
+        self.size = tuple(int(x) for x in size)
         self.paint, self.cut = paint, cut
-        self.plotter = pyvista.Plotter(off_screen=True, window_size=list(self.size))
+        self.renderer = vtkRenderer()
+        self.renderer.SetBackground(*rgb(BACKGROUND))
+        vtkLightKit().AddLightsToRenderer(self.renderer)
+        self.renderer.LightFollowCameraOn()
+        self._window = vtkRenderWindow()
+        self._window.SetOffScreenRendering(1)
+        self._window.SetSize(*self.size)
+        self._window.AddRenderer(self.renderer)
         self.points0 = np.asarray(mesh["points"], float)
-        grid = pyvista.UnstructuredGrid(mesh["topology"], mesh["cell_types"], self.points0.copy())
+        grid = vtkUnstructuredGrid()
+        cells = vtkCellArray()
+        cells.ImportLegacyFormat(numpy_to_vtkIdTypeArray(np.asarray(mesh["topology"], np.int64),
+                                                         deep=True))  # fmt: skip
+        self._types = np.ascontiguousarray(mesh["cell_types"], dtype=np.uint8)
+        grid.SetCells(numpy_to_vtk(self._types, deep=True), cells)
         self._xyz = np.array(self.points0, dtype=float, order="C")
-        grid.SetPoints(vtk.vtkPoints())
+        grid.SetPoints(vtkPoints())
         grid.GetPoints().SetData(numpy_to_vtk(self._xyz, deep=False))
-        n = grid.n_cells if paint.per_cell else grid.n_points
+        n = grid.GetNumberOfCells() if paint.per_cell else grid.GetNumberOfPoints()
         self._values = np.zeros(n)
         colours = numpy_to_vtk(self._values, deep=False)
         colours.SetName("colour")
@@ -70,15 +108,15 @@ class Picture:
         source = grid
         output = None
         if erodes:  # eroded cells are not drawn
-            self._live = np.ones(grid.n_cells)
+            self._live = np.ones(grid.GetNumberOfCells())
             live = numpy_to_vtk(self._live, deep=False)
             live.SetName("live")
             grid.GetCellData().AddArray(live)
-            threshold = vtk.vtkThreshold()
+            threshold = vtkThreshold()
             threshold.SetInputData(grid)
             threshold.SetInputArrayToProcess(0, 0, 0, 1, "live")  # 1: cell data
             threshold.SetUpperThreshold(0.5)  # UPPER keeps the values >= it
-            threshold.SetThresholdFunction(vtk.vtkThreshold.THRESHOLD_UPPER)
+            threshold.SetThresholdFunction(vtkThreshold.THRESHOLD_UPPER)
             output = threshold.GetOutputPort()
             self._filters.append(threshold)
         self.grid = grid
@@ -87,20 +125,21 @@ class Picture:
         kept.GetProperty().SetEdgeVisibility(bool(edges))
         if cut is not None and ghost:
             self._surface(self._clipped(source, output, inside=False), opaque=False)
-        self._loose = vtk.vtkPolyData()
+        self._loose = vtkPolyData()
         self._actor(self._loose, LOOSE_COLOR).GetProperty().SetPointSize(3.0)
         self._walls: list = []
-        self._time = self.plotter.add_text(
-            " ", position=(12, self.size[1] - 32), font_size=12, color="black"
-        )
+        self._surfaces: dict = {}  # the walls' surfaces drawn, by the id of theirs
+        self._time = self._text(" ", 12, self.size[1] - 32, 12)  # in view.TIME_CORNER
+        backing = self._time.GetTextProperty()  # legible over a body that fills the picture
+        backing.SetBackgroundColor(*rgb(BACKGROUND))
+        backing.SetBackgroundOpacity(0.8)
         self._colour_bar()
-        view.apply(self.plotter)
+        view.apply(self.renderer)
         self._view = view
-        self._window = self.plotter.render_window
         # Multisampling costs 7 times the frame in Mesa's software renderer (150 ms, not
         # 20, for the bar demo at 800 x 600): none.
         self._window.SetMultiSamples(0)
-        self._grab = vtk.vtkWindowToImageFilter()
+        self._grab = vtkWindowToImageFilter()
         self._grab.SetInput(self._window)
         self._grab.ShouldRerenderOff()  # the frame was just rendered
         self._grab.SetInputBufferTypeToRGB()
@@ -113,11 +152,10 @@ class Picture:
         the side opposite the normal (``inside``) or the removed side."""
         if self.cut is None:
             return grid, port
-        vtk = self.vtk
-        plane = vtk.vtkPlane()
+        plane = vtkPlane()
         plane.SetOrigin(*self.cut[0])
         plane.SetNormal(*self.cut[1])
-        clip = vtk.vtkTableBasedClipDataSet()
+        clip = vtkTableBasedClipDataSet()
         if port is None:
             clip.SetInputData(grid)
         else:
@@ -128,14 +166,13 @@ class Picture:
         return None, clip.GetOutputPort()
 
     def _surface(self, source, *, opaque: bool):
-        vtk = self.vtk
         grid, port = source
-        surface = vtk.vtkGeometryFilter()
+        surface = vtkGeometryFilter()
         if port is None:
             surface.SetInputData(grid)
         else:
             surface.SetInputConnection(port)
-        mapper = vtk.vtkPolyDataMapper()
+        mapper = vtkPolyDataMapper()
         mapper.SetInputConnection(surface.GetOutputPort())
         self._filters.append(surface)
         mapper.SetLookupTable(self._lut)
@@ -148,7 +185,7 @@ class Picture:
             mapper.InterpolateScalarsBeforeMappingOn()
         mapper.SelectColorArray("colour")
         mapper.ScalarVisibilityOn()
-        actor = vtk.vtkActor()
+        actor = vtkActor()
         actor.SetMapper(mapper)
         prop = actor.GetProperty()
         prop.SetAmbient(0.3)
@@ -157,50 +194,50 @@ class Picture:
         prop.SetLineWidth(0.5)
         if not opaque:
             prop.SetOpacity(GHOST_OPACITY)
-        self.plotter.renderer.AddActor(actor)
+        self.renderer.AddActor(actor)
         return actor
 
     def _actor(self, polydata, colour, opacity: float = 1.0):
         """An actor of one colour drawing ``polydata`` (vertices, or a surface)."""
-        vtk = self.vtk
-        mapper = vtk.vtkPolyDataMapper()
+        mapper = vtkPolyDataMapper()
         mapper.SetInputData(polydata)
         mapper.ScalarVisibilityOff()
-        actor = vtk.vtkActor()
+        actor = vtkActor()
         actor.SetMapper(mapper)
         prop = actor.GetProperty()
-        prop.SetColor(*self.pyvista.Color(colour).float_rgb)
+        prop.SetColor(*rgb(colour))
         prop.SetAmbient(0.3)
         prop.SetDiffuse(0.7)
         prop.SetOpacity(opacity)
-        self.plotter.renderer.AddActor(actor)
+        self.renderer.AddActor(actor)
         return actor
 
     def _lookup_table(self):
         paint = self.paint
-        if paint.names:
-            from matplotlib.colors import ListedColormap
-
-            cmap = ListedColormap(paint.cmap)
-        else:
-            cmap = paint.cmap
-        lut = self.pyvista.LookupTable(cmap, n_values=len(paint.names) or 256)
-        lut.scalar_range = paint.clim
+        table = colour_table(paint.cmap, len(paint.names) or 256)
+        lut = vtkLookupTable()
+        lut.SetNumberOfTableValues(len(table))
+        for i, colour in enumerate(table):
+            lut.SetTableValue(i, *colour, 1.0)
+        lut.SetRange(*paint.clim)
         return lut
 
     # --- the frames ---------------------------------------------------------------------
 
     def set_walls(self, walls, surfaces) -> None:
-        """The walls (shapes) and their ``surfaces`` (pyvista) in this frame; flat walls seen
-        from their allowed side are opaque, the others translucent with their outline."""
+        """The walls (shapes) and their ``surfaces`` (:class:`rwall_fem.output.view.Surface`)
+        in this frame; flat walls seen from their allowed side are opaque, the others
+        translucent with their outline."""
         if not self._walls:
             for wall in walls:
                 behind = self._view.behind(wall)
-                actor = self._actor(self.pyvista.PolyData(), WALL_COLOR, 1.0 if behind else 0.3)
-                self._walls.append(actor)
+                self._walls.append(self._actor(vtkPolyData(), WALL_COLOR, 1.0 if behind else 0.3))
         for actor, surface in zip(self._walls, surfaces, strict=True):
-            if actor.GetMapper().GetInput() is not surface:
-                actor.GetMapper().SetInputData(surface)
+            drawn = self._surfaces.get(id(surface))
+            if drawn is None:
+                drawn = self._surfaces[id(surface)] = (surface, polydata(*surface))
+            if actor.GetMapper().GetInput() is not drawn[1]:
+                actor.GetMapper().SetInputData(drawn[1])
 
     def draw(self, u, values, eroded, loose, time: str) -> np.ndarray:
         """The picture (h, w, 3 uint8) of the body displaced by ``u`` ((n, 3), m) coloured
@@ -220,7 +257,7 @@ class Picture:
         points = self._xyz[loose > 0.5] if loose is not None else np.zeros((0, 3))
         if self.cut is not None and len(points):  # the loose nodes of the kept side
             points = points[(points - self.cut[0]) @ self.cut[1] <= 0.0]
-        self._loose.ShallowCopy(self.pyvista.PolyData(points) if len(points) else self.vtk.vtkPolyData())
+        self._loose.ShallowCopy(polydata(points) if len(points) else vtkPolyData())
         self._time.SetInput(time)
         self._window.Render()
         self._grab.Modified()
@@ -231,7 +268,7 @@ class Picture:
         return np.ascontiguousarray(pixels[::-1, :, :3])  # VTK's rows run from the bottom
 
     def close(self) -> None:
-        self.plotter.close()
+        self._window.Finalize()
 
     # --- the colour bar -----------------------------------------------------------------
 
@@ -239,8 +276,8 @@ class Picture:
         """The colour bar under the picture: the bar from VTK, its title above it and its
         labels (in one format, at round values) under it, placed here: VTK's own placement
         lets them overlap the bar and each other."""
-        vtk, paint, (w, h) = self.vtk, self.paint, self.size
-        bar = vtk.vtkScalarBarActor()
+        paint, (w, h) = self.paint, self.size
+        bar = vtkScalarBarActor()
         bar.SetLookupTable(self._lut)
         bar.SetOrientationToHorizontal()
         bar.SetTitle("")
@@ -253,7 +290,7 @@ class Picture:
         coordinate.SetValue(BAR[0], BAR[1])
         bar.SetWidth(BAR[2])
         bar.SetHeight(BAR[3])
-        self.plotter.renderer.AddViewProp(bar)
+        self.renderer.AddViewProp(bar)
         (left, bottom), width = np.multiply(BAR[:2], self.size), BAR[2] * w
         (low, high), n = paint.clim, paint.n_labels
         if paint.names:  # categories: each name under the middle of its colour
@@ -267,5 +304,17 @@ class Picture:
 
     def _centred_text(self, text: str, x: float, y: float, size: int) -> None:
         """``text`` centred on ``x`` with its foot at ``y`` (pixels from the lower left)."""
-        actor = self.plotter.add_text(text, position=(x, y), font_size=size, color="black")
-        actor.GetTextProperty().SetJustificationToCentered()
+        self._text(text, x, y, size).GetTextProperty().SetJustificationToCentered()
+
+    def _text(self, text: str, x: float, y: float, size: int):
+        """A black label at (``x``, ``y``) pixels from the lower left, of ``size`` points
+        (doubled: pyvista's sizes, which the pictures had first)."""
+        actor = vtkTextActor()
+        actor.SetInput(text)
+        actor.SetPosition(x, y)
+        prop = actor.GetTextProperty()
+        prop.SetFontSize(int(2 * size))
+        prop.SetColor(0.0, 0.0, 0.0)
+        prop.SetFontFamilyToArial()
+        self.renderer.AddViewProp(actor)
+        return actor

@@ -13,15 +13,21 @@ them from their allowed side, behind the body), curved walls translucent with
 their outline, seen as the run's ``[output.view]`` (or ``--view``) says
 (:mod:`rwall_fem.scene.view`: a cut, the camera, the size, the colour range). The camera
 and the colour range are fixed once for all frames, which one scene
-(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see :mod:`rwall_fem.output.frames`).
+(:mod:`rwall_fem.output.picture`) draws in turn. This module must not import DOLFINx (see
+:mod:`rwall_fem.output.frames`). With ``--follow PID`` it is the renderer beside a running
+run (:mod:`rwall_fem.output.worker`).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import signal
 import sys
+import threading
+import time
 import zipfile
 from pathlib import Path
 
@@ -30,7 +36,7 @@ import numpy as np
 from rwall_fem import interrupts
 from rwall_fem.output.atomic import whole
 from rwall_fem.output.coloring import COLORS, coloring, fixed_range
-from rwall_fem.output.view import choose_view, up_direction, wall_surface
+from rwall_fem.output.view import TIME_CORNER, choose_view, up_direction, wall_surface
 from rwall_fem.scene.view import ViewSpec, parse_view_text, view_from_json
 from rwall_fem.scene.keys import SceneError
 from rwall_fem.walls.shapes import shape_from_parameters
@@ -47,22 +53,23 @@ class RenderError(ValueError):
 
 
 def render_frames(
-    directory: str | Path, color: str = "normal_velocity", view: ViewSpec | None = None
+    directory: str | Path,
+    color: str = "normal_velocity",
+    view: ViewSpec | None = None,
+    read: dict[str, dict] | None = None,
 ) -> list[Path]:
     """Render every stored frame of the run in ``directory``, coloured by ``color`` (one of
     :data:`COLORS` or a cell field the run stored), seen as ``view`` says (None: the view
-    the run stored, else the automatic one); returns the PNG paths.
+    the run stored, else the automatic one); returns the PNG paths. ``read``: the arrays
+    of frame files already read, by file name.
 
     Raises RenderError for a folder without frame data, an unknown colouring or a view
     the body cannot give (a part it does not have).
     """
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista
-
-    from rwall_fem.output.picture import Picture
+    from rwall_fem.output.picture import Picture  # VTK: imported when drawing only
 
     directory = Path(directory)
-    mesh, walls, paths, frames = _stored(directory)
+    mesh, walls, paths, frames = _stored(directory, read or {})
     view = _stored_view(mesh) if view is None else view
     points = mesh["points"]
     up = up_direction(mesh.get("gravity"), walls)
@@ -81,6 +88,7 @@ def render_frames(
         points + frames[0]["u"], [body], walls, up, window[0] / window[1],
         azimuth=view.azimuth, elevation=view.elevation, zoom=view.zoom,
         cut_normal=None if cut is None else cut[1], focus=_focus(view.focus, mesh, frames, parts),
+        corner=(TIME_CORNER[0] / window[0], TIME_CORNER[1] / window[1]),
     )  # fmt: skip
     if cut is not None and isinstance(view.cut, str) and cut[1] @ camera.direction < 0:
         cut = (cut[0], -cut[1])  # an axis cut removes the half nearer the camera
@@ -94,7 +102,7 @@ def render_frames(
     # VTK window left half made or half closed fails in its destructor at exit.
     with interrupts.deferred():
         picture = Picture(
-            pyvista, mesh, paint, camera, window, erodes="cell_eroded" in frames[0],
+            mesh, paint, camera, window, erodes="cell_eroded" in frames[0],
             cut=cut, ghost=view.ghost, edges=edges,
         )  # fmt: skip
     try:
@@ -103,7 +111,7 @@ def render_frames(
                 offsets = frame["offsets"]
                 drawn = surfaces.get(offsets.tobytes())
                 if drawn is None:
-                    drawn = [wall_surface(pyvista, w, o, body, size)
+                    drawn = [wall_surface(w, o, body, size)
                              for w, o in zip(walls, offsets, strict=True)]  # fmt: skip
                     surfaces[offsets.tobytes()] = drawn
                 picture.set_walls(walls, drawn)
@@ -188,11 +196,12 @@ def _focus(focus, mesh: dict, frames: list[dict], parts: tuple[str, ...]):
     return 0.5 * (x.min(axis=0) + x.max(axis=0))
 
 
-def _stored(directory: Path):
+def _stored(directory: Path, read: dict[str, dict]):
     """The body (``mesh.npz`` as a dict), the wall shapes, and the frame files that
-    ``directory`` holds with their contents; RenderError when there are none or the body
-    cannot be read. A frame file that cannot be read (cut short by a kill or a full
-    disk) or does not fit the body is left out, with a warning line."""
+    ``directory`` holds with their contents (those in ``read``, by name, are not read
+    again); RenderError when there are none or the body cannot be read. A frame file that
+    cannot be read (cut short by a kill or a full disk) or does not fit the body is left
+    out, with a warning line."""
     data = directory / "frames" / "data"
     if not directory.is_dir():
         raise RenderError(f"{directory}: no such folder")
@@ -209,7 +218,7 @@ def _stored(directory: Path):
     kept, frames = [], []
     for path in paths:
         try:
-            frame = _npz(path, ("t", "u", "v", "offsets"))
+            frame = read.get(path.name) or _npz(path, ("t", "u", "v", "offsets"))
             for name in ("u", "v"):
                 if frame[name].shape != mesh["points"].shape:
                     raise ValueError(f"{name} has shape {frame[name].shape}, not that of the body")
@@ -276,6 +285,31 @@ def _has_mp4_encoder() -> bool:
     return True
 
 
+def _follow(directory: Path, parent: int) -> dict[str, dict] | None:
+    """Beside a running run (:mod:`rwall_fem.output.worker`): import what draws, then read
+    each frame file whose name arrives on stdin until ``end``; returns what was read, or
+    None when stdin ends first (the run is gone or does not want the pictures). When
+    the process ``parent`` ends, this one is sent SIGTERM: it never draws on after it."""
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+    from PIL import Image  # noqa: F401  (imported now, while the loop runs)
+
+    from rwall_fem.output import picture  # noqa: F401
+    read = {}
+    for line in sys.stdin:
+        name = line.strip()
+        if name == "end":
+            return read
+        with contextlib.suppress(OSError, ValueError):  # read again, and judged, at the end
+            read[name] = _npz(directory / "frames" / "data" / name, ("t", "u", "v", "offsets"))
+    return None
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(0.1)
+    os.kill(os.getpid(), signal.SIGTERM)
+
+
 def main(argv: list[str] | None = None) -> int:
     """The command line of this module (also what ``rwall-fem render`` runs)."""
     parser = argparse.ArgumentParser(
@@ -294,11 +328,17 @@ def main(argv: list[str] | None = None) -> int:
         help="the keys of [output.view] as a TOML inline table's inside, e.g. "
         "'cut = \"y\", zoom = 1.5' (default: the run's view)",
     )
+    parser.add_argument("--follow", metavar="PID", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     with interrupts.handling() as say:
         try:
             view = None if args.view is None else parse_view_text(args.view)
-            files = render_frames(args.directory, args.color, view)
+            read = None
+            if args.follow is not None:  # beside the run of process PID (output.worker)
+                read = _follow(Path(args.directory), args.follow)
+                if read is None:
+                    return 0  # the run ended without asking for the pictures
+            files = render_frames(args.directory, args.color, view, read)
         except (RenderError, SceneError) as err:
             print(f"rwall-fem: error: {err}", file=sys.stderr)
             return 2

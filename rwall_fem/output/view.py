@@ -16,17 +16,20 @@ behind the body: lower elevations are tried until they are (a body between a
 floor and a press is seen level). ``[output.view]`` turns that camera (azimuth,
 elevation), turns it to a cut face, zooms and centres it on a point. The view is
 fitted to the body's deformed extent in every frame (not the walls', which are
-context) with a margin, between the time at the top and the colour bar at the
-bottom. The body is drawn at true scale by the renderer.
+context) with a margin, above the colour bar and up to the top of the picture, or
+below the time when the body would reach into its corner (a Taylor rod's last frame,
+two thirds as long as its first, fills more than half of the height). The body is
+drawn at true scale by the renderer.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["View", "choose_view", "up_direction", "wall_surface"]
+__all__ = ["Surface", "View", "choose_view", "up_direction", "wall_surface"]
 
 # (azimuth, elevation) of the camera (degrees), see above; then the elevations LOWER.
 ANGLES = {"flat": (30.0, 30.0), "edge": (0.0, 20.0), "other": (30.0, 20.0)}
@@ -34,9 +37,13 @@ LOWER = (10.0, 0.0, -10.0, -20.0)
 FLAT = 0.2  # a body is flat when its height is below this fraction of its width
 MARGIN = 0.15  # walls reach this fraction of the scene's size beyond the body (m / m)
 SLAB = 0.02  # thickness of a flat wall as a fraction of the scene's size
+ROUND = 96  # points round a cylinder or a sphere's circles
 # The band of the picture that the scene fills (fractions of the height from the bottom):
-# the time is written above it, the colour bar drawn below.
-BAND = (0.16, 0.90)
+# the colour bar is drawn below it; the time is written above it at the top left, in a
+# corner of TIME_CORNER pixels (width, height). A body clear of that corner may reach TOP.
+BAND = (0.15, 0.90)
+TOP = 0.985
+TIME_CORNER = (180, 40)
 FIT_MARGIN = 0.04  # the body's extent and this fraction of it fill the band
 # A cut by a vertical plane is seen from this many degrees round up from its normal and
 # this high; a cut by a horizontal plane from this far off the vertical.
@@ -59,16 +66,24 @@ class View:
         seen from that side."""
         return shape.kind in ("plane", "parallelogram") and shape.normal @ self.direction >= -1e-9
 
-    def apply(self, plotter) -> None:
-        """Set ``plotter``'s camera to this view."""
-        camera = plotter.camera
-        camera.parallel_projection = True
+    def apply(self, renderer) -> None:
+        """Set the camera of ``renderer`` (VTK's) to this view."""
+        camera = renderer.GetActiveCamera()
+        camera.ParallelProjectionOn()
         distance = 10.0 * self.scale
-        camera.position = tuple(self.focal + distance * self.direction)
-        camera.focal_point = tuple(self.focal)
-        camera.up = tuple(self.up)
-        camera.parallel_scale = self.scale
-        plotter.renderer.ResetCameraClippingRange()
+        camera.SetPosition(*(self.focal + distance * self.direction))
+        camera.SetFocalPoint(*self.focal)
+        camera.SetViewUp(*self.up)
+        camera.SetParallelScale(self.scale)
+        renderer.ResetCameraClippingRange()
+
+
+class Surface(NamedTuple):
+    """A wall as drawn: its ``points`` ((n, 3), m) and ``faces`` (VTK's legacy cell array,
+    ``[k, i0, .., ik-1, k, ...]``)."""
+
+    points: np.ndarray
+    faces: np.ndarray
 
 
 def up_direction(gravity, walls) -> np.ndarray:
@@ -92,6 +107,7 @@ def choose_view(
     cut_normal=None,
     zoom: float = 1.0,
     focus=None,
+    corner=(TIME_CORNER[0] / 800, TIME_CORNER[1] / 600),
 ) -> View:
     """The view of a run whose body starts at the points ``start`` ((n, 3), m) and whose
     drawn points are ``clouds`` ((n, 3) arrays, m: the body in every frame), for a picture
@@ -102,7 +118,9 @@ def choose_view(
     ``elevation`` (degrees) sets its height above the horizontal plane; ``cut_normal``
     (unit, toward the removed half of a cut) turns it toward the cut face, unless the
     angles are given. ``zoom`` magnifies the fitted view; ``focus`` (m) is the point at
-    the centre of the picture (else the centre of the clouds)."""
+    the centre of the picture (else the centre of the clouds). ``corner``: the time's
+    corner (fractions of the width and height), which the body reaches up beside, not
+    into."""
     points = np.concatenate(clouds)
     up = np.asarray(up, float)
     across, along = _horizontal_axes(points, up)
@@ -138,17 +156,39 @@ def choose_view(
     view_up /= np.linalg.norm(view_up)
     right = np.cross(view_up, direction)
     x, y = points @ right, points @ view_up
-    band = BAND[1] - BAND[0]
-    scale = (1.0 + FIT_MARGIN) * max(np.ptp(y) / (2 * band), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
-    scale /= zoom
+    depth = float((points @ direction).mean())
+    fit = [x, y, right, view_up, direction, depth, aspect, zoom, focus]
+    view = _framed(*fit, band=(BAND[0], TOP))
+    if _in_corner(view, points, aspect, corner):  # under the time, not beside it
+        view = _framed(*fit, band=BAND)
+    return view
+
+
+def _framed(x, y, right, up, direction, depth, aspect, zoom, focus, *, band) -> View:
+    """The view along ``direction`` whose band (``band``: its bottom and top, fractions of
+    the height) holds the points at ``x`` along ``right`` and ``y`` along ``up`` (m), with
+    a margin, magnified by ``zoom``, centred on ``focus`` (or on them)."""
+    low, high = band
+    fit = max(np.ptp(y) / (2 * (high - low)), np.ptp(x) / (2 * 0.96 * aspect), 1e-12)
+    scale = (1.0 + FIT_MARGIN) * fit / zoom
     if focus is None:
-        centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * view_up
-        centre += (points @ direction).mean() * direction
+        centre = 0.5 * (x.min() + x.max()) * right + 0.5 * (y.min() + y.max()) * up
+        centre += depth * direction
     else:
         centre = np.asarray(focus, float)
     # The middle of the band is above the middle of the picture by this much (m).
-    lift = (0.5 * (BAND[0] + BAND[1]) - 0.5) * 2 * scale
-    return View(centre - lift * view_up, direction, view_up, scale)
+    lift = (0.5 * (low + high) - 0.5) * 2 * scale
+    return View(centre - lift * up, direction, up, scale)
+
+
+def _in_corner(view: View, points: np.ndarray, aspect: float, corner) -> bool:
+    """Whether some of ``points`` (m) lie in the picture's top left ``corner`` (fractions of
+    the width and height) seen by ``view``."""
+    right = np.cross(view.up, view.direction)
+    across = ((points - view.focal) @ right / view.scale + aspect) / (2 * aspect)
+    height = 0.5 * ((points - view.focal) @ view.up / view.scale + 1.0)
+    inside = (across >= 0.0) & (across < corner[0]) & (height > 1.0 - corner[1]) & (height <= 1.0)
+    return bool(inside.any())
 
 
 def _horizontal(vector: np.ndarray, up: np.ndarray, fallback: np.ndarray) -> np.ndarray:
@@ -163,26 +203,34 @@ def _turn(vector: np.ndarray, up: np.ndarray, angle: float) -> np.ndarray:
     return np.cos(angle) * vector + np.sin(angle) * np.cross(up, vector)
 
 
-def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: float):
-    """A pyvista surface of ``shape`` translated by ``offset`` (m), drawn where the ``body``
+def wall_surface(shape, offset: np.ndarray, body: np.ndarray, size: float) -> Surface:
+    """The surface of ``shape`` translated by ``offset`` (m), drawn where the ``body``
     ((n, 3) points, m: of every frame) is, in a scene of ``size`` (m)."""
     margin = MARGIN * size
     point = shape.point + offset
     if shape.kind == "cylinder":
         along = (body - point) @ shape.axis
         low, high = along.min() - margin, along.max() + margin
-        return pyvista.Cylinder(
-            center=point + 0.5 * (low + high) * shape.axis,
-            direction=shape.axis,
-            radius=shape.radius,
-            height=high - low,
-            resolution=96,
-            capping=False,
-        )
+        ring = _circle(shape.axis, shape.radius, ROUND)
+        points = np.vstack([point + low * shape.axis + ring, point + high * shape.axis + ring])
+        k = np.arange(ROUND)
+        quads = np.column_stack([k, (k + 1) % ROUND, ROUND + (k + 1) % ROUND, ROUND + k])
+        return Surface(points, _cells(quads))  # no end caps: the cylinder is infinite
     if shape.kind == "sphere":
-        return pyvista.Sphere(
-            radius=shape.radius, center=point, theta_resolution=64, phi_resolution=64
-        )
+        polar = np.linspace(0.0, np.pi, ROUND // 2 + 1)[1:-1]
+        axis = np.array([0.0, 0.0, 1.0])
+        rings = [shape.radius * np.cos(a) * axis + _circle(axis, shape.radius * np.sin(a), ROUND)
+                 for a in polar]  # fmt: skip
+        poles = np.array([axis, -axis]) * shape.radius
+        points = point + np.vstack([*rings, poles])
+        k, top, bottom = np.arange(ROUND), len(points) - 2, len(points) - 1
+        quads = [np.column_stack([r * ROUND + k, r * ROUND + (k + 1) % ROUND,
+                                  (r + 1) * ROUND + (k + 1) % ROUND, (r + 1) * ROUND + k])
+                 for r in range(len(polar) - 1)]  # fmt: skip
+        last = (len(polar) - 1) * ROUND
+        caps = [np.column_stack([np.full(ROUND, top), (k + 1) % ROUND, k]),
+                np.column_stack([np.full(ROUND, bottom), last + k, last + (k + 1) % ROUND])]
+        return Surface(points, np.concatenate([_cells(q) for q in (*quads, *caps)]))
     if shape.kind == "parallelogram":
         corners = point + np.array([[0, 0], [1, 0], [1, 1], [0, 1]]) @ shape.sides
     else:  # an infinite plane: under the body's footprint, with a margin
@@ -193,15 +241,30 @@ def wall_surface(pyvista, shape, offset: np.ndarray, body: np.ndarray, size: flo
         footprint = [[a.min(), b.min()], [a.max(), b.min()], [a.max(), b.max()], [a.min(), b.max()]]
         outward = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]])
         corners = point + (np.array(footprint) + margin * outward) @ [e1, e2]
-    return _slab(pyvista, corners, -SLAB * size * shape.normal)
+    return _slab(corners, -SLAB * size * shape.normal)
 
 
-def _slab(pyvista, corners: np.ndarray, depth: np.ndarray):
+def _circle(axis: np.ndarray, radius: float, n: int) -> np.ndarray:
+    """``n`` points (m) of the circle of ``radius`` round the origin, normal to ``axis``."""
+    first = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
+    first /= np.linalg.norm(first)
+    second = np.cross(axis, first)
+    angle = np.linspace(0.0, 2 * np.pi, n, endpoint=False)[:, None]
+    return radius * (np.cos(angle) * first + np.sin(angle) * second)
+
+
+def _cells(faces: np.ndarray) -> np.ndarray:
+    """VTK's legacy cell array of ``faces`` ((m, k) point indices)."""
+    faces = np.asarray(faces)
+    return np.column_stack([np.full(len(faces), faces.shape[1]), faces]).ravel()
+
+
+def _slab(corners: np.ndarray, depth: np.ndarray) -> Surface:
     """The closed box whose top face is the quadrilateral ``corners`` (4, 3) and whose
     bottom face is that face moved by ``depth`` (m)."""
     points = np.vstack([corners, corners + depth])
     faces = [[0, 1, 2, 3], [7, 6, 5, 4], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]]
-    return pyvista.PolyData(points, faces=np.hstack([[4, *f] for f in faces]))
+    return Surface(points, _cells(np.array(faces)))
 
 
 def _horizontal_axes(points: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

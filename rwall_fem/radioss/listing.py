@@ -6,8 +6,8 @@ A cell's step is its stable estimate ``L / c`` at rest, the one the run starts f
 (``docs/theory.md``): ``L`` its volume over its largest face area (a tetrahedron: three
 times that), ``c`` the dilatational wave speed of its material,
 ``sqrt(E (1 - nu) / (rho (1 + nu) (1 - 2 nu)))``; a shell's ``L`` is Radioss's L_c and
-``c`` the plate's in-plane speed ``sqrt(E / (rho (1 - nu^2)))``, its mass rho t A. The volume of a hexahedron is the
-2 x 2 x 2 Gauss integral of its Jacobian, exact for the trilinear map.
+``c`` Radioss's shell sound speed ``sqrt(E / rho)``, its mass rho t A. The volume of a
+hexahedron is the 2 x 2 x 2 Gauss integral of its Jacobian, exact for the trilinear map.
 """
 
 from __future__ import annotations
@@ -87,11 +87,10 @@ def starter_listing(deck: Deck, dt_scale: float) -> list[str]:
         for body in bodies:
             rows = deck.node_positions(body.nodes.ravel())
             x = deck.coordinates[rows].reshape(*body.nodes.shape, 3)
-            if body.cell in ("quadrilateral", "triangle"):  # the plate's in-plane speed
+            if body.cell in ("quadrilateral", "triangle"):  # Radioss's shell speed
                 area, length = shell_geometry(x)
                 volume = area * deck.properties[part.prop]["element"]["thickness"]
-                E, nu, rho = material["young"], material["poisson"], material["density"]
-                speed = float(np.sqrt(E / (rho * (1 - nu * nu))))
+                speed = float(np.sqrt(material["young"] / material["density"]))
             else:
                 volume, length = cell_geometry(x)
             name = body.card.key(0)

@@ -200,6 +200,7 @@ class Deck:
     dampings: list = field(default_factory=list)  # /DAMP (cards.loads.Damping)
     walls: list[Wall] = field(default_factory=list)
     rigid_bodies: list = field(default_factory=list)  # /RBODY (cards/rigid_bodies.py)
+    interfaces: list = field(default_factory=list)  # /INTER/TYPE7 (cards/interfaces.py)
     end_time: float | None = None  # s
     dt_scale: float | None = None
     dt_min: float | None = None  # s

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem.radioss.cards.rigid_bodies import scene_tables as rigid_body_tables
+from rwall_fem.radioss.contacts import contact_tables
 from rwall_fem.radioss.groups import node_ids, part_ids
 from rwall_fem.radioss.loads import load_groups, load_tables
 from rwall_fem.radioss.materials import element_table, material_table
@@ -87,6 +88,7 @@ def scene_of(deck: Deck) -> SceneParts:
     mains = {w.main_node for w in deck.walls if w.main_node}
     initial_velocities(deck, parts, mains)
     separate = len({(p.part.mat, p.part.prop) for p in parts}) > 1 or not uniform_velocity(parts)
+    separate = separate or (bool(deck.interfaces) and len(parts) > 1)  # contacts name parts
 
     facts = [
         f"units: input {deck.input_units.describe()}, work {deck.work_units.describe()} "
@@ -160,6 +162,8 @@ def scene_of(deck: Deck) -> SceneParts:
         raw["wall"] = walls
         for w, table in zip(deck.walls, walls, strict=True):
             facts.append(_wall_fact(w, table))
+    if deck.interfaces:
+        raw["contact"] = contact_tables(deck, parts, separate, facts)
     if deck.rigid_bodies:
         raw["rigid_body"] = rigid_body_tables(deck, atoms, by_parts, body_nodes, facts)
     facts.append(

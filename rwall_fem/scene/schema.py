@@ -852,7 +852,8 @@ def _cap_above_yield(v, raw, fail):
 _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 # The cells of a body of shells, and the keys of [element] for shells and for solids.
 SURFACE_CELLS = ("quadrilateral", "triangle")
-SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor")
+SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor",
+              "failed_share", "thickness_change")  # fmt: skip
 SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
@@ -917,6 +918,21 @@ class Element:
         None,
         doc="shells: the transverse shear factor",
         default_doc="5/6",
+    )
+    failed_share: float | None = key(
+        Real(low=0.0, high=1.0),
+        None,
+        doc="shells with [material.failure]: the share of a cell's points through the "
+        "thickness that must have failed for the cell to fail and erode (Radioss's "
+        "P_thickfail)",
+        default_doc="1 (every point)",
+    )
+    thickness_change: bool | None = key(
+        Flag(),
+        None,
+        doc="shells: the thickness follows the membrane strain, plastic flow keeping the "
+        "volume (Radioss's Ithick = 1); false: constant",
+        default_doc="false",
     )
 
 
@@ -1074,6 +1090,13 @@ class Motion:
     velocity: tuple = key(
         Velocity(), unit="m/s", doc="initial (with mass) or prescribed, constant or a history"
     )
+    held: str | None = key(
+        Letters(),
+        None,
+        doc="with mass: the global components of the main node's velocity kept at their "
+        "initial value (the main node of a half or quarter model on its symmetry planes)",
+        default_doc="none: the main node moves freely",
+    )
 
     @property
     def prescribed(self) -> bool:
@@ -1082,12 +1105,17 @@ class Motion:
 
 @rule(
     Motion,
-    json=[{"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}}],
+    json=[
+        {"if": {"required": ["mass"]}, "then": {"properties": {"velocity": Vector().json()}}},
+        {"if": {"not": {"required": ["mass"]}}, "then": {"not": {"required": ["held"]}}},
+    ],
 )
 def _table_without_mass(v, raw, fail):
-    """A velocity history prescribes the motion: no mass with it."""
+    """A velocity history prescribes the motion: no mass with it; `held` needs a mass."""
     if v["mass"] is not None and isinstance(v["velocity"][0], tuple):
         fail("mass", "a velocity table prescribes the motion: drop 'mass'")
+    if v["mass"] is None and v["held"] is not None:
+        fail("held", "a prescribed velocity holds every component: give 'mass' or drop 'held'")
 
 
 @table("The friction filter of Radioss: exactly one of its keys.", one_of=True)
@@ -1214,15 +1242,16 @@ class ContactSpec:
         Real(low=0.0),
         None,
         unit="m",
-        doc="the contact distance (Radioss Gapmin): forces act below it and stiffen toward "
-        "it, k0 g / (g - p) at penetration p",
-        default_doc="0.1 x the shortest edge of the segments",
+        doc="the contact distance (Radioss Gapmin), constant: forces act below it and stiffen "
+        "toward it, k0 g / (g - p) at penetration p",
+        default_doc="0.1 x the shortest edge of the segments; on shells a variable gap, half "
+        "the sum of the thicknesses (Radioss Igap 1)",
     )
     stiffness_scale: float = key(
         Real(low=0.0),
         1.0,
         doc="Radioss Stfac: scales the penalty stiffness k0 = B A^2 / V of the cell under "
-        "each segment",
+        "each segment (E t of a shell segment)",
     )
     damping: float = key(
         Real(low=0.0, low_open=False, high=1.0),

@@ -29,6 +29,7 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.elements import GhostedField
+from rwall_fem.erosion import ErodedParts
 from rwall_fem.kernels import STEP_SLOTS, load
 
 __all__ = ["FORMULATIONS", "ShellBody", "ShellPart", "ShellSection"]
@@ -47,17 +48,24 @@ FORMULATIONS = {
 class ShellSection:
     """A part's shell section (Radioss /PROP/SHELL): the element ``technology`` of the
     kernels (:class:`~rwall_fem.shells.elements.ShellTechnology`), the scene's
-    ``formulation``, the ``thickness`` (m) and the ``points`` through it."""
+    ``formulation``, the ``thickness`` (m) and the ``points`` through it; the share of
+    them that must fail for a cell to fail (``failed_share``, Radioss's P_thickfail), and
+    whether the thickness follows the membrane strain (``thickness_change``, Ithick = 1)."""
 
     technology: object
     formulation: str
     thickness: float
     points: int
+    failed_share: float = 1.0
+    thickness_change: bool = False
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilateral shells, 5 points through 0.002 m'."""
+        change = " (changing with the membrane strain)" if self.thickness_change else ""
+        share = (f", a cell failing when {100 * self.failed_share:.3g} % of its points have"
+                 if self.failed_share < 1.0 else "")  # fmt: skip
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
-                f"{self.thickness:g} m")  # fmt: skip
+                f"{self.thickness:g} m{change}{share}")  # fmt: skip
 
 
 @dataclass
@@ -85,7 +93,6 @@ class ShellBody:
     conservative = False  # the kernels' stresses follow a path (rate form)
     books_work = True
     corrects = False
-    erosion = None
     labels = None  # the update books the work of the body as a whole
     controlling_part = 0
 
@@ -103,7 +110,9 @@ class ShellBody:
         self.elements = [
             ShellForce(V, part.material, part.technology.technology, u, v, self.w,
                        thickness=part.technology.thickness, cells=part.cells, f=self.f,
-                       m=self.m, max_flow_stress=_cap(part.material))  # fmt: skip
+                       m=self.m, max_flow_stress=_cap(part.material),
+                       failed_share=part.technology.failed_share,
+                       thickness_change=part.technology.thickness_change)  # fmt: skip
             for part in parts
         ]
         self.nodal_force = self.f.owned
@@ -124,11 +133,40 @@ class ShellBody:
             else "shells: " + ", ".join(f"{p.name} {p.material.model}" for p in parts)
         )
         self.plastic = any(part.material.plastic for part in parts)
+        self._nodes = np.asarray(_compat.cell_nodes(V))  # each local cell's nodes
+        owned_nodes = V.dofmap.index_map.size_local
+        self._eroded = ErodedParts(parts, self.elements, self.held[:owned_nodes], owned)
+        self._name_energies()
+        self._free = None  # (owned nodes, 3): 0 where a rotation is held, else 1
+        self.turning = None  # (owned nodes,): 0 at a rigid body's nodes (their energy is its)
+        self._acceleration = None
+
+    def _name_energies(self) -> None:
+        """:attr:`energy_names` (the balance's: the rotations' kinetic, internal, hourglass
+        and, when cells may erode, eroded internal energies), :attr:`energy_parts` (beside
+        them: elastic and plastic work, the detached nodes' kinetic energy) and
+        :attr:`erosion` (None when no cell may erode)."""
+        erodes = any(force.erosion is not None for force in self.elements)
         self.energy_names = ("rotational_kinetic", "internal", "hourglass")
         self.energy_parts = ("elastic", "plastic_work") if self.plastic else ()
-        self._nodes = np.asarray(_compat.cell_nodes(V))  # each local cell's nodes
-        self._free = None  # (owned nodes, 3): 0 where a rotation is held, else 1
-        self._acceleration = None
+        if erodes:
+            self.energy_names += ("eroded_internal",)
+            self.energy_parts += ("eroded_kinetic",)
+        self.erosion = self._eroded if erodes else None
+
+    def erode_below(self, floor: float) -> None:
+        """From now on, erode the cells of every part whose step estimate falls below
+        ``floor`` (s), and inverted ones (``run.dt_min_action = "erode"``; collective)."""
+        for force in self.elements:
+            force.erode_below(floor)
+        self._name_energies()
+
+    def detach_nodes(self) -> None:
+        """Count the live cells of the nodes again after a step in which some rank eroded
+        cells (collective)."""
+        for force in self.elements:
+            if force.erosion is not None:
+                force.detach_nodes()
 
     # --- the step ----------------------------------------------------------------------
 
@@ -163,6 +201,22 @@ class ShellBody:
         if self._free is not None:
             self.alpha *= self._free
 
+    def scale_rotations(self, nodes: np.ndarray, ratio: np.ndarray) -> float:
+        """Mass scaling gave the owned ``nodes`` ``ratio`` times their mass: their
+        rotational inertia grows as much (else their rotations, whose inertia holds them
+        at the membrane's step, would set a step below dt_min), their angular momentum is
+        kept, w' = w / ratio, and the kinetic energy this costs is returned (J, <= 0, this
+        rank; :mod:`rwall_fem.mass_scaling`)."""
+        before = self.inertia[nodes, 1].copy()
+        w = self.w.owned[nodes]
+        keep = (1.0 / ratio)[:, None]
+        work = 0.5 * float(np.sum(before[:, None] * w * w * (keep - 1.0)))
+        self.inertia[nodes] *= ratio[:, None]
+        self.inv_inertia[nodes] = 1.0 / self.inertia[nodes, 1]
+        self.w.owned[nodes] = w * keep
+        self.alpha[nodes] *= keep
+        return work
+
     def hold_rotations(self, nodes: np.ndarray, axes: str) -> None:
         """Hold the rotations of the owned ``nodes`` about the global ``axes`` (some of
         "xyz") fixed: their angular velocity stays 0, the reaction moment does no work (a
@@ -188,6 +242,8 @@ class ShellBody:
                 step[6] = part.cells[int(force.step[6])]
                 step[7:10] = force.step[7:10]
             step[5] += force.step[5]
+            step[10] += force.step[10]
+            step[11] += force.step[11]
 
     def book(self, state, first: float, second: float) -> None:
         """After the update of step n: book the work of the forces and moments at mid-step
@@ -204,17 +260,23 @@ class ShellBody:
 
     def energies(self, state) -> dict[str, float]:
         """This rank's energies (J) at step n: the rotations' shadow kinetic energy, the
-        internal energy (the work of the forces and moments less the hourglass energy)
-        and the hourglass energy."""
+        internal energy (the work of the forces and moments less the hourglass energy and
+        what eroded cells took with them), the hourglass energy and, when cells may erode,
+        the eroded cells' internal energy and the detached nodes' kinetic energy
+        (:mod:`rwall_fem.erosion`: as for solids)."""
         hourglass = sum(force.hourglass_energy for force in self.elements)
+        eroded = sum(force.eroded_energy for force in self.elements)
         energies = {
             "rotational_kinetic": self.rotational_kinetic,
-            "internal": self._latest - hourglass,
+            "internal": self._latest - hourglass - eroded,
             "hourglass": hourglass,
         }
         if self.plastic:
             energies["elastic"] = sum(force.stored_energy for force in self.elements)
             energies["plastic_work"] = sum(force.plastic_work for force in self.elements)
+        if self.erosion is not None:
+            energies["eroded_internal"] = eroded
+            energies["eroded_kinetic"] = self._eroded.kinetic_energy(state)
         return energies
 
     def part_columns(self) -> tuple[str, ...]:
@@ -297,12 +359,6 @@ class ShellBody:
         """Every owned cell's stable step estimate at rest (s), part after part."""
         return np.concatenate([force.steps_at_rest() for force in self.elements])
 
-    def erode_below(self, floor: float) -> None:
-        raise NotImplementedError("shells do not erode")
-
-    def detach_nodes(self) -> None:
-        """Nothing to detach: shells do not erode."""
-
     def cell_position(self, cell: int) -> np.ndarray:
         """The centroid (m) of the owned ``cell`` (its local index) at X + u."""
         nodes = self._nodes[cell]
@@ -323,10 +379,12 @@ class ShellBody:
     # --- checkpoints -------------------------------------------------------------------
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The angular velocity w^{n+1/2}, the books of the work, the rotations' latest
-        kinetic energy and each part's kernel state."""
+        """The angular velocity w^{n+1/2}, the nodes' masses and rotational inertias (mass
+        scaling changes them), the books of the work, the rotations' latest kinetic energy
+        and each part's kernel state."""
         arrays = {
             "w": self.w.owned,
+            "inertia": self.inertia,
             "books": np.array([self._done, self._latest, self.rotational_kinetic]),
         }
         for k, force in enumerate(self.elements):
@@ -335,6 +393,9 @@ class ShellBody:
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self.w.owned[:] = arrays["w"]
+        if "inertia" in arrays:
+            self.inertia[...] = arrays["inertia"]
+            self.inv_inertia[:] = 1.0 / self.inertia[:, 1]
         self._done, self._latest, self.rotational_kinetic = arrays["books"].tolist()
         for k, force in enumerate(self.elements):
             prefix = f"part{k}_"

@@ -36,7 +36,8 @@ def solid_keys_on_shells(scene, cell: str) -> None:
     volume mesh (a scene mixes no shells and solids in one mesh)."""
     for where, element in _element_tables(scene):
         given = {name: getattr(element, name) for name in
-                 (*_SOLID_VALUES, "thickness", "formulation")}  # fmt: skip
+                 (*_SOLID_VALUES, "thickness", "formulation", "failed_share",
+                  "thickness_change")}  # fmt: skip
         given = {name: value for name, value in given.items() if value is not None}
         wrong = element_fits_the_surface(where, given, cell)
         if wrong:
@@ -49,31 +50,6 @@ def _element_tables(scene):
     tables = [("element", scene.element)]
     tables += [(f"part[{i}].element", p.element) for i, p in enumerate(scene.parts) if p.element]
     return tables
-
-
-def _unsupported(scene) -> None:
-    """What shells do not do yet, refused in one line naming the key."""
-    run = scene.run
-    if run.dt_min_action in ("mass_scaling", "erode"):
-        raise SceneError(
-            f"{scene.source}: run.dt_min_action: {run.dt_min_action!r} is for solids; a body "
-            "of shells stops at run.dt_min ('stop')"
-        )
-    for table, given in (("rigid_body", scene.rigid_bodies), ("load", scene.loads),
-                         ("added_mass", scene.added_masses), ("damping", scene.damping),
-                         ("contact", scene.contacts)):  # fmt: skip
-        if given:
-            raise SceneError(
-                f"{scene.source}: {table}: is for solids; a body of shells has no "
-                f"{table.replace('_', ' ')} yet (leave it out)"
-            )
-    for i, spec in enumerate(scene.body_parts):
-        where = f"part[{i}].material" if scene.parts else "material"
-        if getattr(spec.material, "failure", None) is not None:
-            raise SceneError(
-                f"{scene.source}: {where}.failure: shells do not fail and erode yet; leave "
-                "it out"
-            )
 
 
 def _section(scene, i: int, spec, cell: str) -> ShellSection:
@@ -104,7 +80,9 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
         said = str(err)
         said = where + said[len("element") :] if said.startswith("element.") else f"{where}: {said}"
         raise SceneError(f"{scene.source}: {said}") from None
-    return ShellSection(technology, formulation, thickness, points)
+    failed_share = 1.0 if element.failed_share is None else element.failed_share
+    return ShellSection(technology, formulation, thickness, points, failed_share,
+                        bool(element.thickness_change))  # fmt: skip
 
 
 # The sides of DOLFINx's triangle and quadrilateral, by local node index.
@@ -128,7 +106,6 @@ def shell_solid(scene, comm: MPI.Comm, body):
 
     cell = body.msh.topology.cell_type.name
     solid_keys_on_shells(scene, cell)
-    _unsupported(scene)
     specs = scene.body_parts
     sections = [_section(scene, i, spec, cell) for i, spec in enumerate(specs)]
     try:
@@ -152,6 +129,16 @@ def shell_solid(scene, comm: MPI.Comm, body):
     ]
     masses = np.column_stack([inertia[:, 0] for inertia in inertias])
     inertia = sum(inertias)
+    if scene.added_masses:  # point masses: no rotational inertia; shared as solids share them
+        from rwall_fem.build import _named_nodes
+        from rwall_fem.loads import added_masses
+
+        owned = len(X)
+        added = added_masses(scene.added_masses, lambda i, name: _named_nodes(
+            scene, f"added_mass[{i}]", name, V, body, owned), owned, comm)  # fmt: skip
+        total = masses.sum(axis=1)
+        masses = masses + added[:, None] * masses / np.where(total > 0, total, 1.0)[:, None]
+        inertia[:, 0] += added
     lowest = comm.allreduce(float(inertia[:, 0].min(initial=np.inf)), op=MPI.MIN)
     if not lowest > 0.0:
         raise SceneError(

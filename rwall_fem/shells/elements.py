@@ -16,7 +16,8 @@ DOLFINx surface mesh, shaped like :class:`~rwall_fem.elements.ElementForce`.
 
 Nodes have 6 degrees of freedom: translations, and rotations whose angular velocities
 (rad/s, global frame) the kernels read; they write the internal force (N) and moment
-(N m) of each node. The element has no drilling stiffness (no moment about its normal).
+(N m) of each node. The elements have no drilling stiffness (no moment about their normal)
+unless :attr:`ShellTechnology.drilling_stiffness` gives the quadrilaterals drilling springs.
 """
 
 from __future__ import annotations
@@ -61,6 +62,9 @@ typedef struct {
   int warping, omit_energy;
   double hk;
   int hourglass_slot;
+  double kd;
+  int drill_slot;
+  double *new_thickness;
 } shell_params;
 """
     + "".join(
@@ -190,11 +194,14 @@ class ShellTechnology:
     shear_factor: float = 5.0 / 6.0
     # elastic hourglass stiffness (quadrilaterals; 0: viscous only, shell_quad.c)
     hourglass_stiffness: float = 0.0
+    # drilling stiffness over G t A (quadrilaterals; 0: none, shell_quad.c)
+    drilling_stiffness: float = 0.0
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
                hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
-               hourglass_stiffness: float = 0.0) -> ShellTechnology:
+               hourglass_stiffness: float = 0.0,
+               drilling_stiffness: float = 0.0) -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -217,8 +224,14 @@ class ShellTechnology:
             raise ValueError(
                 f"element.hourglass_stiffness: must be >= 0, got {hourglass_stiffness}"
             )
+        if not drilling_stiffness >= 0.0:
+            raise ValueError(
+                f"element.drilling_stiffness: must be >= 0, got {drilling_stiffness}"
+            )
+        quad = cell == "quadrilateral"
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
-                   float(hourglass_stiffness) if cell == "quadrilateral" else 0.0)  # fmt: skip
+                   float(hourglass_stiffness) if quad else 0.0,
+                   float(drilling_stiffness) if quad else 0.0)  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -240,7 +253,8 @@ class ShellKernel:
     ``material`` needs ``young``, ``poisson``, ``density`` and, elasto-plastic (``plastic``),
     the hardening constants of :class:`rwall_fem.scene.Material`; ``max_flow_stress`` (Pa)
     caps the flow stress (inf: no cap), ``failed_share`` is the share of a cell's points that
-    must fail for the cell to fail (1: all).
+    must fail for the cell to fail (1: all); ``thickness_change``: the kernels update
+    :attr:`thickness` from the membrane strain (Radioss's Ithick = 1, ``shell.h``).
     """
 
     def __init__(
@@ -252,6 +266,7 @@ class ShellKernel:
         *,
         max_flow_stress: float = math.inf,
         failed_share: float = 1.0,
+        thickness_change: bool = False,
     ):
         if not material.plastic and material.model != "linear_elastic":
             raise ValueError(
@@ -263,7 +278,7 @@ class ShellKernel:
         self.plastic = bool(material.plastic)
         self.cells = np.ascontiguousarray(cells, dtype=np.int32)
         n = self.num_cells = len(self.cells)
-        self.thickness = np.ascontiguousarray(np.broadcast_to(thickness, (n,)), dtype=np.float64)
+        self.thickness = np.array(np.broadcast_to(thickness, (n,)), dtype=np.float64)  # own copy
         if not np.all(self.thickness > 0.0):
             raise ValueError("element.thickness: must be > 0")
         E, nu, rho = float(material.young), float(material.poisson), float(material.density)
@@ -278,11 +293,13 @@ class ShellKernel:
         self.shell = s = ffi.new("shell_params *")
         s.thickness = ffi.cast("double *", self.thickness.ctypes.data)
         s.young, s.poisson, s.shear_factor = E, nu, technology.shear_factor
-        s.bar_speed = math.sqrt(E / (rho * (1 - nu * nu)))
+        # Radioss's shell sound speed (PM(27) = sqrt(E / rho), the engine's CDT3 and CNDT3):
+        # the step L_c / c is sqrt(1 - nu^2) times longer than with the plate speed.
+        s.bar_speed = math.sqrt(E / rho)
         s.hm, s.hf, s.hr = technology.hourglass
         s.warping = int(technology.formulation == "bwc")
         if not 0.0 < failed_share <= 1.0:
-            raise ValueError(f"failure.thickness_share: must be in (0, 1], got {failed_share}")
+            raise ValueError(f"element.failed_share: must be in (0, 1], got {failed_share}")
         s.fail_fraction = failed_share
         self.failure = getattr(material, "failure", None) if self.plastic else None
         if self.plastic:
@@ -295,9 +312,16 @@ class ShellKernel:
             s.points = 0
             self.history = np.zeros((8, n))
         s.hk = technology.hourglass_stiffness
+        self.thickness_change = bool(thickness_change)
+        if self.thickness_change:
+            s.new_thickness = ffi.cast("double *", self.thickness.ctypes.data)
         if s.hk > 0.0:  # the elastic hourglass forces, in rows after the others
             s.hourglass_slot = len(self.history)
             self.history = np.concatenate([self.history, np.zeros((5, n))])
+        s.kd = technology.drilling_stiffness
+        if s.kd > 0.0:  # the nodal drilling moments, in rows after the others
+            s.drill_slot = len(self.history)
+            self.history = np.concatenate([self.history, np.zeros((4, n))])
         self.family = FAMILY[technology.cell]
         law = "plastic" if self.plastic else "elastic"
         self.name = f"shell_{self.family}_{law}"
@@ -452,7 +476,7 @@ class ShellForce:
 
     def __init__(self, V, material, technology: ShellTechnology, u, v, w, *, thickness,
                  cells=None, f=None, m=None, max_flow_stress: float = math.inf,
-                 failed_share: float = 1.0):  # fmt: skip
+                 failed_share: float = 1.0, thickness_change: bool = False):  # fmt: skip
         from rwall_fem import _compat
         from rwall_fem.elements import GhostedField
 
@@ -474,13 +498,14 @@ class ShellForce:
         thickness = thickness[self.cell_ids] if cells is not None else thickness
         self.kernel = k = ShellKernel(
             material, technology, nodes, thickness, max_flow_stress=max_flow_stress,
-            failed_share=failed_share,
+            failed_share=failed_share, thickness_change=thickness_change,
         )  # fmt: skip
         self.plastic, self.failure = k.plastic, k.failure
         self.params, self.ffi = k.params, k.ffi
         self.cells, self.num_cells = k.cells, k.num_cells
         self.history = k.history
         self.area0, self.length0 = k.sizes(self.X)
+        self.volume0 = self.area0 * k.thickness  # m^3, at rest
         self.step = np.zeros(STEP_SLOTS)
         self._energy = np.zeros(4)
         self.erosion = None
@@ -523,6 +548,26 @@ class ShellForce:
         if self.erosion is None:
             self._erode()
             self._kernel = self._bind()
+
+    def list_cells_below(self, floor: float, factor: np.ndarray) -> None:
+        """From now on, scale each cell's step estimate by ``factor`` (per cell, sqrt of its
+        mass over its mass at rest) and list the cells whose scaled step is below ``floor``
+        (s) in :attr:`below` and :attr:`below_step` (their steps before scaling), the first
+        ``int(step[10])`` entries: mass scaling (:mod:`rwall_fem.mass_scaling`)."""
+        self.below = np.zeros(self.num_cells, dtype=np.int32)
+        self.below_step = np.zeros(self.num_cells)
+        self._factor = factor
+        p, ffi = self.params, self.ffi
+        p.step_factor = ffi.cast("double *", factor.ctypes.data)
+        p.step_floor = floor
+        p.below = ffi.cast("int32_t *", self.below.ctypes.data)
+        p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
+
+    @property
+    def damage(self) -> np.ndarray:
+        """The damage of every point (points, cells): with a failure criterion."""
+        start = self.params.damage_slot
+        return self.history[start : start + self.kernel.points]
 
     def steps_at_rest(self) -> np.ndarray:
         """Each owned cell's stable step estimate at rest (s): calibration x L_c / c_bar."""
@@ -579,7 +624,7 @@ class ShellForce:
         xx, yy, xy in the cell's local frame, Pa; of the outermost and middle points for
         elasto-plastic cells, the surfaces' for elastic ones), ``von_mises_stress`` (the
         largest of the three), and elasto-plastic ``plastic_strain`` (the largest of the
-        points'), ``damage`` (the largest), ``eroded``."""
+        points'), ``damage`` (the largest), ``eroded``; ``thickness`` (m) when it changes."""
         sig = self.kernel.point_stresses()
         surfaces = sig[[0, len(sig) // 2, -1]]
         fields = {
@@ -591,14 +636,17 @@ class ShellForce:
         if self.plastic:
             fields["plastic_strain"] = self.kernel.plastic_strains().max(axis=0)
         if self.failure is not None:
-            start = self.params.damage_slot
-            fields["damage"] = self.history[start : start + self.kernel.points].max(axis=0)
+            fields["damage"] = self.damage.max(axis=0)
+        if self.kernel.thickness_change:
+            fields["thickness"] = self.kernel.thickness.copy()
         if self.erosion is not None:
             fields["eroded"] = (~self.erosion.alive).astype(float)
         return fields
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         arrays = {"energy": self._energy, "step": self.step, "history": self.history}
+        if self.kernel.thickness_change:
+            arrays["thickness"] = self.kernel.thickness
         if self.erosion is not None:
             arrays |= {f"erosion_{k}": v for k, v in self.erosion.checkpoint_state().items()}
         return arrays
@@ -607,6 +655,8 @@ class ShellForce:
         self._energy[:] = arrays["energy"]
         self.step[:] = arrays["step"]
         self.history[...] = arrays["history"]
+        if self.kernel.thickness_change:
+            self.kernel.thickness[:] = arrays["thickness"]
         if self.erosion is not None:
             e, prefix = self.erosion, "erosion_"
             e.restore_state(

@@ -35,6 +35,9 @@ class ShellUpdate(CentralDifference):
         self._w_old[:] = w
         first = float(np.einsum("ij,ij->", moments, w))
         w += state.dt_velocity * alpha
+        turning = getattr(body, "turning", None)  # 0 at a rigid body's nodes: its energy
+        if turning is not None:
+            inertia = inertia * turning
         body.rotational_kinetic = 0.5 * float(
             np.einsum("i,ij,ij->", inertia, self._w_old, w)
         )

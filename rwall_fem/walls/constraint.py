@@ -28,6 +28,9 @@ the same step: the wall's velocity over the step solves
 the identity for tied nodes; b_i the target normal velocity), i.e. the wall
 moves with the mass of the nodes it treats: the reference's one-step mass
 coupling, without its lag of one step. Tied and sticking nodes then follow the wall exactly.
+The components the motion holds (``held``: a main node on the symmetry planes of a half or
+quarter model) keep their velocity: their rows of that system are V_j = V*_j, and what
+the nodes push along them goes to the planes (as the reaction of a boundary condition).
 
 Energy: the work of the contact impulses is booked at mid-step velocities
 relative to the wall, 1/2 I . (w^{n-1/2} + w^{n+1/2}) with w = v - V, split into
@@ -300,6 +303,7 @@ class RigidWall:
         if motion.dynamic:
             # The main node takes exactly what the nodes received (momentum to round-off).
             final = predicted - self.comm.allreduce(impulse_sum) / motion.mass
+            final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
         before = motion.velocity
         motion.advance(final, dt)
         self.normal_work += 0.5 * passes.work(normal, before)
@@ -397,7 +401,7 @@ class RigidWall:
         if extra is not None:
             rhs -= extra.sum(axis=0)
         total = self.comm.allreduce(np.concatenate([matrix.ravel(), rhs]))
-        mass = self.motion.mass
-        return np.linalg.solve(
-            mass * np.eye(3) + total[:9].reshape(3, 3), mass * predicted + total[9:]
-        )
+        mass, held = self.motion.mass, self.motion.held
+        matrix, rhs = mass * np.eye(3) + total[:9].reshape(3, 3), mass * predicted + total[9:]
+        matrix[held], rhs[held] = np.eye(3)[held], predicted[held]  # held components
+        return np.linalg.solve(matrix, rhs)

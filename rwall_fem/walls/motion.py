@@ -58,16 +58,19 @@ class _Translating(FixedMotion):
 class MainNodeMotion(_Translating):
     """A wall carried by a main node of ``mass`` (kg) starting at ``velocity`` (m/s).
 
-    Contact impulses act on the main node by momentum conservation.
+    Contact impulses act on the main node by momentum conservation, but for the global
+    components ``held`` (some of "xyz"), which keep their initial velocity: the main node
+    of a half or quarter model lies on its symmetry planes, and may not leave them.
     """
 
     dynamic = True
 
-    def __init__(self, mass: float, velocity):
+    def __init__(self, mass: float, velocity, held: str = ""):
         super().__init__()
         self.mass = float(mass)
         self.velocity = np.asarray(velocity, dtype=float).copy()
         self.previous_velocity = self.velocity.copy()
+        self.held = np.array(["xyz".index(c) for c in held], dtype=int)
 
 
 class PrescribedMotion(_Translating):

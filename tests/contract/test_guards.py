@@ -190,6 +190,7 @@ def test_pictures_that_fail_to_render_leave_the_other_outputs(shared_dir, monkey
         return subprocess.CompletedProcess(args, 1, "", "Traceback\nRuntimeError: no display")
 
     monkeypatch.setattr(rwall_fem.output.frames.subprocess, "run", failed_render)
+    monkeypatch.setenv("RWALL_FEM_RENDER", "inline")  # the renderer started after the loop
     out = Path(shared_dir)
     if MPI.COMM_WORLD.rank == 0:
         (out / "scene.toml").write_text(SCENE)

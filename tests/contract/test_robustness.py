@@ -123,8 +123,11 @@ def _stopped(process, sig, ranks=1) -> list[str]:
     assert "Traceback" not in stderr
     openmpi = ranks > 1 and not mpi_launch(ranks)[0][0].endswith("mpiexec")
     assert process.returncode == (1 if openmpi else 3), stderr
-    time.sleep(0.5)
-    left = {pid for pid in started if _alive(pid)}
+    # The launcher's daemon and the ranks it kills end within a moment of the command, a
+    # moment that a loaded machine stretches: each must be gone within seconds.
+    deadline = time.monotonic() + 10.0
+    while (left := {pid for pid in started if _alive(pid)}) and time.monotonic() < deadline:
+        time.sleep(0.05)
     assert not left, f"left running: {left}"
     return ours
 

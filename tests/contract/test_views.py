@@ -227,3 +227,109 @@ def test_a_body_that_erodes_away_ends_normally_drawn_as_points(shared_dir, cells
         assert not coloured.any()  # no cell is left to draw
     else:
         assert coloured.sum() > 100  # the strong half is drawn
+
+
+# --- the renderer beside the time loop (rwall_fem.output.worker) ---------------------------
+
+
+def _partial_files(directory) -> list[Path]:
+    """Files left half-written (rwall_fem.output.atomic's hidden partial names)."""
+    return sorted(Path(directory).rglob(".*.partial.*"))
+
+
+def test_the_renderer_beside_the_loop_draws_what_the_renderer_after_it_draws(
+    shared_dir, monkeypatch
+):
+    """RWALL_FEM_RENDER=worker (on 2 ranks too: rank 0 feeds it): every frame is drawn,
+    pixel for pixel as ``render`` draws the same folder after the run, and no partial file
+    is left."""
+    monkeypatch.setenv("RWALL_FEM_RENDER", "worker")
+    raw = taylor_scene()
+    raw["run"]["end_time"] = 2e-6
+    sim = build_simulation(parse_scene(raw, source="test"), COMM, shared_dir)
+    assert sim.run() == "done"
+    if COMM.rank != 0:
+        return
+    beside = _pictures(shared_dir)
+    assert len(beside) == 3 and not _partial_files(shared_dir)
+    result = _render(shared_dir, "--color", "plastic_strain")
+    assert result.returncode == 0, result.stderr
+    after = _pictures(shared_dir)
+    assert all(np.array_equal(a, b) for a, b in zip(beside, after, strict=True))
+
+
+def test_a_renderer_beside_the_loop_that_fails_is_replaced(shared_dir, monkeypatch, capfd):
+    """A renderer beside the loop that dies at once: the run goes on, says so in one
+    warning line at the end, and draws every frame after the loop."""
+    from rwall_fem.output import worker
+
+    monkeypatch.setenv("RWALL_FEM_RENDER", "worker")
+    monkeypatch.setattr(worker, "renderer_command", lambda *args: [
+        sys.executable, "-c", "import sys; sys.exit('the renderer broke')"])  # fmt: skip
+    raw = taylor_scene()
+    raw["run"]["end_time"] = 2e-6
+    sim = build_simulation(parse_scene(raw, source="test"), COMM, shared_dir)
+    assert sim.run() == "done"
+    if COMM.rank != 0:
+        return
+    err = capfd.readouterr().err
+    assert "warning: the renderer beside the run failed (the renderer broke)" in err
+    assert len(_pictures(shared_dir)) == 3 and not _partial_files(shared_dir)
+
+
+class _Breaks:
+    """A recorder that fails at the first step past ``time`` (s): a run failing midway."""
+
+    def __init__(self, time: float):
+        self.time = time
+
+    def due(self, state) -> bool:
+        return state.t > self.time
+
+    def record(self, sim, state) -> None:
+        raise RuntimeError("broken midway")
+
+    def close(self, sim) -> None:
+        """Nothing to close."""
+
+
+def test_a_run_failing_midway_keeps_every_frame_written(shared_dir, monkeypatch):
+    """A run that fails at half its time, with the renderer beside the loop: the error
+    reaches the caller, and each frame stored before it is drawn, whole."""
+    monkeypatch.setenv("RWALL_FEM_RENDER", "worker")
+    raw = taylor_scene()
+    raw["output"]["frames"] = 5
+    sim = build_simulation(parse_scene(raw, source="test"), COMM, shared_dir)
+    sim.recorders.append(_Breaks(0.5 * raw["run"]["end_time"]))
+    with pytest.raises(RuntimeError, match="broken midway"):
+        sim.run()
+    if COMM.rank != 0:
+        return
+    stored = sorted((Path(shared_dir) / "frames" / "data").glob("frame_*.npz"))
+    assert len(stored) == 3  # at 0, 2 and 4 us of 8
+    assert len(_pictures(shared_dir)) == 3 and not _partial_files(shared_dir)
+
+
+def test_a_renderer_whose_run_is_gone_draws_nothing(shared_dir):
+    """``render DIR --follow PID`` (what the run starts): when its stdin ends before
+    ``end`` it leaves at once without drawing; when PID is not its parent (the run was
+    killed) it ends itself (exit 3) without drawing."""
+    raw = taylor_scene()
+    raw["run"]["end_time"] = 2e-6
+    build_simulation(parse_scene(raw, source="test"), COMM, shared_dir).run()
+    if COMM.rank != 0:
+        return
+    for png in (Path(shared_dir) / "frames").glob("frame_*.png"):
+        png.unlink()
+    command = [sys.executable, "-m", "rwall_fem.output.render", str(shared_dir), "--follow"]
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMI", "PMIX"))}
+    left = subprocess.run([*command, str(os.getpid())], input="", env=env, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert left.returncode == 0, left.stderr
+    orphan = subprocess.Popen([*command, "1"], stdin=subprocess.PIPE, env=env,
+                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+    orphan.wait(timeout=120)  # its stdin open: it ends by itself
+    err = orphan.stderr.read()
+    orphan.stdin.close()
+    assert orphan.returncode == 3 and "terminated by SIGTERM" in err, err
+    assert not _pictures(shared_dir) and not _partial_files(shared_dir)

@@ -66,7 +66,7 @@ def no_material(lines):
 
 def unsupported(lines):
     k = line_of(lines, "/PROP")
-    lines[k:k] = ["/INTER/TYPE7/1", "contact", "         1         2"]
+    lines[k:k] = ["/RBE2/1", "a rigid element", "         1         2"]
 
 
 def unknown(lines):
@@ -151,9 +151,9 @@ CASES = {
     "ID that refers to nothing": (dangling_mat, "/PART", r"mat_ID 7 refers to no /MAT"),
     "part without a material": (no_material, "/PART", r"part 1 has no material"),
     "a card of physics not read": (
-        unsupported, "/INTER/TYPE7/1",
-        r"/INTER/TYPE7/1: contact interfaces are not read: bodies meet rigid walls \(/RWALL\) "
-        r"only; the cards read: docs/radioss.md",
+        unsupported, "/RBE2/1",
+        r"/RBE2/1: kinematic conditions of this kind are not read: /BCS and /IMPVEL are; the "
+        r"cards read: docs/radioss.md",
     ),
     "an unknown card": (
         unknown, "/XYZ/1", r"/XYZ/1: unsupported card; the starter cards read are /BEGIN, /UNIT",

@@ -131,16 +131,35 @@ def test_bcs_rotation_codes_hold_the_shells_rotations(shared_dir):
         (lambda lines: _replace(lines, "/PROP/SHELL/1", 4, i10(5) + i10(0) + f20(0.0)),
          "Thick = 0 m: a shell needs a thickness > 0"),
         (lambda lines: _replace(lines, "/PROP/SHELL/1", 4, i10(11)), "N = 11: 1 to 10 points"),
+        (lambda lines: _replace(lines, "/PROP/SHELL/1", 4, i10(5) + i10(0) + f20(1.0)
+                                + f20(0.0) + " " * 10 + i10(3)), "Ithick = 3: 1 "),
+        (lambda lines: _replace(lines, "/PROP/SHELL/1", 2, i10(1) + i10(0) * 4 + " " * 10
+                                + f20(1.5)), "P_thickfail = 1.5: a share"),
         (lambda lines: _replace(lines, "/SHELL/1", 1, i10(1) + i10(1) * 2 + i10(10) + i10(11)),
          "element 1 repeats a node"),
     ],
-    ids=["ishell", "thickness", "points", "degenerate"],
+    ids=["ishell", "thickness", "points", "ithick", "thickfail", "degenerate"],
 )
 def test_bad_shell_cards_are_one_line(edit, message, shared_dir):
     path = written(plate_deck(), shared_dir, edit)
     with pytest.raises(DeckError, match=message) as caught:
         load_deck(path)
     assert "\n" not in str(caught.value) and "model_0000.rad:" in str(caught.value)
+
+
+def test_ithick_and_p_thickfail_map_onto_the_element(shared_dir):
+    """Ithick = 1: the thickness follows the membrane strain; P_thickfail: the share of the
+    points through the thickness that fail a cell."""
+
+    def edit(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, i10(1) + i10(0) * 4 + " " * 10 + f20(0.6))
+        _replace(lines, "/PROP/SHELL/1", 4, i10(5) + i10(0) + f20(1.0) + f20(0.0) + " " * 10
+                 + i10(1))  # fmt: skip
+
+    scene = load_deck(written(plate_deck(), shared_dir, edit))
+    assert scene.element.thickness_change is True
+    assert scene.element.failed_share == pytest.approx(0.6, rel=1e-15)
+    assert load_deck(written(plate_deck(), shared_dir)).element.thickness_change is None
 
 
 def test_a_solid_property_on_shells_and_shells_beside_solids_are_refused(shared_dir):

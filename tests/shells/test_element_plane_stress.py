@@ -136,6 +136,34 @@ def test_return_equals_the_3d_return_with_sigma_zz_zero(de, sigma0, eps_p0):
     assert q == pytest.approx(A + B * eps_p**N, rel=1e-10)  # on the yield surface
 
 
+@pytest.mark.parametrize("exponent", [0.1, 0.3])
+def test_return_is_on_the_yield_surface(exponent):
+    """Random trial stresses at random plastic strains, virgin points barely past yield
+    among them (a power law's slope is infinite at eps_p = 0, its increment there may be
+    1e-30): after the return the von Mises stress equals the law's flow stress at the new
+    plastic strain to 1e-12."""
+    k = kernel(material(hardening_exponent=exponent))
+    rng = np.random.default_rng(7)
+    worst, flowed = 0.0, 0
+    for trial in range(1500):
+        eps_p0 = (0.0, 1e-6, 1e-3, 0.05, 0.5)[trial % 5]
+        direction = rng.normal(size=3)
+        sigma0 = direction / von_mises(direction) * (A + B * eps_p0**exponent)
+        sigma0 *= rng.uniform(0.8, 1.0)
+        de = rng.normal(size=3) * 10 ** rng.uniform(-6, -2)
+        sigma, eps_p, _, _ = k.point(sigma0, eps_p0, 0.0, de)
+        if eps_p > eps_p0:
+            flowed += 1
+            flow = A + B * eps_p**exponent
+            worst = max(worst, abs(von_mises(sigma) - flow) / flow)
+    assert flowed > 300
+    assert worst <= 1e-12
+
+
+def von_mises(sigma):
+    return math.sqrt(sigma[0] ** 2 + sigma[1] ** 2 - sigma[0] * sigma[1] + 3 * sigma[2] ** 2)
+
+
 def test_flow_stress_cap():
     """Radioss LAW2's SIG_max0: the uniaxial stress rises along the law up to the cap and
     stays there."""

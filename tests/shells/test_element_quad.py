@@ -65,14 +65,17 @@ def rigid_run(kernel, X, steps=60, angle=3.0, dt=1e-4):
     return worst, energy
 
 
-@pytest.mark.parametrize("stiffness", [0.0, 0.1], ids=["viscous", "elastic-hourglass"])
+@pytest.mark.parametrize("stiffness", [(0.0, 0.0), (0.1, 0.0), (0.1, 0.01)],
+                         ids=["viscous", "elastic-hourglass", "drilling"])  # fmt: skip
 @pytest.mark.parametrize("material", [ELASTIC, J2], ids=["elastic", "j2"])
 @pytest.mark.parametrize("n", [1, 3])
 def test_rigid_motion_strains_nothing(material, n, stiffness):
     """A cell (n = 1, warped) and an irregular warped patch translated and turned through
-    3 rad: no force, no moment, no energy (relative to those of a strain of 1e-3)."""
+    3 rad: no force, no moment, no energy (relative to those of a strain of 1e-3); with
+    the elastic hourglass forces and the drilling springs too."""
     X, cells = (WARPED, np.array([[0, 1, 2, 3]], np.int32)) if n == 1 else patch(n)
-    technology = ShellTechnology.choose("quadrilateral", hourglass_stiffness=stiffness)
+    technology = ShellTechnology.choose("quadrilateral", hourglass_stiffness=stiffness[0],
+                                        drilling_stiffness=stiffness[1])  # fmt: skip
     kernel = ShellKernel(material, technology, cells, T)
     worst, energy = rigid_run(kernel, X)
     force_scale = E * T * 1e-3 * 1.0  # N: a membrane strain of 1e-3 over a 1 m edge
@@ -101,13 +104,15 @@ def test_warping_correction_against_plain_bt():
 
 @pytest.mark.parametrize("formulation", ["bwc", "bt"])
 def test_forces_of_any_motion_are_in_equilibrium(formulation):
-    """Random resultants and random nodal velocities on the warped cell: zero resultant
-    force and moment (nodal moments included) with the projection; plain BT's hourglass
-    forces of the in-plane velocities at the warped nodes' heights leave a moment."""
+    """Random resultants, drilling moments and random nodal velocities on the warped cell:
+    zero resultant force and moment (nodal moments included) with the projection; plain BT's
+    hourglass forces of the in-plane velocities at the warped nodes' heights leave a
+    moment."""
     cells = np.array([[0, 1, 2, 3]], np.int32)
-    kernel = ShellKernel(ELASTIC, ShellTechnology.choose("quadrilateral", formulation), cells, T)
+    technology = ShellTechnology.choose("quadrilateral", formulation, drilling_stiffness=0.01)
+    kernel = ShellKernel(ELASTIC, technology, cells, T)
     rng = np.random.default_rng(3)
-    kernel.history[:, 0] = rng.normal(size=8) * 1e5
+    kernel.history[:, 0] = rng.normal(size=12) * 1e5
     v, w = rng.normal(size=(4, 3)), rng.normal(size=(4, 3))
     f, m = np.zeros((4, 3)), np.zeros((4, 3))
     zero = np.zeros((4, 3))  # dt = 0: the mid-step configuration (the hourglass forces')

@@ -3,7 +3,6 @@ the walls as drawn, the camera, the body at true scale."""
 
 import numpy as np
 import pytest
-import pyvista
 
 from rwall_fem.output.coloring import coloring, round_range
 from rwall_fem.output.render import _time_decimals, _time_unit
@@ -92,6 +91,17 @@ def test_displacement_in_micrometres_and_cell_fields_on_cells():
         coloring("plastic_strain", _frames([u], [u]), points, [], UP, 0.0)
 
 
+def test_damage_ranges_up_to_failure_at_most():
+    """Damage is in [0, 1] (1: failed): a failed cell's damage of 1.13 does not stretch the
+    range to 1.2; a damage of at most 0.31 is ranged to 0.4 as any field."""
+    points, u = np.zeros((20, 3)), np.zeros((20, 3))
+    for largest, top in [(1.13, 1.0), (1.0, 1.0), (0.31, 0.4)]:
+        frames = [{"u": u, "v": u, "offsets": np.zeros((0, 3)),
+                   "cell_damage": np.array([0.0, 0.2, largest])}]  # fmt: skip
+        paint = coloring("damage", frames, points, [], UP, 0.0)
+        assert paint.clim == (0.0, top) and paint.title == "damage D"
+
+
 @pytest.mark.parametrize(
     "end, unit", [(6e-5, "µs"), (3e-3, "ms"), (0.45, "ms"), (2.0, "s"), (0.0, "µs")]
 )
@@ -108,6 +118,8 @@ def test_time_labels_tell_the_frames_apart():
 
 def test_body_at_true_scale():
     """The scene reused for every frame moves the body's points to X + u (m) in place."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
     from rwall_fem.output.picture import Picture
 
     points = _box([0, 0, 0], [1, 1, 1], n=2)
@@ -118,13 +130,14 @@ def test_body_at_true_scale():
     }
     paint = coloring("displacement", _frames([0 * points], [0 * points]), points, [], UP, 0.0)
     view = choose_view(points, [points], [], UP, 4 / 3)
-    picture = Picture(pyvista, mesh, paint, view, (160, 120), erodes=False, cut=None,
-                      ghost=False, edges=False)  # fmt: skip
+    picture = Picture(mesh, paint, view, (160, 120), erodes=False, cut=None, ghost=False,
+                      edges=False)  # fmt: skip
     try:
         for seed in (1, 2):
             u = np.random.default_rng(seed).normal(scale=0.1, size=points.shape)
             image = picture.draw(u, np.linalg.norm(u, axis=1), None, None, "t")
-            assert np.array_equal(picture.grid.points, points + u)
+            drawn = vtk_to_numpy(picture.grid.GetPoints().GetData())
+            assert np.array_equal(drawn, points + u)
             assert image.shape == (120, 160, 3)
     finally:
         picture.close()
@@ -134,36 +147,59 @@ def test_walls_are_drawn_where_the_body_is():
     body = _box([0.0, 0.0, 0.001], [0.01, 0.01, 0.1])
     size = 0.1
     floor = PlaneWall([0, 0, 0], [0, 0, 1])
-    slab = wall_surface(pyvista, floor, np.zeros(3), body, size)
+    slab = wall_surface(floor, np.zeros(3), body, size)
     d = floor.distance(slab.points)
     assert d.max() == pytest.approx(0.0, abs=1e-15) and d.min() == pytest.approx(-SLAB * size)
     assert np.all(slab.points.min(axis=0)[:2] < 0) and np.all(slab.points.max(axis=0)[:2] > 0.01)
-    moved = wall_surface(pyvista, floor, np.array([0, 0, 0.002]), body, size)
+    moved = wall_surface(floor, np.array([0, 0, 0.002]), body, size)
     assert floor.distance(moved.points).max() == pytest.approx(0.002)
     cylinder = CylinderWall([0, 0, -0.02], [0, 1, -0.02], 0.02)
-    tube = wall_surface(pyvista, cylinder, np.zeros(3), body, size)
+    tube = wall_surface(cylinder, np.zeros(3), body, size)
     assert np.allclose(cylinder.distance(tube.points), 0.0, atol=1e-3 * cylinder.radius)
-    rims = tube.extract_feature_edges(
-        boundary_edges=True, feature_edges=False, manifold_edges=False, non_manifold_edges=False
-    )
-    assert rims.n_cells > 0  # open ends: an infinite cylinder has no end caps
+    quads = tube.faces.reshape(-1, 5)
+    assert np.all(quads[:, 0] == 4)  # one band of quadrilaterals, open at both ends: an
+    edges = np.sort(np.stack([quads[:, 1:], np.roll(quads[:, 1:], -1, axis=1)], -1), -1)
+    _, uses = np.unique(edges.reshape(-1, 2), axis=0, return_counts=True)
+    assert np.sum(uses == 1) == 2 * 96  # infinite cylinder has no end caps: two free rims
     ends = tube.points @ cylinder.axis
     assert ends.min() < 0.0 and ends.max() > 0.01  # over the body's extent along the axis
     sphere = SphereWall([0, 0, -0.05], 0.02)
-    ball = wall_surface(pyvista, sphere, np.zeros(3), body, size)
+    ball = wall_surface(sphere, np.zeros(3), body, size)
     assert np.allclose(sphere.distance(ball.points), 0.0, atol=1e-3 * sphere.radius)
 
 
 def _fits(view, clouds, aspect):
     """Whether every point of ``clouds`` is in the picture, between the text and the bar."""
-    from rwall_fem.output.view import BAND
+    from rwall_fem.output.view import BAND, TIME_CORNER, TOP
 
     points = np.concatenate(clouds) - view.focal
     right = np.cross(view.up, view.direction)
     x, y = points @ right / view.scale, points @ view.up / view.scale
-    return np.all(np.abs(x) <= aspect) and np.all(
-        (y >= 2 * BAND[0] - 1 - 1e-9) & (y <= 2 * BAND[1] - 1 + 1e-9)
+    corner = (x < -aspect + 2 * aspect * TIME_CORNER[0] / 800) & (y > 1 - 2 * TIME_CORNER[1] / 600)
+    return np.all(np.abs(x) <= aspect) and not corner.any() and np.all(
+        (y >= 2 * BAND[0] - 1 - 1e-9) & (y <= 2 * TOP - 1 + 1e-9)
     )
+
+
+def _rod(length, radius, foot=0.0, n=40):
+    """Points (m) of the surface of a rod along z from 0 to ``length`` whose radius
+    swells to ``foot`` (m) at z = 0 over its first fifth (a Taylor rod's mushroom)."""
+    z, angle = np.meshgrid(np.linspace(0, length, n), np.linspace(0, 2 * np.pi, n))
+    r = radius + max(foot - radius, 0.0) * np.clip(1 - z / (0.2 * length), 0, 1) ** 2
+    return np.column_stack([(r * np.cos(angle)).ravel(), (r * np.sin(angle)).ravel(), z.ravel()])
+
+
+@pytest.mark.parametrize("cut", [None, [1.0, 0.0, 0.0]])
+def test_a_taylor_rods_last_frame_fills_half_of_the_picture(cut):
+    """A copper rod 32.4 mm long that ends 21.5 mm long with a foot 7.15 mm in radius (the
+    Taylor demo), seen in one view for every frame: the last frame is more than half of
+    the picture's height (it is beside the time's corner, not under it), and every frame
+    is in the picture."""
+    first, last = _rod(32.4e-3, 3.2e-3), _rod(21.5e-3, 3.2e-3, foot=7.15e-3)
+    walls = [PlaneWall([0, 0, 0], [0, 0, 1])]
+    view = choose_view(first, [first, last], walls, UP, 4 / 3, cut_normal=cut)
+    assert np.ptp(last @ view.up) / (2 * view.scale) > 0.5
+    assert _fits(view, [first, last], 4 / 3)
 
 
 def test_camera_between_a_floor_and_a_press_looks_level():
@@ -201,3 +237,15 @@ def test_camera_beside_a_finite_wall_looks_along_its_edge():
     view = choose_view(body[:-1], [body], [wall], UP, 4 / 3)
     assert view.direction[0] == pytest.approx(0.0, abs=1e-12) and view.direction[1] < 0
     assert view.behind(wall)
+
+
+@pytest.mark.parametrize("name", ["viridis", "coolwarm"])
+def test_colour_maps_are_matplotlibs(name):
+    """The renderer's colour maps (65 colours each, interpolated) are matplotlib's to 5 of
+    255 levels, without importing it."""
+    import matplotlib
+
+    from rwall_fem.output.coloring import colour_table
+
+    theirs = matplotlib.colormaps[name](np.linspace(0.0, 1.0, 256))[:, :3]
+    assert np.abs(colour_table(name, 256) - theirs).max() < 5 / 255

@@ -31,6 +31,7 @@ from rwall_fem.radioss.cards import (
     failures,
     functions,
     groups,
+    interfaces,
     loads,
     materials,
     nodes,
@@ -47,7 +48,7 @@ __all__ = ["ENGINE_FAMILIES", "STARTER_FAMILIES", "keyword", "lookup", "supporte
 
 STARTER_FAMILIES = (
     begin, nodes, solids, shells, parts, materials, failures, groups, functions, conditions,
-    walls, control, loads, rigid_bodies,
+    walls, control, loads, rigid_bodies, interfaces,
 )  # fmt: skip
 ENGINE_FAMILIES = (run, control)
 

@@ -8,7 +8,8 @@ Belytschko-Wong-Chiang warping correction and viscous hourglass control), with a
 that QEPH's physical stabilisation is not there. Ish3n 1 and 2 (the C0 triangle) to
 ``"bsc"``. N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
 ``thickness``, ``shear_factor`` and ``hourglass_coefficients`` (Radioss's defaults where
-blank: N 5, Ashear 5/6, hm hf hr 0.01).
+blank: N 5, Ashear 5/6, hm hf hr 0.01); P_thickfail becomes ``failed_share`` (blank: 1,
+every point) and Ithick = 1 ``thickness_change = true`` (2 or blank: constant).
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def _property(deck: Deck, card: Card) -> None:
         card.fail(f"property {pid} is defined twice")
     units = card_units(deck, card, 3)
     first = card.line(1, "Ishell Ismstr Ish3n Idrill Ipinch P_thickfail")
-    ishell, ismstr, ish3n, idrill, _, _ = read_fields(
+    ishell, ismstr, ish3n, idrill, _, thickfail = read_fields(
         card, first, "i:Ishell i:Ismstr i:Ish3n i:Idrill i:Ipinch -:blank f:P_thickfail"
     )
     hm, hf, hr, _, _ = card.read(2, "f:hm f:hf f:hr f:dm f:dn", "hm hf hr dm dn")
@@ -69,6 +70,7 @@ def _property(deck: Deck, card: Card) -> None:
         "given": {"ishell": ishell, "ismstr": ismstr, "ish3n": ish3n, "idrill": idrill,
                   "ithick": ithick, "iplas": iplas},
         "n": n, "thick": thick * units.length, "ashear": ashear, "hourglass": (hm, hf, hr),
+        "thickfail": thickfail,
     }  # fmt: skip
 
 
@@ -95,9 +97,12 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     if value["ismstr"] not in (0, 2, 4):
         card.fail(f"Ismstr = {value['ismstr']}: small-strain formulations are not supported; "
                   "leave it blank (full geometric non-linearity)", first)  # fmt: skip
-    if value["ithick"] not in (0, 2):
-        card.fail(f"Ithick = {value['ithick']}: the thickness is constant (Ithick 2 or "
-                  "blank)", third)  # fmt: skip
+    if value["ithick"] not in (0, 1, 2):
+        card.fail(f"Ithick = {value['ithick']}: 1 (the thickness follows the membrane "
+                  "strain) or 2 (constant, as when blank)", third)  # fmt: skip
+    if not 0.0 <= raw["thickfail"] <= 1.0:
+        card.fail(f"P_thickfail = {raw['thickfail']:g}: a share of the points through the "
+                  "thickness, 0 to 1 (blank: 1)", first)  # fmt: skip
     if raw["thick"] <= 0.0:
         card.fail(f"Thick = {raw['thick']:g} m: a shell needs a thickness > 0", third)
     points = raw["n"] or 5
@@ -111,6 +116,10 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
                "hourglass_coefficients": hourglass}  # fmt: skip
     if raw["ashear"]:
         element["shear_factor"] = raw["ashear"]
+    if raw["thickfail"]:
+        element["failed_share"] = raw["thickfail"]
+    if value["ithick"] == 1:
+        element["thickness_change"] = True
     if ishell in (12, 24):
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   "warping correction and viscous hourglass control hm, hf, hr (QEPH's "

@@ -8,7 +8,6 @@ __all__ = ["refusal"]
 _WHY = {
     "element": "elements of this kind are not read: rwall_fem's elements are /BRICK (hexahedra) "
     "and /TETRA4 (tetrahedra)",
-    "interface": "contact interfaces are not read: bodies meet rigid walls (/RWALL) only",
     "kinematic": "kinematic conditions of this kind are not read: /BCS and /IMPVEL are",
     "load": "loads and initial states of this kind are not read: /INIVEL/TRA, /BCS, /IMPVEL, "
     "/GRAV, /CLOAD, /PLOAD and /ADMAS are",
@@ -19,7 +18,6 @@ _WHY = {
 KINDS = {
     **dict.fromkeys(("SHELL", "SH3N", "BEAM", "SPRING", "TRUSS", "QUAD", "TRIA", "BRIC20",
                      "TETRA10", "PENTA6", "SHEL16", "SPHCEL", "XELEM"), "element"),
-    "INTER": "interface",
     **dict.fromkeys(("RBE2", "RBE3", "RLINK", "CYL_JOINT", "GJOINT", "MERGE", "MPC",
                      "BCS/CYCLIC", "BCS/LAGMUL"), "kinematic"),
     **dict.fromkeys(("LOAD", "IMPDISP", "IMPACC", "PBLAST", "PFLUID",

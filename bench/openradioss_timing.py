@@ -1,0 +1,95 @@
+"""The peer shell decks timed in OpenRadioss and in rwall_fem on this machine: CPU time,
+cycles and the loop-time ratio (1 thread / 1 rank each).
+
+    .venv/bin/python bench/openradioss_timing.py [--openradioss DIR] [--decks DIR]
+
+DIR holds OpenRadioss's executables ``starter_linux64_gf`` and ``engine_linux64_gf``
+(default ``$OPENRADIOSS_PATH/exec``, else ``../openradioss-src/exec`` beside the clone);
+without them the script says so in one line and stops (exit 0). Each deck
+(``../shared/peer-decks/gen_shell.py``: the tube at h 2.5 mm, Ishell 24, and the plate,
+Ishell 24, 20 m/s) runs once in each code: OpenRadioss's engine (its starter not counted)
+with OMP_NUM_THREADS=1, its cycles from the last ``NC=`` line it prints; rwall_fem's time
+loop in this process (set-up not counted). CPU times, not wall times: the machine is
+shared, and a CPU time does not count the cycles other processes took.
+"""
+
+import argparse
+import os
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from rwall_fem.build import build_simulation, run_in_folder
+from rwall_fem.radioss import load_deck
+
+ROOT = Path(__file__).resolve().parents[1]
+DECKS = {"tube": ["tube", "--h", "2.5"], "plate": ["plate", "--h", "2.5"]}
+STARTER, ENGINE = "starter_linux64_gf", "engine_linux64_gf"
+
+
+def children_cpu() -> float:
+    """CPU seconds (user + system) of the finished children so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def openradioss(folder: Path, name: str, exe: Path) -> dict:
+    """Starter, then engine, in ``folder``: the engine's CPU and wall seconds and cycles."""
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMP_STACKSIZE="400m")
+    lib = exe / ".." / "extlib" / "hm_reader" / "linux64"
+    env["LD_LIBRARY_PATH"] = f"{exe}:{lib}:" + env.get("LD_LIBRARY_PATH", "")
+    env.setdefault("RAD_CFG_PATH", str(exe / ".." / "hm_cfg_files"))
+    subprocess.run([str(exe / STARTER), "-i", f"{name}_0000.rad", "-np", "1", "-nt", "1"],
+                   cwd=folder, env=env, check=True, capture_output=True)  # fmt: skip
+    cpu, wall = children_cpu(), time.perf_counter()
+    command = [str(exe / ENGINE), "-i", f"{name}_0001.rad", "-nt", "1"]
+    done = subprocess.run(command, cwd=folder, env=env, check=True, capture_output=True,
+                          text=True)  # fmt: skip
+    cycles = re.findall(r"NC=\s*(\d+)", done.stdout)
+    return {"cpu": children_cpu() - cpu, "wall": time.perf_counter() - wall,
+            "cycles": int(cycles[-1]) if cycles else None}  # fmt: skip
+
+
+def ours(starter: Path, out: Path) -> dict:
+    """rwall_fem's time loop on the deck as it is: CPU and wall seconds, cycles."""
+    sim = build_simulation(load_deck(starter), out=out)
+    cpu = time.process_time()
+    run_in_folder(sim)
+    cpu = time.process_time() - cpu
+    s = sim.history.summary
+    return {"cpu": cpu, "wall": s["wall_seconds"], "cycles": s["steps"]}
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    default = Path(os.environ.get("OPENRADIOSS_PATH", ROOT.parent / "openradioss-src")) / "exec"
+    parser.add_argument("--openradioss", default=str(default))
+    parser.add_argument("--decks", default=str(ROOT.parent / "shared" / "peer-decks"))
+    args = parser.parse_args()
+    exe = Path(args.openradioss)
+    if not all((exe / name).is_file() for name in (STARTER, ENGINE)):
+        print(f"SKIPPED: no OpenRadioss {STARTER} and {ENGINE} in {exe} (--openradioss DIR)")
+        sys.exit(0)
+    print("deck   code         CPU (s)   wall (s)   cycles   CPU per cycle (ms)")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, deck in DECKS.items():
+            folder = Path(tmp) / name
+            folder.mkdir()
+            subprocess.run([sys.executable, str(Path(args.decks) / "gen_shell.py"), *deck,
+                            "--name", name, "--out", str(folder)], check=True,
+                           capture_output=True)  # fmt: skip
+            theirs = openradioss(folder, name, exe)
+            mine = ours(folder / f"{name}_0000.rad", folder / "rwall_fem")
+            for code, r in (("OpenRadioss", theirs), ("rwall_fem", mine)):
+                per = 1e3 * r["cpu"] / r["cycles"] if r["cycles"] else float("nan")
+                print(f"{name:6s} {code:11s} {r['cpu']:9.2f} {r['wall']:10.2f} "
+                      f"{r['cycles'] or '-':>8} {per:12.3f}")  # fmt: skip
+            print(f"{name:6s} loop-time ratio (CPU, OpenRadioss / rwall_fem): "
+                  f"{theirs['cpu'] / mine['cpu']:.2f}; cycles {mine['cycles']} against "
+                  f"{theirs['cycles']}")  # fmt: skip
+            shutil.rmtree(folder, ignore_errors=True)

@@ -1,0 +1,145 @@
+"""Contact interfaces: /INTER/TYPE7 (Radioss's general node-to-surface contact), read into
+:class:`Interface` (in SI) for :mod:`rwall_fem.radioss.contacts` to turn into ``[[contact]]``
+tables. Other kinds of interface are refused naming the kind; TYPE3 and TYPE5 (Radioss's
+older surface-to-surface and node-to-surface contacts) too, saying that TYPE7 does what
+they do.
+
+Fields read: grnd_IDs, surf_IDm, Istf, Igap, Idel, Gapmin, Stfac, Fric, Inacti, VISs,
+Ifric, Ifiltr, Xfreq. Each other field that is not at its default gives one warning line
+saying it is not honoured (``docs/radioss.md``, "Contact interfaces").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from rwall_fem.radioss.cards.base import card_units, catch_all, ident
+from rwall_fem.radioss.model import Deck
+from rwall_fem.radioss.reader import Card
+
+__all__ = ["Interface", "STARTER"]
+
+
+@dataclass
+class Interface:
+    """An /INTER/TYPE7 in SI: its secondary node group and main surface, the stiffness
+    flag and scale, the gap flag and minimum gap (m, 0: Radioss's default), Coulomb's
+    coefficient with its filter (``ifq``, ``xfreq``: as /RWALL's), the normal damping."""
+
+    id: int
+    title: str
+    node_group: int
+    surface: int
+    istf: int
+    igap: int
+    gap_min: float
+    stiffness_scale: float
+    friction: float
+    filter_flag: int
+    filter_factor: float
+    damping: float
+    where: str
+
+
+def _ignored(deck: Deck, card: Card, line, values: dict) -> None:
+    """One warning line for each field of ``values`` (name -> value) not at its default."""
+    for name, value in values.items():
+        if value:
+            deck.warn(card, f"{name} = {value:g}: not honoured (rwall_fem's contact has no "
+                      "such option; the field is left out)", line)  # fmt: skip
+
+
+def _type7(deck: Deck, card: Card) -> None:
+    iid = ident(card, 2, "inter_ID")
+    units = card_units(deck, card, 3)
+    if any(i.id == iid for i in deck.interfaces):
+        card.fail(f"interface {iid} is defined twice")
+    layout = "i:grnd_IDs i:surf_IDm i:Istf i:Ithe i:Igap -:blank i:Ibag i:Idel i:Icurv i:Iadm"
+    nodes, surf, istf, ithe, igap, ibag, idel, icurv, iadm = card.read(1, layout)
+    if surf <= 0:
+        card.fail(f"surf_IDm = {surf}: the main surface is a /SURF ID > 0", card.lines[1])
+    if nodes < 0:
+        card.fail(f"grnd_IDs = {nodes}: the secondary nodes are a /GRNOD ID (0: none)",
+                  card.lines[1])  # fmt: skip
+    if istf < 0 or istf not in (0, 1, 2, 3, 4, 5, 1000):
+        card.fail(f"Istf = {istf}: 0 or 1000 (the main side's stiffness), 1 (Stfac is the "
+                  "stiffness), 2 to 5 (main and secondary combined)", card.lines[1])  # fmt: skip
+    if istf == 1:
+        card.fail("Istf = 1: a stiffness given as a value (Stfac, N/m) is not supported; "
+                  "give Istf 0 and Stfac as a scale of the main side's stiffness",
+                  card.lines[1])  # fmt: skip
+    if istf in (2, 3, 4, 5):
+        deck.warn(card, f"Istf = {istf}: not honoured: the stiffness is the main side's "
+                  "(Istf 1000)", card.lines[1])  # fmt: skip
+    if igap not in (0, 1, 2, 3, 1000):
+        card.fail(f"Igap = {igap}: 0 or 1000 (a constant gap), 1, 2 or 3 (variable)",
+                  card.lines[1])  # fmt: skip
+    if igap in (2, 3):
+        deck.warn(card, f"Igap = {igap}: read as Igap 1 (the variable gap without "
+                  "Fscalegap, Gap_max or the mesh size)", card.lines[1])  # fmt: skip
+    if idel not in (0, 1000):
+        deck.warn(card, f"Idel = {idel}: not honoured: contact bodies do not erode here, "
+                  "so no segment is ever deleted", card.lines[1])  # fmt: skip
+    _ignored(deck, card, card.lines[1], {"Ithe": ithe, "Ibag": ibag, "Icurv": icurv,
+                                         "Iadm": iadm})  # fmt: skip
+    fscale, gapmax, fpenmax, itied, ists = card.read(
+        2, "f:Fscalegap f:Gap_max f:Fpenmax -:blank:20 i:Itied i:Ists")
+    _ignored(deck, card, card.lines[2], {"Fscalegap": fscale, "Gap_max": gapmax,
+                                         "Fpenmax": fpenmax, "Itied": itied,
+                                         "Ists": ists})  # fmt: skip
+    stmin, stmax, mesh, dtmin, irem_gap, irem_i2 = card.read(
+        3, "f:Stmin f:Stmax f:Percent_mesh_size f:dtmin i:Irem_gap i:Irem_i2")
+    _ignored(deck, card, card.lines[3], {"Stmin": stmin, "Stmax": stmax,
+                                         "%mesh_size": mesh, "dtmin": dtmin,
+                                         "Irem_gap": irem_gap, "Irem_i2": irem_i2})  # fmt: skip
+    at = 5 if icurv in (1, 2) else 4  # the curvature's node line
+    stfac, fric, gapmin, tstart, tstop = card.read(at, "f:Stfac f:Fric f:GAPmin f:Tstart f:Tstop")
+    if stfac < 0:
+        card.fail(f"Stfac = {stfac:g}: the stiffness scale is >= 0 (0: 1)", card.lines[at])
+    if fric < 0:
+        card.fail(f"Fric = {fric:g}: Coulomb's coefficient is >= 0", card.lines[at])
+    if gapmin < 0:
+        card.fail(f"GAPmin = {gapmin:g}: the minimum gap is >= 0 (0: Radioss's default)",
+                  card.lines[at])  # fmt: skip
+    _ignored(deck, card, card.lines[at], {"Tstart": tstart, "Tstop": tstop})
+    ibc, inacti, viss, visf, bumult = card.read_optional(
+        at + 1, "s:IBC -:blank:20 i:Inacti f:VIS_S f:VIS_F f:Bumult")
+    if inacti not in (0, 6, 1000):
+        deck.warn(card, f"Inacti = {inacti}: not honoured: taken as 6 (a node inside the gap "
+                  "at the start gets a gap of 0.95 of its distance, growing back)")  # fmt: skip
+    if not 0.0 <= viss <= 1.0:
+        card.fail(f"VIS_S = {viss:g}: the normal damping is a fraction of critical in [0, 1]",
+                  card.lines[at + 1])  # fmt: skip
+    _ignored(deck, card, None, {"IBC": int(ibc or 0), "VIS_F": visf, "Bumult": bumult})
+    ifric, ifiltr, xfreq, iform, sensor, fct, ascale, fric_id = card.read_optional(
+        at + 2, "i:Ifric i:Ifiltr f:Xfreq i:Iform i:sens_ID i:fct_IDF f:AscaleF i:fric_ID")
+    if ifric:
+        card.fail(f"Ifric = {ifric}: only Coulomb friction (Ifric 0) is supported")
+    if ifiltr not in (0, 1, 2, 3):
+        card.fail(f"Ifiltr = {ifiltr}: 0 (no filter), 1 (alpha), 2 (period in steps), 3 "
+                  "(cut-off frequency)")  # fmt: skip
+    _ignored(deck, card, None, {"Iform": iform if iform != 1 else 0, "sens_ID": sensor,
+                                "fct_IDF": fct, "AscaleF": ascale, "fric_ID": fric_id})  # fmt: skip
+    if xfreq == 0.0:
+        ifiltr = 0  # Radioss: no factor, no filter
+    deck.interfaces.append(Interface(
+        iid, card.title(), nodes, surf, istf, 1 if igap in (1, 2, 3) else 0,
+        gapmin * units.length, stfac or 1.0, fric, ifiltr,
+        xfreq * (units.factor("rate") if ifiltr == 3 else 1.0), viss or 0.05,
+        card.header.where,
+    ))  # fmt: skip
+
+
+def _older(deck: Deck, card: Card) -> None:
+    card.fail(f"interfaces of {card.key(1)} are not read: /INTER/TYPE7 is (node-to-surface "
+              "contact, both sides of shells, self-contact): write the contact as a TYPE7")
+
+
+@catch_all
+def _other(deck: Deck, card: Card) -> None:
+    card.fail(f"interfaces of {card.key(1) or 'no kind'} are not read; supported: "
+              "/INTER/TYPE7")
+
+
+STARTER = {"INTER/TYPE7": _type7, "INTER/TYPE3": _older, "INTER/TYPE5": _older,
+           "INTER": _other}  # fmt: skip
