@@ -165,7 +165,7 @@ def build_simulation(
     if scene.contacts:
         from rwall_fem.contact import build_contacts
 
-        sim.contacts = build_contacts(scene, solid, sim.state)
+        sim.contacts = build_contacts(scene, solid, sim.state, sim.internal)
         sim.step_size.contacts = sim.contacts
         if sim.step_size.varies and not sim.internal.books_work:
             # Contact makes the step vary: the stored energies take its correction.
@@ -241,13 +241,19 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
     element technologies and the stable step; refused above ``max_cells`` cells (None: no
     limit)."""
     spec = scene.mesh
-    if body is None and spec is None:
-        raise SceneError(f"{scene.source}: mesh: missing (give [mesh], or a body to the API)")
+    if body is None and spec is None and not scene.pieces:
+        raise SceneError(f"{scene.source}: mesh: missing (give [mesh] or [[piece]], or a body "
+                         "to the API)")  # fmt: skip
     if body is not None:
         comm = body.msh.comm  # the caller's mesh: it lives as long as the caller keeps it
     else:  # keep the caller's comm: a DOLFINx 0.5 mesh's comm dies with the mesh
         try:
-            body = body_mesh(comm, spec, max_cells)
+            if spec is None:
+                from rwall_fem.pieces import pieces_mesh
+
+                body = pieces_mesh(comm, scene.pieces, max_cells)
+            else:
+                body = body_mesh(comm, spec, max_cells)
         except MeshTooLarge as err:
             raise SceneError(
                 f"{scene.source}: run.max_cells: the mesh has {err.cells} cells, more than "
@@ -255,7 +261,8 @@ def _solid(scene: Scene, comm: MPI.Comm, body: BodyMesh | None, max_cells) -> _S
                 f"{LIFT_HINT}"
             ) from None
         except ValueError as err:  # a file gmsh cannot read, mixed cell types, ...
-            where = "mesh.file" if spec.file is not None else "mesh"
+            where = "mesh" if spec is None or spec.file is None else "mesh.file"
+            where = "piece" if spec is None else where
             raise SceneError(f"{scene.source}: {where}: {err}") from None
     cell = body.msh.topology.cell_type.name
     if body.msh.topology.dim == 2:

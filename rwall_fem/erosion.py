@@ -42,6 +42,11 @@ class ErodedCells:
         self._nodal = la.vector(V.dofmap.index_map, 1)
         self.holding = self._count(np.arange(num_cells))  # live cells of each owned node
         self._pending: list[np.ndarray] = []  # eroded here since the last count
+        # The steps in which some rank eroded cells, so far: the same on every rank; and per
+        # cell, whether it was alive at the latest count (the contact surfaces follow these,
+        # rwall_fem.contact.erosion, whatever the latest kernel pass eroded since).
+        self.detachments = 0
+        self.settled = np.ones(num_cells, dtype=bool)
 
     @property
     def count(self) -> int:
@@ -75,6 +80,8 @@ class ErodedCells:
         eroded = np.concatenate(self._pending) if self._pending else np.zeros(0, np.int32)
         self._pending.clear()
         self.holding -= self._count(eroded)
+        self.settled[eroded] = False
+        self.detachments += 1
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
         """Which cells are alive, their work so far and the live cells of each node."""
@@ -84,6 +91,7 @@ class ErodedCells:
         self.alive[:] = arrays["alive"]
         self.work[...] = arrays["work"]
         self.holding[:] = arrays["holding"]
+        self.settled[:] = self.alive
         self._pending.clear()
         self.live = None if self.alive.all() else np.flatnonzero(self.alive).astype(np.int32)
 

@@ -146,7 +146,7 @@ def bar_mesh(
     Regions: "body", and with ``front`` > 0 the first ``front`` metres along its own z,
     "front".
     """
-    params = dict(zip(("lx", "ly", "lz"), size, strict=True)) | {"front": front}
+    params = _bar(size, front)
     return _swept_body(comm, "bar.geo", params, origin, axis, element_size, cell, refine, max_cells)
 
 
@@ -170,7 +170,7 @@ def round_bar_mesh(
     Regions: "body", and with ``front`` > 0 the first ``front`` metres of its length,
     "front".
     """
-    params = {"radius": radius, "length": length, "front": front}
+    params = _round_bar(radius, length, front)
     return _swept_body(
         comm, "round_bar.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
@@ -195,8 +195,7 @@ def plate_mesh(
     Regions: "body", and the layers of thicknesses ``layers_at`` (m; 0: none) at its bottom
     and top faces, "bottom_layer" and "top_layer".
     """
-    params = dict(zip(("lx", "ly", "thickness"), size, strict=True)) | {"layers": layers}
-    params |= dict(zip(("bottom_layer", "top_layer"), layers_at, strict=True))
+    params = _plate(size, layers, layers_at)
     return _swept_body(
         comm, "plate.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
@@ -311,10 +310,7 @@ def plate_with_hole_mesh(
 
     The faces of the hole are the group ``hole``.
     """
-    params = dict(zip(("lx", "ly", "thickness"), size, strict=True))
-    params |= {"hole_radius": hole_radius, "layers": layers}
-    params |= dict(zip(("bottom_layer", "top_layer"), layers_at, strict=True))
-    params |= dict(zip(("hole_dx", "hole_dy"), hole_offset, strict=True))
+    params = _plate_with_hole(size, hole_radius, hole_offset, layers, layers_at)
     return _swept_body(
         comm, "plate_with_hole.geo", params, origin, axis, element_size, cell, refine, max_cells
     )
@@ -322,6 +318,25 @@ def plate_with_hole_mesh(
 
 def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine, max_cells) -> BodyMesh:
     """Mesh ``meshes/<geo>`` in the body's own frame and turn it about ``origin`` onto ``axis``."""
+    params = swept_parameters(params, origin, axis, element_size, cell, refine)
+    # Shipped as the package rwall_fem.meshes (the repository's meshes/ folder); gmsh reads
+    # the file from disk and finds its Include "refine.geo" beside it.
+    with importlib.resources.as_file(importlib.resources.files("rwall_fem.meshes") / geo) as path:
+        body = read_mesh(comm, path, params, max_cells)
+    x = body.msh.geometry.x
+    x[:] = turned(x, origin, axis)
+    return body
+
+
+def turned(x: np.ndarray, origin, axis) -> np.ndarray:
+    """Points ``x`` (n, 3) of a body's own frame turned about ``origin`` onto ``axis`` (m)."""
+    origin = np.asarray(origin, dtype=float)
+    return (x - origin) @ rotation_to(axis).T + origin
+
+
+def swept_parameters(params, origin, axis, element_size, cell, refine) -> dict[str, float]:
+    """The gmsh parameters of a swept shape's .geo: its own ``params``, and where it is, its
+    element size, cell and refinement in its own frame."""
     origin = np.asarray(origin, dtype=float)
     R = rotation_to(axis)
     params = dict(params) | dict(zip(("x0", "y0", "z0"), origin, strict=True))
@@ -331,13 +346,42 @@ def _swept_body(comm, geo, params, origin, axis, element_size, cell, refine, max
         own = (np.asarray(refine.point, dtype=float) - origin) @ R + origin
         params |= dict(zip(("refine_x", "refine_y", "refine_z"), own, strict=True))
         params |= {"refine_size": refine.size, "refine_radius": refine.radius}
-    # Shipped as the package rwall_fem.meshes (the repository's meshes/ folder); gmsh reads
-    # the file from disk and finds its Include "refine.geo" beside it.
-    with importlib.resources.as_file(importlib.resources.files("rwall_fem.meshes") / geo) as path:
-        body = read_mesh(comm, path, params, max_cells)
-    x = body.msh.geometry.x
-    x[:] = (x - origin) @ R.T + origin
-    return body
+    return params
+
+
+def shape_geometry(spec) -> tuple[str, dict[str, float]]:
+    """The .geo of ``meshes/`` and its own parameters for the swept built-in shape of
+    ``spec`` (a [mesh] table or a piece: bar, round_bar, plate, plate_with_hole)."""
+    layers_at = (spec.bottom_layer, spec.top_layer)
+    if spec.shape == "bar":
+        return "bar.geo", _bar(spec.size, spec.front_length)
+    if spec.shape == "round_bar":
+        return "round_bar.geo", _round_bar(spec.radius, spec.length, spec.front_length)
+    if spec.shape == "plate":
+        return "plate.geo", _plate(spec.size, spec.layers, layers_at)
+    if spec.shape == "plate_with_hole":
+        return "plate_with_hole.geo", _plate_with_hole(
+            spec.size, spec.hole_radius, spec.hole_offset, spec.layers, layers_at
+        )
+    raise ValueError(f"not a swept solid shape: {spec.shape!r}")
+
+
+def _bar(size, front) -> dict[str, float]:
+    return dict(zip(("lx", "ly", "lz"), size, strict=True)) | {"front": front}
+
+
+def _round_bar(radius, length, front) -> dict[str, float]:
+    return {"radius": radius, "length": length, "front": front}
+
+
+def _plate(size, layers, layers_at) -> dict[str, float]:
+    params = dict(zip(("lx", "ly", "thickness"), size, strict=True)) | {"layers": layers}
+    return params | dict(zip(("bottom_layer", "top_layer"), layers_at, strict=True))
+
+
+def _plate_with_hole(size, hole_radius, hole_offset, layers, layers_at) -> dict[str, float]:
+    params = _plate(size, layers, layers_at) | {"hole_radius": hole_radius}
+    return params | dict(zip(("hole_dx", "hole_dy"), hole_offset, strict=True))
 
 
 def rotation_to(axis) -> np.ndarray:

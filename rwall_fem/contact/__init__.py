@@ -6,6 +6,8 @@ segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surf
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
 nodes against their own faces, each node kept off its own faces and their neighbours.
+In a body whose cells may erode, the surfaces of the solid parts that may erode follow
+the erosion (:mod:`~rwall_fem.contact.erosion`).
 
 On a body of shells the segments are the shells, both sides active
 (:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
@@ -19,15 +21,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from rwall_fem.contact.erosion import ErodingContact, ErodingSurface, may_erode
 from rwall_fem.contact.interface import ContactInterface, Pass
 from rwall_fem.contact.surface import Surface, part_surface, shell_surface
 
 __all__ = ["build_contacts"]
 
 
-def build_contacts(scene, solid, state) -> list[ContactInterface]:
+def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]:
     """The contact interfaces of ``scene`` on the body of ``solid`` (``build._Solid``),
-    acting on ``state``; :class:`~rwall_fem.scene.SceneError` (one line, on every rank)
+    acting on ``state``, whose cells erode as those of ``internal`` (the
+    :class:`~rwall_fem.body.Body` of the step; default: the solid's);
+    :class:`~rwall_fem.scene.SceneError` (one line, on every rank)
     for a part the body does not have, a side without faces, or a gap not smaller than a
     part."""
     from rwall_fem.scene import SceneError
@@ -36,17 +41,20 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
 
     body, comm = solid.elastic, solid.comm
     faces = shell_surface if solid.shells else part_surface
-    failing = any(getattr(p.material, "failure", None) for p in scene.body_parts)
-    if failing or scene.run.dt_min_action == "erode":
-        raise SceneError(
-            f"{scene.source}: contact[0]: contact in a body whose cells may erode (a failure "
-            "criterion, or run.dt_min_action = 'erode') is not supported yet: the faces of "
-            "eroded cells would stay in the contact surface; drop [[contact]] or the erosion"
-        )
     names = [part.name for part in solid.parts]
     owned = solid.V.dofmap.index_map.local_to_global(np.arange(solid.owned, dtype=np.int32))
     surfaces: dict[str, Surface] = {}
+    eroding: dict[str, ErodingSurface] = {}  # the parts whose cells may erode
     interfaces = []
+
+    def _total(parts: tuple[str, ...]) -> Surface:
+        """The faces of ``parts`` now, part after part."""
+        found = [eroding[n].surface if n in eroding else surfaces[n] for n in dict.fromkeys(parts)]
+        total = found[0]
+        for more in found[1:]:
+            total = total + more
+        return total
+
     for i, spec in enumerate(scene.contacts):
         where = f"{scene.source}: contact[{i}]"
 
@@ -58,50 +66,64 @@ def build_contacts(scene, solid, state) -> list[ContactInterface]:
                         f"{did_you_mean(name, names)}; its parts: {', '.join(names)}"
                     )
             for name in parts:
-                if name not in surfaces:
-                    surfaces[name] = faces(body, names.index(name), comm)
-            found = [surfaces[name] for name in dict.fromkeys(parts)]
-            total = found[0]
-            for more in found[1:]:
-                total = total + more
+                k = names.index(name)
+                if name in surfaces or name in eroding:
+                    continue
+                if not solid.shells and may_erode(scene, body.parts[k]):
+                    eroding[name] = ErodingSurface(body, k, comm, (internal or body).elements[k])
+                else:
+                    surfaces[name] = faces(body, k, comm)
+            total = _total(parts)
             if not len(total.segments):
                 raise SceneError(f"{where}.{key}: the parts {', '.join(parts)} have no "
                                  "boundary face")  # fmt: skip
             return total
 
         if spec.single_surface:
-            main = side("main", spec.main or tuple(names))
+            main = spec.main or tuple(names)
+            side("main", main)
             sides = [(main, main, True)]
         else:
-            main, secondary = side("main", spec.main), side("secondary", spec.secondary)
+            main, secondary = spec.main, spec.secondary
+            side("main", main), side("secondary", secondary)
             sides = [(secondary, main, False)] + ([(main, secondary, False)] if spec.symmetric else [])
-        nodes = np.unique(np.concatenate([s.nodes for pair in sides for s in pair[:2]]))
-        edge = float(min(s.edge.min() for pair in sides for s in pair[:2]))
-        half = float(max(-s.depth.min(initial=0.0) for pair in sides for s in pair[:2]))
-        node_gap = _node_gaps(nodes, [s for pair in sides for s in pair[:2]])
-        gap = spec.gap if spec.gap is not None else _gap_floor(sides, edge)
-        passes = [
-            Pass(
-                np.searchsorted(nodes, sec.nodes).astype(np.int64),
-                np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
-                spec.stiffness_scale * seg.stiffness,
-                seg.depth.copy(),
-                exclude,
-            )
-            for sec, seg, exclude in sides
-        ]
-        interface = ContactInterface(
-            f"contact[{i}]", nodes, passes, gap=gap, friction=spec.friction,
-            alpha=filter_alpha(spec.friction_filter, state.dt), margin=edge, state=state,
-            comm=comm, owned_global=owned, damping=spec.damping,
+        parts = {name: None for pair in sides for name in pair[0] + pair[1]}
+        here = [eroding[name] for name in parts if name in eroding]
+        start = [(_total(a), _total(b), exclude) for a, b, exclude in sides]
+        nodes = np.unique(np.concatenate([s.nodes for pair in start for s in pair[:2]]
+                                         + [s.nodes for s in here]))  # fmt: skip
+        edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
+        half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
+        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]])
+        gap = spec.gap if spec.gap is not None else _gap_floor(start, edge)
+
+        def passes(sides=sides, nodes=nodes, scale=spec.stiffness_scale) -> list[Pass]:
+            """The passes of the interface from its sides' surfaces as they are."""
+            out = []
+            for sec_parts, seg_parts, exclude in sides:
+                sec, seg = _total(sec_parts), _total(seg_parts)
+                out.append(Pass(
+                    np.searchsorted(nodes, sec.nodes).astype(np.int64),
+                    np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
+                    scale * seg.stiffness, seg.depth.copy(), exclude,
+                ))  # fmt: skip
+            return out
+
+        common = dict(
+            gap=gap, friction=spec.friction, alpha=filter_alpha(spec.friction_filter, state.dt),
+            margin=edge, state=state, comm=comm, owned_global=owned, damping=spec.damping,
         )  # fmt: skip
+        if here:
+            interface = ErodingContact(f"contact[{i}]", nodes, here, passes, **common)
+        else:
+            interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
         if spec.gap is None and half > 0.0:
             interface.vary_gap(node_gap)
         interface.start(state)
         gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
-                ids = np.searchsorted(nodes, surfaces[name].nodes)
+                ids = np.searchsorted(nodes, _total((name,)).nodes)
                 x = interface.x[ids]
                 extent = np.sort(x.max(axis=0) - x.min(axis=0))
                 # A flat sheet has no extent across: its width then

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Surface", "part_surface", "shell_surface"]
+__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface", "shell_surface"]
 
 # The faces of DOLFINx's reference cells as cycles of their vertices.
 _FACES = {
@@ -71,6 +71,13 @@ def _area_vector(p: np.ndarray, triangle: np.ndarray) -> np.ndarray:
 def part_surface(body, k: int, comm) -> Surface:
     """The boundary faces of part ``k`` of ``body`` (a :class:`~rwall_fem.body.Body`), the
     same on every rank of ``comm`` (collective)."""
+    return boundary_faces(*cell_faces(body, k), comm)
+
+
+def cell_faces(body, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every face of this rank's cells of part ``k``, cell after cell (row ``c x faces per
+    cell + f``): its 4 global node numbers oriented outward of the cell, the same sorted
+    (the face's key), and its k0 (N/m), depth (m) and shortest edge (m)."""
     force = body.elements[k]
     cells, X = force.cells, body.X
     faces = np.array(_FACES[cells.shape[1]])
@@ -113,8 +120,13 @@ def part_surface(body, k: int, comm) -> Surface:
         corners[:, 0] - corners[:, 2], axis=1), np.minimum(edges[2], edges[3]))])  # fmt: skip
     ids = np.where(local >= 0, to_global(np.where(local >= 0, local, 0).ravel().astype(np.int32)).reshape(-1, 4), -1)
     values = np.column_stack([bulk * area**2 / volume, 0.5 * volume / area, edge])
+    return ids, np.sort(ids, axis=1), values
+
+
+def boundary_faces(ids: np.ndarray, key: np.ndarray, values: np.ndarray, comm) -> Surface:
+    """The faces (rows of :func:`cell_faces`) that one cell holds over all ranks of
+    ``comm``, the same on every rank, sorted by their keys (collective)."""
     # The faces held once on this rank, then once over all ranks.
-    key = np.sort(ids, axis=1)
     _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
     once = np.sort(first[counts == 1])
     gathered = comm.allgather((ids[once], key[once], values[once]))

@@ -9,6 +9,8 @@ the reference page prints. The validation (:func:`~rwall_fem.scene.keys.read_tab
 
 from __future__ import annotations
 
+import dataclasses
+
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -58,6 +60,8 @@ __all__ = [
     "LoadSpec",
     "Material",
     "MeshSpec",
+    "PIECE_SHAPES",
+    "PieceSpec",
     "Motion",
     "Output",
     "PartSpec",
@@ -591,6 +595,52 @@ def _noise_is_small(v, raw, fail):
             f"{amplitude:g} m is more than 0.1 x the smallest element size ({h:g} m): "
             f"it would distort the elements and shrink the stable step; at most {0.1 * h:g} m",
         )
+
+
+# --- [[piece]] ---------------------------------------------------------------------
+
+# The built-in shapes a piece may be (the swept solids) and their keys: a [mesh]'s but the
+# cell, which every piece shares (the body has one cell type).
+PIECE_SHAPES = {
+    shape: tuple(name for name in MESH_SHAPES[shape] if name != "cell")
+    for shape in ("bar", "round_bar", "plate", "plate_with_hole")
+}
+
+
+def _piece_fields() -> list[tuple]:
+    """The fields of a piece: its name, then [mesh]'s keys of the piece shapes, in their
+    order there (a key's bounds refer to keys before it), the shape and cell its own."""
+    own = {
+        "shape": key(Choice(tuple(PIECE_SHAPES)), None, required=True,
+                     doc="the built-in solid shape"),
+        "cell": key(Choice(("hexahedron", "tetrahedron")), "hexahedron",
+                    doc="the cell type, the same in every piece"),
+    }  # fmt: skip
+    used = {"shape", *_REFINE_KEYS, *(n for names in PIECE_SHAPES.values() for n in names)}
+    fields = [("name", str, key(
+        Identifier("a piece name"),
+        doc="its region's name (a part's volumes; a [[part]] of that name takes it), and the "
+        "prefix of its other regions and face groups (rod_front, rod_top, ...)",
+    ))]  # fmt: skip
+    for f in dataclasses.fields(MeshSpec):
+        if f.name in used or f.name == "cell":
+            made = own.get(f.name) or dataclasses.field(default=f.default, metadata=f.metadata)
+            fields.append((f.name, f.type, made))
+    return fields
+
+
+PieceSpec = table(
+    "A piece of the body: a built-in solid shape placed on its own (the pieces of [[piece]] "
+    "stand instead of [mesh]); its region, named after it, is a part with [[part]].",
+    variants=Variants("shape", PIECE_SHAPES, common=("name", "cell", *_REFINE_KEYS),
+                      noun="a {} piece"),  # fmt: skip
+)(dataclasses.make_dataclass("PieceSpec", _piece_fields(), frozen=True, kw_only=True))
+PieceSpec.__module__ = __name__
+
+
+for _check in (_hole_fits, _refinement_comes_whole, _regions_fit, _refinement_is_meshable,
+               _refinement_reaches_the_body):  # fmt: skip
+    rule(PieceSpec, json=_check.json)(_check)
 
 
 # --- [material], [element], [initial], [gravity] ------------------------------------
@@ -1420,6 +1470,13 @@ class Scene:
         doc="the body",
         default_doc="a body given to the API",
     )
+    pieces: tuple[PieceSpec, ...] = key(
+        Each(PieceSpec),
+        (),
+        toml="piece",
+        doc="the body as separate pieces of built-in shapes, instead of [mesh]",
+        default_doc="none: the body of [mesh]",
+    )
     material: Material | None = key(
         Sub(Material),
         None,
@@ -1557,6 +1614,25 @@ def element_fits_the_surface(where: str, given, cell: str) -> str | None:
         return (f"{where}.formulation: {formulation!r} is not an element of {cell} cells; "
                 f"allowed: {', '.join(fits[cell])}")  # fmt: skip
     return None
+
+
+@rule(Scene, json=[{"not": {"required": ["mesh", "piece"]}}])
+def _pieces_instead_of_mesh(v, raw, fail):
+    """[[piece]] stands instead of [mesh]; the pieces have unique names and one cell type."""
+    pieces = v["pieces"]
+    if not pieces:
+        return
+    if v["mesh"] is not None:
+        fail("piece", "give either [mesh] or [[piece]], not both (the pieces are the body)")
+    names: dict[str, int] = {}
+    for i, piece in enumerate(pieces):
+        if piece.name in names:
+            fail(f"piece[{i}].name",
+                 f"{piece.name!r} is also the name of piece[{names[piece.name]}]")  # fmt: skip
+        names[piece.name] = i
+        if piece.cell != pieces[0].cell:
+            fail(f"piece[{i}].cell", f"{piece.cell!r}, and piece[0] is {pieces[0].cell!r}: a "
+                 "body has one cell type")  # fmt: skip
 
 
 @rule(Scene)
