@@ -184,6 +184,12 @@ OTHERS = [
     },
 ]
 
+# [[piece]] instead of [mesh]: FULL's shape as the body's one piece.
+OTHERS.append(
+    {k: v for k, v in FULL.items() if k != "mesh"}
+    | {"piece": [{"name": "body", **{k: v for k, v in FULL["mesh"].items() if k != "noise"}}]}
+)
+
 # A value of every TOML type, and the awkward ones of each.
 VALUES = [
     "text",

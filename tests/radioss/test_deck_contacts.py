@@ -9,6 +9,7 @@ GAPmin (``i7sti3.F``): the mean thickness of the main shells, at most half their
 shortest side: min(1, 2.5) mm here.
 """
 
+import logging
 import subprocess
 import sys
 from pathlib import Path
@@ -93,8 +94,13 @@ def test_fields_not_honoured_give_one_line_each(shared_dir, caplog):
         field(lines, k, 4, 60, "0.01".rjust(20))  # Tstart
         field(lines, k, 1, 20, "3".rjust(10))  # Istf 3: main and secondary's maximum
 
-    with caplog.at_level("WARNING", logger="rwall_fem"):
-        load_deck(tube(shared_dir, edit))
+    log = logging.getLogger("rwall_fem")  # the command line, run in-process by other
+    log.addHandler(caplog.handler)  # tests, stops it propagating to the root's handler
+    try:
+        with caplog.at_level("WARNING", logger="rwall_fem"):
+            load_deck(tube(shared_dir, edit))
+    finally:
+        log.removeHandler(caplog.handler)
     said = [r.getMessage() for r in caplog.records if "/INTER/TYPE7/1" in r.getMessage()]
     assert any("Tstart = 0.01: not honoured" in s for s in said)
     assert any("Istf = 3: not honoured" in s for s in said)
