@@ -7,8 +7,16 @@ rotations and rotational inertia.
   the body's kinetic energy drifts as a solid rigid body's under precession (within the
   2e-6 of tests/verification/test_rigid_body.py; seen 1e-8, the balance's error).
 - A plate with one end rigid, spinning and falling onto a plane wall: the rigid nodes
-  keep w = omega and the balance closes to 1e-9 (seen 7e-10: the rigid contact's; 5e-12
-  without the wall, 2e-15 without the spin).
+  keep w = omega and the balance closes within omega dt of the body's rotational energy.
+  That error is the body's integrator's, not the shells' (a solid block with a rigid end
+  shows the same): the shadow rotational energy 1/4 (L^- . omega^+ + L^+ . omega^-),
+  omega = R J0^-1 R^T L at mid-step rotations, is exact for a steady L only to the
+  precession error (2e-15 here without the wall); an impulse dL from the wall in one
+  step leaves 1/4 L . (J^-1(n+3/2) - J^-1(n+1/2)) dL, and the inertia turns by omega dt
+  over a step, so the error is first order in omega dt: |error| <= omega dt |L| |dL|
+  (1/J_min - 1/J_max) / 2 <= omega dt E_rot when the wall stops the spin. Measured
+  0.03 omega dt E_rot at dt_scale 0.9, 0.45 and 0.225, and 0.006-0.009 at 200 and 300
+  rad/s (5e-12 without the wall, 3e-15 without the spin).
 """
 
 import copy
@@ -79,6 +87,12 @@ def test_a_plate_with_a_rigid_end_falls_on_a_wall(shared_dir):
           f"{energy['wall_work']:.3e} J, internal {energy['internal']:.3e} J")
     assert energy["wall_work"] < 0.0
     assert energy["internal"] > 0.0
-    assert energy["max_balance_error"] <= 1e-9
+    omega = np.array([0.0, 100.0, 0.0])
+    spin = 0.5 * float(omega @ body.inertia0 @ omega)  # E_rot at the start, J
+    history = sim.history
+    dt = float(history.energy[:, history.balance.columns.index("dt")].max())
+    error = energy["max_balance_error"] * history.balance.reference  # J
+    print(f"rigid end: error {error:.2e} J = {error / (100.0 * dt * spin):.3f} omega dt E_rot")
+    assert error <= 100.0 * dt * spin  # the spin's first-order error at the impact
     w = sim.internal.w.owned[body.nodes]
     assert np.allclose(w, body.omega, rtol=1e-12, atol=0)
