@@ -5,7 +5,9 @@ From fixed and prescribed walls of free sliding, the body's change of velocity i
 of least kinetic energy for which every node a wall treated leaves with at least the
 normal velocity the wall asked for: a least-distance problem in six unknowns
 (:func:`least_distance`, by Lawson and Hanson's non-negative least squares), whose
-multipliers are the contact impulses the walls then book. From walls that are tied, with
+multipliers are the contact impulses the walls then book, their work at the body's
+velocities V + omega x a (what its kinetic energy takes), not at the nodes' chords of its
+finite rotation. From walls that are tied, with
 friction or carried by a main node, the impulses they gave the nodes, as they are.
 """
 
