@@ -5,7 +5,9 @@ From fixed and prescribed walls of free sliding, the body's change of velocity i
 of least kinetic energy for which every node a wall treated leaves with at least the
 normal velocity the wall asked for: a least-distance problem in six unknowns
 (:func:`least_distance`, by Lawson and Hanson's non-negative least squares), whose
-multipliers are the contact impulses the walls then book. From walls that are tied, with
+multipliers are the contact impulses the walls then book, their work at the body's
+velocities V + omega x a (what its kinetic energy takes), not at the nodes' chords of its
+finite rotation. From walls that are tied, with
 friction or carried by a main node, the impulses they gave the nodes, as they are.
 """
 
@@ -158,11 +160,37 @@ class RigidContact:
             change = G.T @ mu  # the sum of the impulses, and their moment about c
             body.correct(state, change[:3] / body.mass, change[3:])
         mu = impulses[offset : offset + len(rows)]
-        normals = mine[:, 1:4]
+        given = mu[:, None] * mine[:, 1:4]
+        before, after = self._body_velocity_shifts(state, rows)
         for w, wall in enumerate(self.walls):
             mask = rows[:, 0] == w
             if mask.any():
-                wall.reassign(rows[mask, 1], mu[mask, None] * normals[mask])
+                halves = [0.5 * float(np.einsum("ij,ij->", given[mask], shift[mask]))
+                          for shift in (before, after)]  # fmt: skip
+                wall.reassign(rows[mask, 1], given[mask], halves)
+
+    def _body_velocity_shifts(self, state, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For each row (a node of a body): (V + omega x a) - v (m/s) at n - 1/2 and at
+        n + 1/2, with a = x^n - c^n the arm of the body's moments and v the node's
+        velocity, the chord of the body's finite rotation (it differs from omega x a by
+        dt/2 omega x (omega x a)). The wall's impulses I booked at V + omega x a do the
+        work the body receives, 1/2 (sum I . (V^- + V^+) + dL . (omega^- + omega^+)),
+        which its kinetic energy takes; at the nodes' velocities they would miss it by
+        O(dt omega^2 |a| |I|)."""
+        shifts = np.zeros((2, len(rows), 3))
+        nodes_before = np.concatenate([b.nodes_before for b in self.bodies])
+        nodes_after = np.concatenate([b.node_velocity for b in self.bodies])
+        for b, body in enumerate(self.bodies):
+            mask = rows[:, 2] == b
+            if not mask.any():
+                continue
+            nodes = rows[mask, 3]
+            arms = state.X[nodes] + state.u[nodes] - body.center
+            line = self._row_of[nodes]
+            V0, _, w0 = body.previous
+            shifts[0, mask] = V0 + np.cross(w0, arms) - nodes_before[line]
+            shifts[1, mask] = body.velocity + np.cross(body.omega, arms) - nodes_after[line]
+        return shifts[0], shifts[1]
 
     def _redistribute(self, state, rows: np.ndarray) -> None:
         """The bodies take the impulses (N s) that walls of other kinds gave their nodes

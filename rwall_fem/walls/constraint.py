@@ -137,6 +137,7 @@ class RigidWall:
         # the nodes then have (whatever acted on them after the wall).
         self._latest = None
         self._pending_driving = 0.0  # J
+        self._pending_body = 0.0  # J, the v^{n+1/2} half of a rigid body's share (reassign)
         self._passes: ContactPasses | None = None  # the compiled passes, at the first step
         filtered = slide == "friction" and friction_filter is not None
         self._previous_tangential = np.zeros((len(self.nodes), 3)) if filtered else None
@@ -192,7 +193,8 @@ class RigidWall:
             "normal_impulse": self.normal_impulse,
             "tangential_impulse": self.tangential_impulse,
             "works": np.array(
-                [self.normal_work, self.friction_work, self.driving_work, self._pending_driving]
+                [self.normal_work, self.friction_work, self.driving_work, self._pending_driving,
+                 self._pending_body]  # fmt: skip
             ),
             "contact_times": np.array([self.first_contact, self.last_contact]),
             "contacts": np.array(self.contacts),
@@ -213,7 +215,8 @@ class RigidWall:
         self.normal_impulse[:] = arrays["normal_impulse"]
         self.tangential_impulse[:] = arrays["tangential_impulse"]
         works = arrays["works"].tolist()
-        self.normal_work, self.friction_work, self.driving_work, self._pending_driving = works
+        (self.normal_work, self.friction_work, self.driving_work, self._pending_driving,
+         self._pending_body) = works  # fmt: skip
         self.first_contact, self.last_contact = arrays["contact_times"].tolist()
         self.contacts = int(arrays["contacts"])
         self.touching = arrays["touching"]
@@ -250,7 +253,8 @@ class RigidWall:
                 self.friction_work += 0.5 * passes.work(tangential, final, nodes)
             self._latest = None
         self.driving_work += self._pending_driving
-        self._pending_driving = 0.0
+        self.normal_work += self._pending_body
+        self._pending_driving = self._pending_body = 0.0
 
     def constrain(self, state) -> None:
         """Edit ``state.a`` of the secondary nodes in contact at step ``state.step``."""
@@ -336,10 +340,13 @@ class RigidWall:
             impulses = impulses + passes.tangential[positions]
         return impulses
 
-    def reassign(self, positions: np.ndarray, impulses: np.ndarray) -> None:
+    def reassign(self, positions: np.ndarray, impulses: np.ndarray, body_halves=(0.0, 0.0)) -> None:
         """The contacts ``positions`` of the latest step received ``impulses`` (N s, (k, 3))
         rather than those the wall gave them (their rigid body took the wall's push as a
-        whole): the wall's impulse and works are booked with these. Free sliding only."""
+        whole): the wall's impulse and works are booked with these, the work at the body's
+        velocities rather than its nodes': ``body_halves`` (J) are what that adds to the
+        v^{n-1/2} half, booked now, and to the v^{n+1/2} half, booked at the next step
+        (:mod:`rwall_fem.rigid_contact`). Free sliding only."""
         passes = self._passes
         change = impulses - passes.normal[positions]
         passes.normal[positions] = impulses  # the latest step's, booked again at the next
@@ -347,7 +354,8 @@ class RigidWall:
         before = self.motion.previous_velocity
         self.normal_impulse -= total
         relative = passes.previous[positions] - before
-        self.normal_work += 0.5 * float(np.einsum("ij,ij->", change, relative))
+        self.normal_work += 0.5 * float(np.einsum("ij,ij->", change, relative)) + body_halves[0]
+        self._pending_body += body_halves[1]
         if self.motion.prescribed:
             self.driving_work += 0.5 * float(total @ before)
             self._pending_driving += 0.5 * float(total @ self.motion.velocity)
