@@ -33,7 +33,7 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.elements import ElementForce, GhostedField, Technology
-from rwall_fem.erosion import ErodedParts
+from rwall_fem.erosion import ErodedParts, ErodingBody
 from rwall_fem.kernels import STEP_SLOTS
 
 __all__ = [
@@ -131,7 +131,7 @@ def parts_of(specs, body_mesh, technologies: list[Technology], comm) -> list[Par
     return parts
 
 
-class Body:
+class Body(ErodingBody):
     """The internal force of the body's ``parts`` (:class:`Part`) on the vector space ``V``,
     with the displacement and velocity fields ``u`` and ``v``: an effect that *sets*
     ``state.a``. ``explicit``: the scene gave its parts (the outputs report them).
@@ -207,20 +207,6 @@ class Body:
         order = ("elastic", "plastic_work", "eroded_kinetic")
         self.energy_parts = tuple(n for n in order if n in parts)
         self.erosion = self._eroded if any(f.erosion for f in self.elements) else None
-
-    def erode_below(self, floor: float) -> None:
-        """From now on, erode the cells of every part whose step estimate falls below
-        ``floor`` (s), and inverted ones (collective)."""
-        for force in self.elements:
-            force.erode_below(floor)
-        self._name_energies()
-
-    def detach_nodes(self) -> None:
-        """Count the live cells of the nodes again after a step in which some rank eroded
-        cells (collective)."""
-        for force in self.elements:
-            if force.erosion is not None:
-                force.detach_nodes()
 
     # --- the step ----------------------------------------------------------------------
 

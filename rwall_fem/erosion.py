@@ -150,3 +150,23 @@ class ErodedParts:
             float(damage[:, e.alive].max(initial=0.0) if e else damage.max(initial=0.0))
             for damage, e in damaged
         )
+
+
+class ErodingBody:
+    """The erosion controls a body shares (:class:`~rwall_fem.body.Body`, shell bodies):
+    over its ``elements`` (the parts' element forces), renaming its energies
+    (``_name_energies``) when what may erode changes."""
+
+    def erode_below(self, floor: float) -> None:
+        """From now on, erode the cells of every part whose step estimate falls below
+        ``floor`` (s), and inverted ones (``run.dt_min_action = "erode"``; collective)."""
+        for force in self.elements:
+            force.erode_below(floor)
+        self._name_energies()
+
+    def detach_nodes(self) -> None:
+        """Count the live cells of the nodes again after a step in which some rank eroded
+        cells (collective)."""
+        for force in self.elements:
+            if force.erosion is not None:
+                force.detach_nodes()

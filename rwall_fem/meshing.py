@@ -473,9 +473,18 @@ def _read_mesh(comm, path, parameters, max_cells, keep) -> BodyMesh:
         except Exception as err:  # gmsh raises plain Exceptions, naming the file
             error = " ".join(str(err).replace(f"'{path}', ", "").split())
             error = f"{Path(path).name}: gmsh cannot read it: {error}"
-    groups, volumes, error, cells = comm.bcast((groups, volumes, error, cells), root=0)
+    return model_to_body(gmsh, comm, (groups, volumes, error, cells), max_cells,
+                         running=comm.rank == 0)
+
+
+def model_to_body(gmsh, comm, found: tuple, max_cells: float | None, running: bool) -> BodyMesh:
+    """The model gmsh holds on rank 0 as a DOLFINx body (collective). ``found`` is rank 0's
+    (groups, volumes, error, cells); an error, or more cells than ``max_cells``, is raised
+    on every rank (ValueError, :class:`MeshTooLarge`). gmsh is finalised on rank 0 in every
+    case (where ``running``: its session was started)."""
+    groups, volumes, error, cells = comm.bcast(found, root=0)
     if error or (max_cells is not None and cells > max_cells):
-        if comm.rank == 0:
+        if running:
             gmsh.finalize()
         raise ValueError(error) if error else MeshTooLarge(cells)
     try:

@@ -19,15 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-from rwall_fem import _compat, interrupts
+from rwall_fem import interrupts
 from rwall_fem.meshing import (
     BodyMesh,
-    MeshTooLarge,
     Refinement,
     _gmsh_model,
     _GmshError,
     _sigint_kept,
     gmsh_module,
+    model_to_body,
     shape_geometry,
     swept_parameters,
     turned,
@@ -137,14 +137,4 @@ def pieces_mesh(comm, pieces, max_cells: float | None = None) -> BodyMesh:
                 error = f"mesh.piece[{len(meshed)}]: {err}"
             except Exception as err:  # gmsh raises plain Exceptions
                 error = f"mesh.piece[{len(meshed)}]: gmsh: {' '.join(str(err).split())}"
-        groups, volumes, error, cells = comm.bcast((groups, volumes, error, cells), root=0)
-        if error or (max_cells is not None and cells > max_cells):
-            if running:
-                gmsh.finalize()
-            raise ValueError(error) if error else MeshTooLarge(cells)
-        try:
-            msh, cell_tags, facet_tags = _compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-        finally:
-            if comm.rank == 0:
-                gmsh.finalize()
-    return BodyMesh(msh, facet_tags, groups, cell_tags, volumes)
+        return model_to_body(gmsh, comm, (groups, volumes, error, cells), max_cells, running)

@@ -29,7 +29,7 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.elements import GhostedField
-from rwall_fem.erosion import ErodedParts
+from rwall_fem.erosion import ErodedParts, ErodingBody
 from rwall_fem.kernels import STEP_SLOTS, load
 
 __all__ = ["FORMULATIONS", "ShellBody", "ShellPart", "ShellSection"]
@@ -86,7 +86,7 @@ class ShellPart:
     velocity: tuple[float, float, float]
 
 
-class ShellBody:
+class ShellBody(ErodingBody):
     """The internal force and moments of the shell ``parts`` (:class:`ShellPart`) on the
     vector space ``V``, with the displacement and velocity fields ``u`` and ``v`` (m, m/s)
     of the state; ``inertia`` (owned nodes, 2) holds the nodes' masses (kg) and
@@ -158,20 +158,6 @@ class ShellBody:
             self.energy_names += ("eroded_internal",)
             self.energy_parts += ("eroded_kinetic",)
         self.erosion = self._eroded if erodes else None
-
-    def erode_below(self, floor: float) -> None:
-        """From now on, erode the cells of every part whose step estimate falls below
-        ``floor`` (s), and inverted ones (``run.dt_min_action = "erode"``; collective)."""
-        for force in self.elements:
-            force.erode_below(floor)
-        self._name_energies()
-
-    def detach_nodes(self) -> None:
-        """Count the live cells of the nodes again after a step in which some rank eroded
-        cells (collective)."""
-        for force in self.elements:
-            if force.erosion is not None:
-                force.detach_nodes()
 
     # --- the step ----------------------------------------------------------------------
 
