@@ -24,7 +24,7 @@ secondary, both passes. References independent of the code:
 import copy
 
 import numpy as np
-from conftest import run
+from conftest import StopAt, run
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
@@ -148,3 +148,29 @@ def test_a_punch_perforates_a_shell_plate_whose_eroded_shells_leave_the_contact(
         for columns in (slice(2, 5), slice(5, 8), slice(8, 9)):
             size = np.abs(table[:, columns]).max()
             assert np.abs(rows[:, columns] - table[:, columns]).max() <= 1e-10 * size, columns
+
+
+def test_a_resumed_punch_with_eroding_shells_equals_the_uninterrupted_run(shared_dir):
+    """Stopped after shells eroded (the surface changed), resumed from its checkpoint: the
+    segments are built again from the live shells, and the outputs are the same to the
+    bit."""
+    raw = punch_scene(shared_dir)
+    raw["run"]["end_time"] = 3e-5
+    raw["output"]["checkpoint_steps"] = 10
+    whole = run(raw, shared_dir / "whole")
+    out = shared_dir / "stopped"
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, out)
+    sim.recorders.append(StopAt(150))
+    assert sim.run().startswith("stopped: step 150,")
+    assert sim.contacts[0].updates > 0  # stopped after the surface changed
+    resumed = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, out)
+    resumed.checkpoints.resume(resumed)
+    assert resumed.run() == "done"
+    assert resumed.contacts[0].updates > sim.contacts[0].updates  # more erosion after it
+    assert np.array_equal(resumed.state.u, whole.state.u)
+    np.testing.assert_array_equal(resumed.contacts[0].surfaces[0].surface.segments,
+                                  whole.contacts[0].surfaces[0].surface.segments)  # fmt: skip
+    comm.Barrier()
+    if comm.rank == 0:
+        for name in ("energy.csv", "contacts.csv"):
+            assert (out / name).read_text() == (shared_dir / "whole" / name).read_text()
