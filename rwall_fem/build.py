@@ -530,7 +530,8 @@ def _add_recorders(
     if sim.contacts:
         from rwall_fem.output.contact_loads import ContactLoads
 
-        loads = ContactLoads(sim.contacts, sim.comm, solid.V.dofmap.index_map.local_to_global(owned))
+        to_global = solid.V.dofmap.index_map.local_to_global
+        loads = ContactLoads(sim.contacts, sim.comm, to_global(owned))
     if scene.output.fields:
         from rwall_fem.output.fields import Fields
 

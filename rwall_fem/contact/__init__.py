@@ -22,7 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from rwall_fem.contact.erosion import ErodingContact, ErodingShells, ErodingSurface, may_erode
+from rwall_fem.contact.erosion import (
+    ErodingContact,
+    ErodingShells,
+    ErodingSurface,
+    may_erode,
+)
 from rwall_fem.contact.interface import ContactInterface, Pass
 from rwall_fem.contact.surface import Surface, part_surface, shell_surface
 

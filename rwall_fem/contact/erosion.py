@@ -38,7 +38,13 @@ from collections.abc import Callable
 import numpy as np
 
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, boundary_faces, cell_faces, once, shell_segments
+from rwall_fem.contact.surface import (
+    Surface,
+    boundary_faces,
+    cell_faces,
+    once,
+    shell_segments,
+)
 
 __all__ = ["ErodingContact", "ErodingShells", "ErodingSurface", "may_erode"]
 

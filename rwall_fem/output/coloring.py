@@ -6,8 +6,8 @@ part of a body of ``[[part]]``, labelled with their names). One range serves eve
 fits the scene: a nodal quantity spans the 95th percentile of its magnitude
 over all nodes and frames (the spikes at a wave front or under a ball
 saturate, the bulk of the motion spans the range; the contact pressure: of the nodes in
-contact), velocities at least the initial speed; a cell field spans its maximum (plastic strain is often zero
-but in a few cells, which are the point), up to its physical bound (damage
+contact), velocities at least the initial speed; a cell field spans its maximum (plastic
+strain is often zero but in a few cells, which are the point), up to its physical bound (damage
 ends at 1: :data:`BOUNDS`). The range is rounded up to a round number, in a
 unit with a prefix that keeps the labels short (``µm``, ``MPa``), and its labels
 fall on round values written with one format. This module needs neither DOLFINx nor

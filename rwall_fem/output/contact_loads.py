@@ -38,15 +38,14 @@ FACING = 0.5
 
 class ContactLoads:
     """The nodal contact force and pressure of the interfaces ``contacts`` on the owned
-    nodes (``owned`` of them, global numbers ``owned_global``) of the state, communicator
-    ``comm``."""
+    nodes of the state (their global numbers ``owned_global``), communicator ``comm``."""
 
     def __init__(self, contacts, comm, owned_global: np.ndarray):
         self.contacts, self.comm = list(contacts), comm
         self.owned_global = np.asarray(owned_global, dtype=np.int64)
 
-    def force(self, s) -> np.ndarray:
-        """The contact force on each owned node of ``s`` (N, rows of 3)."""
+    def force(self) -> np.ndarray:
+        """The contact force on each owned node (N, rows of 3)."""
         total = np.zeros((len(self.owned_global), 3))
         for contact in self.contacts:
             rows, force, _ = contact.nodal_forces()

@@ -111,11 +111,12 @@ class Fields:
         """The nodal contact force (N) and contact pressure (Pa) of the step."""
         if not self._loads:
             V = self.u.function_space
-            force, pressure = fem.Function(V), fem.Function(_compat.scalar_space(V.mesh, "Lagrange", 1))
+            nodal = _compat.scalar_space(V.mesh, "Lagrange", 1)
+            force, pressure = fem.Function(V), fem.Function(nodal)
             force.name, pressure.name = "contact_force", "contact_pressure"
             self._loads = (force, pressure)
         force, pressure = self._loads
-        values = self._contact.force(s)
+        values = self._contact.force()
         force.x.array[: values.size] = values.ravel()
         values = self._contact.pressure(s)
         pressure.x.array[: values.size] = values
