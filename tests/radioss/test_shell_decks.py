@@ -162,6 +162,28 @@ def test_ithick_and_p_thickfail_map_onto_the_element(shared_dir):
     assert load_deck(written(plate_deck(), shared_dir)).element.thickness_change is None
 
 
+def test_blank_ishell_and_iplas_take_openradioss_defaults(shared_dir):
+    """A blank Ishell is 1 (Belytschko-Tsay: OpenRadioss's starter, defaults_mod.F90
+    init_def_elem, gives /DEF_SHELL's Ishell 1 outside /IMPLICIT; hm_read_prop01.F takes
+    it for a blank field); a blank Iplas is Radioss's radial return for LAW2 (cgrtails.F
+    keeps 0, m2cplr.F scales the trial stress), read as the exact return with one warning;
+    Iplas 1 gives none."""
+
+    def blank(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, " " * 10)
+        k = lines.index("/PROP/SHELL/1") + 4
+        lines[k] = lines[k][:80]
+
+    said = []
+    scene = load_deck(written(plate_deck(), shared_dir, blank), report=said)
+    assert scene.element.formulation == "bt"
+    warned = [w for w in said[0].warnings if "Iplas = 0 (blank)" in w]
+    assert len(warned) == 1 and "exact one of Iplas 1" in warned[0]
+    said = []
+    load_deck(written(plate_deck(), shared_dir), report=said)
+    assert not [w for w in said[0].warnings if "Iplas" in w]
+
+
 @pytest.mark.parametrize("ishell, idrill", [(1, 1), (3, 0), (3, 2)])
 def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, shared_dir):
     """Idrill 1: drilling springs of 0.01 G t A per node (2 or blank: none); Ishell 3 (the

@@ -7,8 +7,10 @@ hourglass stiffness, orthogonal to the rigid modes) to ``"bwc"`` with
 ``hourglass_stiffness`` :data:`HOURGLASS_STIFFNESS` (elastic: a warning says so); 24
 (QEPH, Belytschko-Leviathan's physical stabilisation) and 12 to ``"bwc"``
 (Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and viscous
-hourglass control), with a warning that QEPH's physical stabilisation is not there. Ish3n
-1 and 2 (the C0 triangle) to ``"bsc"``. Idrill 1 gives the quadrilaterals drilling
+hourglass control), with a warning that QEPH's physical stabilisation is not there; a
+blank Ishell is 1, as in OpenRadioss's starter. Ish3n 1 and 2 (the C0 triangle) to
+``"bsc"``. Iplas 0 (blank) or 2, Radioss's radial return for LAW2, is read as the exact
+plane-stress return (Iplas 1), with a warning. Idrill 1 gives the quadrilaterals drilling
 springs, ``drilling_stiffness`` :data:`DRILLING_STIFFNESS` (2 or blank: none). N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
 ``thickness``, ``shear_factor`` and ``hourglass_coefficients`` (Radioss's defaults where
 blank: N 5, Ashear 5/6, hm hf hr 0.01); P_thickfail becomes ``failed_share`` (blank: 1,
@@ -97,7 +99,9 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     first = next(li for li in card.lines if li.where == raw["first"])
     third = next(li for li in card.lines if li.where == raw["third"])
     value = {k: v or deck.shell_defaults.get(k, 0) for k, v in raw["given"].items()}
-    ishell = value["ishell"] or 24  # Radioss's default (QEPH)
+    # a blank Ishell (and /DEF_SHELL's) is 1 in OpenRadioss's starter (defaults_mod.F90,
+    # init_def_elem: 24 only with /IMPLICIT, which is not read here)
+    ishell = value["ishell"] or 1
     ish3n = value["ish3n"] or 2
     if ishell not in ISHELL:
         card.fail(f"Ishell = {ishell}: supported: {_ISHELL_TEXT}", first)
@@ -139,6 +143,11 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
         element["failed_share"] = raw["thickfail"]
     if value["ithick"] == 1:
         element["thickness_change"] = True
+    if value["iplas"] in (0, 2):
+        deck.warn(card, f"Iplas = {value['iplas']}{' (blank)' if not value['iplas'] else ''}: "
+                  "Radioss returns a LAW2 material's plane stress radially (a scaled trial "
+                  "stress, cgrtails.F and m2cplr.F); rwall_fem's return is the exact one of "
+                  "Iplas 1", third)  # fmt: skip
     if ishell in (12, 24):
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   "warping correction and viscous hourglass control hm, hf, hr (QEPH's "
