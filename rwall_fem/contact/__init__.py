@@ -80,7 +80,10 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 if name in surfaces or name in eroding:
                     continue
                 if not solid.shells and may_erode(scene, body.parts[k]):
-                    eroding[name] = ErodingSurface(body, k, comm, (internal or body).elements[k])
+                    eroding[name] = ErodingSurface(body, k, comm, (internal or body).elements[k],
+                                                   held)  # fmt: skip
+                    if held is not None:
+                        cut[name], axes[name] = eroding[name].cut, eroding[name].axes
                 else:
                     surfaces[name] = faces(body, k, comm)
                     if held is not None:
