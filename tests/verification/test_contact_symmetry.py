@@ -11,8 +11,8 @@ one bar on it is taken as a whole gap inside the other's cut face (distance 0): 
 penalty pushes it along the plane's normal, which the symmetry condition cancels, so the
 node passes through the other bar, and the spring at its cap stiffness shrinks the step
 until the run stops (undamped, at the automatic step: "the changes of the time step have
-put 5.43 % of the body's energy into it" at step 252, with 4 of the 9 nodes of each end
-in contact and a fifth of the impulse). Now the faces on symmetry planes are not segments, and a node on
+put 5.43 % of the body's energy into it" at step 252, with at most 6 of the 18 nodes of
+the two passes in contact, where 18 should be). Now the faces on symmetry planes are not segments, and a node on
 the planes acts as its share of the whole node (``docs/theory.md``, "Symmetry planes").
 
 Both runs take one fixed step (5e-8 s, below both stable steps): the automatic step of
