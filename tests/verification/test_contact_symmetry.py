@@ -12,8 +12,9 @@ penalty pushes it along the plane's normal, which the symmetry condition cancels
 node passes through the other bar, and the spring at its cap stiffness shrinks the step
 until the run stops (undamped, at the automatic step: "the changes of the time step have
 put 5.43 % of the body's energy into it" at step 252, with at most 6 of the 18 nodes of
-the two passes in contact, where 18 should be). Now the faces on symmetry planes are not segments, and a node on
-the planes acts as its share of the whole node (``docs/theory.md``, "Symmetry planes").
+the two passes in contact). Now the faces on symmetry planes are not segments, and a node
+on the planes acts as its share of the whole node (``docs/theory.md``, "Symmetry
+planes").
 
 Both runs take one fixed step (5e-8 s, below both stable steps): the automatic step of
 a quarter differs from the whole's, since the highest eigenvalue of its mesh is found
