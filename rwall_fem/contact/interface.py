@@ -96,7 +96,7 @@ class ContactInterface:
         self.gap, self.friction, self.alpha, self.margin = gap, friction, alpha, margin
         self.ffi, self.lib = load()
         n = len(nodes)
-        self.size = n
+        self.size, self.nodes = n, nodes
         position = np.searchsorted(nodes, owned_global)
         position = np.minimum(position, max(n - 1, 0))
         hit = (nodes[position] == owned_global) if n else np.zeros(len(owned_global), bool)
@@ -281,6 +281,15 @@ class ContactInterface:
         self.latest, self.normal_force, self.contacts = latest, normal, contacts
         self._pending = True
         self._previous_dt = s.dt_previous
+
+    def nodal_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What the latest pass added to the accelerations: the state rows of this rank's
+        owned surface nodes, the force on each (N, rows of 3), and the segments of every
+        pass (rows of 4 global node numbers, -1 as the 4th of a triangle; the same on every
+        rank), for the outputs (:mod:`rwall_fem.output.contact_loads`)."""
+        segments = [np.where(ps.segments >= 0, self.nodes[np.maximum(ps.segments, 0)], -1)
+                    for ps in self.passes]  # fmt: skip
+        return self.mine, self._owned_force, np.concatenate(segments).reshape(-1, 4)
 
     def energies(self) -> dict[str, float]:
         """This rank's share of the books (J) after the update of step n: -W - D on its
