@@ -533,7 +533,9 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
  * point on the planes, so the normal lies in them: its components normal to the planes go.
  * The node holds share[s] of the whole node's mass (1/2 on a plane, 1/4 on two), so its
  * pair takes that share of the whole pair's stiffness (hence of its force, energy and
- * friction); the damping sees the whole nodes' masses, mass / share. */
+ * friction); the damping sees the whole nodes' masses, mass / share; the velocity
+ * relative to the point loses its components normal to the planes, as the blend of the
+ * mirror images averages them away. */
 INLINE double mirror(const contact_params *prm, int64_t s, surface_point *pt)
 {
   if (!prm->share)
@@ -671,6 +673,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       for (int c = 0; c < 3; ++c)
         w[c] -= pt.weight[m] * v[3 * pt.node[m] + c];
     }
+    if (prm->planes) /* the whole model's blend: the mirror images' velocities averaged */
+      for (int c = 0; c < 3; ++c)
+        w[c] = (prm->planes[s] >> c) & 1 ? 0.0 : w[c];
     const double *normal = pt.normal;
     const double wn = cdot(w, normal);
     const double whole = mass[s] / share; /* the whole node's */

@@ -66,7 +66,7 @@ def bars_geo(quarter: bool, separation=2e-4) -> str:
     return "\n".join(lines) + "\n"
 
 
-def bars(directory, quarter: bool) -> dict:
+def bars(directory, quarter: bool, friction=0.0) -> dict:
     raw = {
         "run": {"end_time": 3.2e-5, "dt": 5e-8},
         "mesh": {"file": str(write_geo(directory, "bars.geo", bars_geo(quarter)))},
@@ -75,7 +75,7 @@ def bars(directory, quarter: bool) -> dict:
             {"name": "lower", "initial": {"velocity": [0, 0, SPEED]}},
             {"name": "upper", "initial": {"velocity": [0, 0, -SPEED]}},
         ],
-        "contact": [{"main": ["upper"], "secondary": ["lower"]}],
+        "contact": [{"main": ["upper"], "secondary": ["lower"], "friction": friction}],
         "output": {"plot": False},
     }
     if quarter:
@@ -84,10 +84,12 @@ def bars(directory, quarter: bool) -> dict:
     return raw
 
 
-def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory):
-    """The quarter's impulse, kinetic and strain energy x 4 equal the whole model's to
-    1e-9 of the whole's; its surface has a quarter of the whole's segments (the cut faces
-    left out); the contact acted (the bars rebound) and the books close."""
+@pytest.mark.parametrize("friction", [0.0, 0.3])
+def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory, friction):
+    """The quarter's impulse, kinetic and strain energy and the contact's dissipation
+    (damping; and friction, as the bars' ends bulge and slide on each other) x 4 equal the
+    whole model's to 1e-9 of the whole's; its surface has a quarter of the whole's segments
+    (the cut faces left out); the contact acted (the bars rebound) and the books close."""
 
     def folder(name):
         comm = MPI.COMM_WORLD
@@ -96,7 +98,7 @@ def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory):
     books = {}
     for quarter in (False, True):
         directory = folder("quarter" if quarter else "whole")
-        sim = run(bars(directory, quarter), directory)
+        sim = run(bars(directory, quarter, friction), directory)
         s = sim.history.summary
         share = 4.0 if quarter else 1.0
         books[quarter] = {
@@ -104,13 +106,14 @@ def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory):
             "kinetic": share * s["energy"]["kinetic"],
             "internal": share * s["energy"]["internal"],
             "segments": share * s["contacts"][0]["segments"],
+            "friction": share * s["energy"]["contact_friction"],
         }
         assert s["energy"]["max_balance_error"] <= 1e-12
     whole, part = books[False], books[True]
     mass = STEEL["density"] * A_SIDE**2 * L
     assert -whole["impulse"] == pytest.approx(2 * mass * SPEED, rel=0.02)  # the rebound
     assert part["segments"] == whole["segments"]
-    for name in ("impulse", "kinetic", "internal"):
+    for name in ("impulse", "kinetic", "internal", "friction"):
         scale = abs(whole["impulse"]) if name == "impulse" else whole["kinetic"] + whole["internal"]
         assert abs(part[name] - whole[name]) <= 1e-9 * scale, name
 
