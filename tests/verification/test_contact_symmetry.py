@@ -1,7 +1,8 @@
 """A quarter model cut by symmetry planes meets another body as the whole model does.
 
-Two equal steel bars (4 x 4 x 40 mm, nu = 0.3, so their ends bulge and slide sideways on
-each other) meet head-on at +-10 m/s through a [[contact]]. The quarter (x >= 0, y >= 0,
+Two bars (4 x 4 x 40 mm), of aluminium (nu = 0.33) below and steel (nu = 0.3) above, meet
+head-on at +-10 m/s through a [[contact]]: their ends bulge unequally and slide on each
+other (with friction 0.3, the contact dissipates 3.5 % more than without). The quarter (x >= 0, y >= 0,
 cut by the planes x = 0 and y = 0 through the bars' axis, u_x = 0 held on the first and
 u_y = 0 on the second) must give a quarter of the whole model's impulse, kinetic and
 strain energy, step by step. Reference: the whole model itself (symmetry).
@@ -19,7 +20,7 @@ planes").
 Both runs take one fixed step (5e-8 s, below both stable steps): the automatic step of
 a quarter differs from the whole's, since the highest eigenvalue of its mesh is found
 without its symmetry conditions. With the contact's default damping the quarter equals
-the whole to 1e-9 (6e-11 measured); undamped, the nodes that come into and out of
+the whole to 1e-9 (2e-11 measured, with and without friction); undamped, the nodes that come into and out of
 contact at each ringing of the stiff springs grow the round-off of the two sums (the
 whole model adds mirror forces in another order) to about 1e-6, as they do between rank
 counts.
@@ -33,6 +34,7 @@ from test_contact import write_geo
 
 L, A_SIDE, H, SPEED = 0.04, 0.004, 0.001, 10.0
 STEEL = {"model": "linear_elastic", "density": 7850.0, "young": 200e9, "poisson": 0.3}
+ALUMINIUM = {"model": "linear_elastic", "density": 2700.0, "young": 70e9, "poisson": 0.33}
 
 
 def bars_geo(quarter: bool, separation=2e-4) -> str:
@@ -72,7 +74,7 @@ def bars(directory, quarter: bool, friction=0.0) -> dict:
         "mesh": {"file": str(write_geo(directory, "bars.geo", bars_geo(quarter)))},
         "material": STEEL,
         "part": [
-            {"name": "lower", "initial": {"velocity": [0, 0, SPEED]}},
+            {"name": "lower", "initial": {"velocity": [0, 0, SPEED]}, "material": ALUMINIUM},
             {"name": "upper", "initial": {"velocity": [0, 0, -SPEED]}},
         ],
         "contact": [{"main": ["upper"], "secondary": ["lower"], "friction": friction}],
@@ -89,7 +91,8 @@ def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory, friction):
     """The quarter's impulse, kinetic and strain energy and the contact's dissipation
     (damping; and friction, as the bars' ends bulge and slide on each other) x 4 equal the
     whole model's to 1e-9 of the whole's; its surface has a quarter of the whole's segments
-    (the cut faces left out); the contact acted (the bars rebound) and the books close."""
+    (the cut faces left out); the contact acted (the aluminium bar turns back) and the
+    books close."""
 
     def folder(name):
         comm = MPI.COMM_WORLD
@@ -110,8 +113,8 @@ def test_a_quarter_of_two_bars_meets_as_the_whole(tmp_path_factory, friction):
         }
         assert s["energy"]["max_balance_error"] <= 1e-12
     whole, part = books[False], books[True]
-    mass = STEEL["density"] * A_SIDE**2 * L
-    assert -whole["impulse"] == pytest.approx(2 * mass * SPEED, rel=0.02)  # the rebound
+    mass = ALUMINIUM["density"] * A_SIDE**2 * L
+    assert -whole["impulse"] >= 2 * mass * SPEED  # the aluminium bar turns back
     assert part["segments"] == whole["segments"]
     for name in ("impulse", "kinetic", "internal", "friction"):
         scale = abs(whole["impulse"]) if name == "impulse" else whole["kinetic"] + whole["internal"]
