@@ -2,28 +2,29 @@
 
 Two bars (4 x 4 x 40 mm), of aluminium (nu = 0.33) below and steel (nu = 0.3) above, meet
 head-on at +-10 m/s through a [[contact]]: their ends bulge unequally and slide on each
-other (with friction 0.3, the contact dissipates 3.5 % more than without). The quarter (x >= 0, y >= 0,
-cut by the planes x = 0 and y = 0 through the bars' axis, u_x = 0 held on the first and
-u_y = 0 on the second) must give a quarter of the whole model's impulse, kinetic and
-strain energy, step by step. Reference: the whole model itself (symmetry).
+other (with friction 0.3, the contact dissipates 3.5 % more than without). The quarter
+(x >= 0, y >= 0, cut by the planes x = 0 and y = 0 through the bars' axis, u_x = 0 held on
+the first and u_y = 0 on the second) must give a quarter of the whole model's impulse,
+kinetic and strain energy and contact dissipation. Reference: the whole model itself
+(symmetry).
 
 Without care it does not: the cut faces of the two bars lie in one plane, and a node of
 one bar on it is taken as a whole gap inside the other's cut face (distance 0): the
 penalty pushes it along the plane's normal, which the symmetry condition cancels, so the
 node passes through the other bar, and the spring at its cap stiffness shrinks the step
-until the run stops (undamped, at the automatic step: "the changes of the time step have
-put 5.43 % of the body's energy into it" at step 252, with at most 6 of the 18 nodes of
-the two passes in contact). Now the faces on symmetry planes are not segments, and a node
-on the planes acts as its share of the whole node (``docs/theory.md``, "Symmetry
-planes").
+until the run stops (two steel bars, undamped, at the automatic step: "the changes of the
+time step have put 5.43 % of the body's energy into it" at step 252, with at most 6 of
+the 18 nodes of the two passes in contact). Now the faces on symmetry planes are not
+segments, and a node on the planes acts as its share of the whole node
+(``docs/theory.md``, "Symmetry planes").
 
 Both runs take one fixed step (5e-8 s, below both stable steps): the automatic step of
 a quarter differs from the whole's, since the highest eigenvalue of its mesh is found
 without its symmetry conditions. With the contact's default damping the quarter equals
-the whole to 1e-9 (2e-11 measured, with and without friction); undamped, the nodes that come into and out of
-contact at each ringing of the stiff springs grow the round-off of the two sums (the
-whole model adds mirror forces in another order) to about 1e-6, as they do between rank
-counts.
+the whole to 1e-9 (2e-11 measured, with and without friction). Undamped (two steel bars),
+the nodes that come into and out of contact at each ringing of the stiff springs grow the
+round-off of the two sums (the whole model adds mirror forces in another order) to about
+1e-6.
 """
 
 import pytest
