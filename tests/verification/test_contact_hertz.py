@@ -54,13 +54,14 @@ def spheres(directory, speed, h_min, h_far, end_time, quarter=False, damping=0.0
 Physical Volume("upper") = {2};"""
     if quarter:
         e = 1e-6
+        low = f"{-e}, {-3 * R}, {-e}"  # the boxes' lower corner
         volumes = f"""Box(3) = {{0, {-3 * R}, 0, {2 * R}, {6 * R}, {2 * R}}};
 v[] = BooleanIntersection{{ Volume{{1}}; Delete; }}{{ Volume{{3}}; }};
 w[] = BooleanIntersection{{ Volume{{2}}; Delete; }}{{ Volume{{3}}; Delete; }};
 Physical Volume("lower") = {{v[]}};
 Physical Volume("upper") = {{w[]}};
-Physical Surface("cut_x") = Surface In BoundingBox{{{-e}, {-3 * R}, {-e}, {e}, {3 * R}, {2 * R}}};
-Physical Surface("cut_z") = Surface In BoundingBox{{{-e}, {-3 * R}, {-e}, {2 * R}, {3 * R}, {e}}};"""
+Physical Surface("cut_x") = Surface In BoundingBox{{{low}, {e}, {3 * R}, {2 * R}}};
+Physical Surface("cut_z") = Surface In BoundingBox{{{low}, {2 * R}, {3 * R}, {e}}};"""
     geo = f"""SetFactory("OpenCASCADE");
 Sphere(1) = {{0, {-R - s}, 0, {R}}};
 Sphere(2) = {{0, {R + s}, 0, {R}}};
