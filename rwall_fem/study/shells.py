@@ -49,14 +49,18 @@ STEEL = {"density": 7850.0, "young": 210.0e9, "poisson": 0.3}
 # on solids (no membrane stiffening: 34 % more deflection here), while the shells'
 # co-rotational frame makes it exact for large rotations (the strains stay small).
 LOADS = {
-    "elastic": ({"model": "linear_elastic", **STEEL}, 5.0, 4.0e-3),
+    "elastic": ({"model": "linear_elastic", **STEEL}, 5.0, 3.0e-3),
     "plastic": ({"model": "elastic_plastic", **STEEL, "hardening": "linear",
                  "yield_stress": 300.0e6, "hardening_modulus": 300.0e6}, 20.0, 2.0e-3),
 }  # fmt: skip
 SOLID_MODEL = {"linear_elastic": "saint_venant_kirchhoff"}
-# (in-plane size m, layers through the thickness): the aspect of the hexahedra stays 5.
-SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.6667e-3, 6))
-SHELL_LEVELS = (5.0e-3, 2.5e-3)  # m, quadrilaterals
+# (in-plane size m, layers through the thickness): halved together (RATIO), so the aspect of
+# the hexahedra stays 5 and three levels give Richardson's extrapolation.
+SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.25e-3, 8))
+RATIO = 2.0
+CONVERGED = 0.01  # the finest solid within this of the extrapolation: converged
+SAFETY = 1.25  # Roache's safety factor of the grid convergence index (three levels)
+SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
 QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
 SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
 MASS = 1.0  # kg, the whole sphere's
@@ -179,76 +183,203 @@ def measure(summary: dict, rows, share: int = 1) -> dict:
 
 FIGURES = {"peak_force": ("peak force", 1e-3, "kN"), "contact_time": ("contact time", 1e3, "ms"),
            "deflection": ("largest deflection", 1e3, "mm")}  # fmt: skip
+# the committed reference: the solid levels' rows (the finest take an hour each on 1 rank)
+REFERENCE = Path(__file__).resolve().parents[2] / "docs" / "study_shells_solids.csv"
+_TEXT = ("load", "kind", "status")
+_WHOLE = ("layers", "cells", "steps")
 
 
-def report(rows: list[dict], seconds: float) -> str:
-    """The markdown section: every run, and each shell's error against the finest solid."""
+def richardson(values, ratio: float = RATIO) -> dict:
+    """Richardson's extrapolation of a figure from three levels, coarse to fine, each
+    ``ratio`` times finer than the one before: the observed order p = ln(d21 / d32) /
+    ln(ratio) (d21 = f2 - f1, d32 = f3 - f2), the extrapolated value f3 + d32 / (ratio^p - 1),
+    its estimated error the grid convergence index of the finest level, SAFETY |d32| /
+    (ratio^p - 1), relative to it (Roache 1994), and the finest level's distance from it.
+    Not converging monotonically at an order of 0.5 at least (the differences change sign,
+    or do not shrink): no extrapolation, the finest level stands, with twice its last
+    change as its error and the order nan."""
+    f1, f2, f3 = (float(v) for v in values)
+    d21, d32 = f2 - f1, f3 - f2
+    order = math.log(d21 / d32) / math.log(ratio) if d21 * d32 > 0 else math.nan
+    if not order >= 0.5:  # nan too
+        return {"order": order, "value": f3, "error": 2 * abs(d32 / f3), "finest_error": 0.0,
+                "extrapolated": False}  # fmt: skip
+    value = f3 + d32 / (ratio**order - 1)
+    return {"order": order, "value": value, "error": SAFETY * abs(d32 / value) / (ratio**order - 1),
+            "finest_error": abs(f3 / value - 1), "extrapolated": True}  # fmt: skip
+
+
+def reference(rows: list[dict], load: str) -> dict:
+    """The solid reference of ``load``: per figure of :data:`FIGURES` Richardson's
+    extrapolation of the three solid levels (:func:`richardson`), or the finest solid alone
+    (``extrapolated`` False, error nan) with fewer levels."""
+    solids = [r for r in rows if r["load"] == load and r["kind"] == "solid"]
+    if len(solids) >= 3:
+        return {k: richardson([r[k] for r in solids[-3:]]) for k in FIGURES}
+    return {k: {"order": math.nan, "value": solids[-1][k], "error": math.nan,
+                "finest_error": math.nan, "extrapolated": False} for k in FIGURES}  # fmt: skip
+
+
+def _percent(x: float) -> str:
+    return "-" if math.isnan(x) else f"{100 * x:.2f} %"
+
+
+def report(rows: list[dict], seconds: float, cached: str = "") -> str:
+    """The markdown section: every run, the solids' extrapolation, and each run's error
+    against it; ``cached`` says where the solids' rows came from."""
     lines = ["## Shells against solids: a clamped 2 mm steel plate struck by a sphere", "",
              __doc__.split("\n\n", 1)[1].strip(), ""]  # fmt: skip
+    if cached:
+        lines += [cached, ""]
     for load in LOADS:
         runs = [r for r in rows if r["load"] == load]
         solids = [r for r in runs if r["kind"] == "solid"]
         if not solids:
             continue
-        ref = solids[-1]
+        ref = reference(rows, load)
         material, speed, end = LOADS[load]
         lines += [f"**{load}** ({material['model']} shells, "
                   f"{SOLID_MODEL.get(material['model'], material['model'])} solids, "
-                  f"{speed:g} m/s, {end * 1e3:g} ms); errors against the finest solid "
-                  f"({ref['cells']:,} hexahedra in the quarter).", ""]  # fmt: skip
-        if len(solids) > 1:
-            before = solids[-2]
-            change = ", ".join(f"{label} {100 * (ref[k] / before[k] - 1):+.2f} %"
-                               for k, (label, _, _) in FIGURES.items())  # fmt: skip
-            lines += [f"The finest solid against the level before it: {change}.", ""]
+                  f"{speed:g} m/s, {end * 1e3:g} ms).", ""]  # fmt: skip
         lines += ["| model | h (mm) | layers | cells | steps | loop wall (s) | loop CPU (s) | "
                   + " | ".join(f"{label} ({unit})" for label, _, unit in FIGURES.values())
                   + " | balance |",
                   "|---" * (7 + len(FIGURES) + 1) + "|"]  # fmt: skip
         for r in runs:
-            cells = [f"{r[k] * scale:.4g} ({100 * (r[k] / ref[k] - 1):+.2f} %)"
-                     if r is not ref else f"{r[k] * scale:.4g}"
+            cells = [f"{r[k] * scale:.4g} ({100 * (r[k] / ref[k]['value'] - 1):+.2f} %)"
                      for k, (_, scale, _) in FIGURES.items()]  # fmt: skip
             layers = r["layers"] if r["kind"] == "solid" else "-"
             lines.append(f"| {r['kind']} | {r['element_size'] * 1e3:.3g} | {layers} | "
                          f"{r['cells']:,} | {r['steps']:,} | {r['wall_seconds']:.3g} | "
                          f"{r['cpu_seconds']:.3g} | " + " | ".join(cells)
                          + f" | {r['balance_error']:.1e} |")  # fmt: skip
+        lines.append("| **solid reference** | " + " | " * 6 + " | ".join(
+            f"**{ref[k]['value'] * scale:.4g}**" for k, (_, scale, _) in FIGURES.items())
+            + " | |")  # fmt: skip
+        lines += ["", "| solid reference | " + " | ".join(label for label, _, _ in FIGURES.values())
+                  + " |", "|---" * (1 + len(FIGURES)) + "|"]  # fmt: skip
+        for name, key, fmt in (("observed order", "order", lambda x: "-" if math.isnan(x)
+                                else f"{x:.2f}"),
+                               ("estimated error (GCI)", "error", _percent),
+                               ("finest solid from it", "finest_error", _percent)):  # fmt: skip
+            lines.append(f"| {name} | " + " | ".join(fmt(ref[k][key]) for k in FIGURES) + " |")
+        lines.append("| converged (finest within 1 %) | " + " | ".join(
+            ("yes" if ref[k]["finest_error"] <= CONVERGED else "no")
+            if ref[k]["extrapolated"] else "not extrapolated" for k in FIGURES) + " |")
         lines.append("")
     lines.append(f"The shell study took {seconds:.0f} s (set-up included) on 1 rank.")
     return "\n".join(lines) + "\n"
 
 
+def read_rows(path: Path) -> list[dict]:
+    """Rows written by :func:`write_rows` (shells.csv, solids.csv), numbers as numbers."""
+    with open(path, newline="") as f:
+        return [{k: v if k in _TEXT else int(v) if k in _WHOLE else float(v)
+                 for k, v in r.items()} for r in csv.DictReader(f)]  # fmt: skip
+
+
+def write_rows(path: Path, rows: list[dict]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def _run(plan, out: Path, comm, echo) -> list[dict]:
+    """Each (load, kind, h, layers) of ``plan`` run in turn -> their rows."""
+    rows = []
+    for load, kind, h, layers in plan:
+        folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm"
+        row = run_plate(load, kind, h, layers, comm, folder)
+        if row["status"] != "done":  # stopped (a signal, a limit): so is the study
+            raise OutputError(f"study shells: {folder}: the run {row['status']}")
+        rows.append(row)
+        if comm.rank == 0 and echo:
+            echo(f"study shells: {load} {kind} h={h * 1e3:.3g}mm layers={layers} "
+                 f"cells={row['cells']} steps={row['steps']} loop={row['wall_seconds']:.3g}s "
+                 f"cpu={row['cpu_seconds']:.3g}s peak={row['peak_force']:.5g}N "
+                 f"contact={row['contact_time']:.5g}s deflection={row['deflection']:.5g}m",
+                 flush=True)  # fmt: skip
+    return rows
+
+
+def _solid_plan(loads, levels) -> list[tuple]:
+    return [(load, "solid", h, n) for load in loads for h, n in levels]
+
+
+def run_solid_reference(out="results/study-shells", *, comm=None, loads=tuple(LOADS),
+                        echo=print, keep: Path | None = REFERENCE) -> list[dict]:  # fmt: skip
+    """Every solid level of every load (hours on 1 rank: the finest elastic one alone about
+    an hour of CPU): writes ``solids.csv`` in ``out`` and, with ``keep``, the committed
+    reference the study reads (``python -m rwall_fem.study.shells --solids``)."""
+    from mpi4py import MPI
+
+    comm = comm or MPI.COMM_WORLD
+    out = Path(out)
+    rows = _run(_solid_plan(loads, SOLID_LEVELS), out, comm, echo)
+    if comm.rank == 0:
+        write_rows(out / "solids.csv", rows)
+        if keep:  # the other loads' rows stay
+            others = [r for r in read_rows(keep) if r["load"] not in loads] if keep.exists() else []
+            write_rows(keep, sorted(others + rows, key=lambda r: list(LOADS).index(r["load"])))
+    return rows
+
+
+def _cached_solids(loads, comm, out: Path, echo) -> tuple[list[dict], str]:
+    """The solid levels from the committed reference (:data:`REFERENCE`), the missing ones
+    run; the coarsest of each load run again, to check the reference against this code."""
+    kept = read_rows(REFERENCE) if REFERENCE.exists() else []
+    kept = comm.bcast(kept if comm.rank == 0 else None, root=0)
+    rows, notes = [], []
+    for load in loads:
+        for h, n in SOLID_LEVELS:
+            found = [r for r in kept if r["load"] == load and r["element_size"] == h
+                     and r["layers"] == n]  # fmt: skip
+            rows += found[:1] or _run([(load, "solid", h, n)], out, comm, echo)
+        h, n = SOLID_LEVELS[0]
+        again = _run([(load, "solid", h, n)], out, comm, echo)[0]
+        first = next(r for r in rows if r["load"] == load)
+        change = max(abs(again[k] / first[k] - 1) for k in FIGURES)
+        notes.append(f"{load} {change:.1e}")
+    return rows, ("The solid rows are read from docs/study_shells_solids.csv (written by "
+                  "`python -m rwall_fem.study.shells --solids`); the coarsest solid of each "
+                  "load was run again with this code and its figures moved by at most "
+                  + ", ".join(notes) + " from the kept ones.")  # fmt: skip
+
+
 def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=None,
                     loads=tuple(LOADS), echo=print) -> list[dict]:  # fmt: skip
-    """Every load (of ``loads``) x (solid levels, shell levels); writes ``shells.csv`` and
-    ``shells.md``."""
+    """Every load (of ``loads``): the solid levels (read from :data:`REFERENCE`, see
+    :func:`_cached_solids`; with ``quick`` the coarsest solid only, run) and the shell
+    levels (run); writes ``shells.csv`` and ``shells.md``."""
     from mpi4py import MPI
 
     comm = comm or MPI.COMM_WORLD
     out = Path(out)
     started = time.perf_counter()
-    rows = []
-    for load in loads:
-        plan = [("solid", h, n) for h, n in (QUICK_SOLID if quick else SOLID_LEVELS)]
-        plan += [("shell", h, 0) for h in (QUICK_SHELL if quick else SHELL_LEVELS)]
-        for kind, h, layers in plan:
-            folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm"
-            row = run_plate(load, kind, h, layers, comm, folder)
-            if row["status"] != "done":  # stopped (a signal, a limit): so is the study
-                raise OutputError(f"study shells: {folder}: the run {row['status']}")
-            rows.append(row)
-            if comm.rank == 0 and echo:
-                echo(f"study shells: {load} {kind} h={h * 1e3:.3g}mm layers={layers} "
-                     f"cells={row['cells']} steps={row['steps']} loop={row['wall_seconds']:.3g}s "
-                     f"cpu={row['cpu_seconds']:.3g}s peak={row['peak_force']:.5g}N "
-                     f"contact={row['contact_time']:.5g}s deflection={row['deflection']:.5g}m",
-                     flush=True)  # fmt: skip
+    if quick:
+        solids, cached = _run(_solid_plan(loads, QUICK_SOLID), out, comm, echo), ""
+    else:
+        solids, cached = _cached_solids(loads, comm, out, echo)
+    shells = _run([(load, "shell", h, 0) for load in loads
+                   for h in (QUICK_SHELL if quick else SHELL_LEVELS)], out, comm, echo)  # fmt: skip
+    rows = [r for load in loads for r in solids + shells if r["load"] == load]
     seconds = comm.allreduce(time.perf_counter() - started, op=MPI.MAX)
     if comm.rank == 0:
-        with open(out / "shells.csv", "w", newline="") as f:
-            writer = csv.DictWriter(f, list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        (out / "shells.md").write_text(report(rows, seconds))
+        write_rows(out / "shells.csv", rows)
+        (out / "shells.md").write_text(report(rows, seconds, cached))
     return rows
+
+
+if __name__ == "__main__":
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m rwall_fem.study.shells", description=(
+        "the solid reference of the shell study: every solid level, written to OUT/solids.csv "
+        "and docs/study_shells_solids.csv"))  # fmt: skip
+    parser.add_argument("--solids", action="store_true", required=True)
+    parser.add_argument("--out", default="results/study-shells")
+    parser.add_argument("--load", choices=tuple(LOADS), action="append")
+    args = parser.parse_args()
+    run_solid_reference(args.out, loads=tuple(args.load or LOADS))
