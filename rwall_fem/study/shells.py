@@ -2,25 +2,35 @@
 
 The plate of the peer decks (``../shared/peer-decks/gen_shell.py plate``): 200 x 200 mm,
 2 mm steel (rho 7850 kg/m^3, E 210 GPa, nu 0.3), its rim clamped, struck at its centre by
-a rigid sphere of 40 mm on a 1 kg main node; elastic at 5 m/s (4 ms), and elasto-plastic
+a rigid sphere of 40 mm on a 1 kg main node; elastic at 5 m/s (3 ms), and elasto-plastic
 (J2, sigma_y = 300 MPa + 300 MPa eps_p) at 20 m/s (2 ms). The sphere starts 0.1 mm above
 the skin it strikes: the solids' top face, the shells' mid-surface (walls act on the
-shells' nodes, with no thickness offset). The shells are the whole plate; the solids a
-quarter of it (the planes x = 0 and y = 0 are planes of symmetry, the sphere's mass is a
-quarter), one-point hexahedra with the Flanagan-Belytschko stiffness hourglass control,
-refined in the plane and through the thickness together (the cells' aspect stays 5); the
-reference is the finest solid. The sphere's main node of the quarter lies on both planes:
-its x and y velocity are held (``motion.held = "xy"``). Free, it drifted sideways as soon
-as the plastic plate wrapped round it (nodes off the axis touching it all push it away from
-the quarter), about 4 m/s by 2 ms, and rebounded late or not at all; held, a quarter of the
-shells gives the whole plate's answers to 1e-12, elastic and elasto-plastic
-(``tests/shells/test_shell_symmetry.py``).
+shells' nodes, with no thickness offset). The shells are the whole plate in 5-point
+Belytschko-Lin-Tsay quadrilaterals with the Belytschko-Wong-Chiang warping correction; the
+solids a quarter of it (the planes x = 0 and y = 0 are planes of symmetry, held by u_x = 0
+on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahedra with the Flanagan-Belytschko stiffness hourglass control
+(coefficient 0.1), refined in the plane and through the thickness together, 5 mm x 2
+layers, 2.5 mm x 4 and 1.25 mm x 8 (the cells' aspect stays 5). The sphere's main node of
+the quarter lies on both planes: its x and y velocity are held (``motion.held = "xy"``).
+Free, it drifted sideways as soon as the plastic plate wrapped round it (nodes off the axis
+touching it all push it away from the quarter); held, a quarter of the shells gives the
+whole plate's answers to 1e-12 (``tests/shells/test_shell_symmetry.py``), and the coarsest
+solid quarter the whole solid plate's to 3e-5 (the whole plate, meshed by the built-in
+``plate`` shape, takes a step 1e-3 longer).
+
+The reference of each figure is Richardson's extrapolation of the three solid levels
+(:func:`richardson`): the observed order, the extrapolated value and its estimated error
+(Roache's grid convergence index, safety factor 1.25); the reference is converged when
+the finest solid lies within 1 % of it. The solid rows are computed by
+``python -m rwall_fem.study.shells --solids`` (hours on one rank) and kept in
+docs/study_shells_solids.csv, which ``rwall-fem study --shells`` reads, running its missing
+levels and the coarsest level again to check the kept rows against the code.
 
 Figures per run: the peak force on the sphere (N, its largest 50-us mean), the contact
 time (s, of the first contact: gaps under 50 us bridged, later touches of the receding
 sphere by the vibrating plate left out) and the largest deflection under the sphere (m:
 its largest travel less the 0.1 mm gap), with the cells, steps and the wall and CPU times
-of the time loop.
+of the time loop; each figure's error against the solid reference in brackets.
 """
 
 from __future__ import annotations
@@ -263,12 +273,26 @@ def report(rows: list[dict], seconds: float, cached: str = "") -> str:
                                ("estimated error (GCI)", "error", _percent),
                                ("finest solid from it", "finest_error", _percent)):  # fmt: skip
             lines.append(f"| {name} | " + " | ".join(fmt(ref[k][key]) for k in FIGURES) + " |")
+        if len(solids) > 1:
+            lines.append("| finest solid against the level before | " + " | ".join(
+                f"{100 * (solids[-1][k] / solids[-2][k] - 1):+.2f} %" for k in FIGURES) + " |")
         lines.append("| converged (finest within 1 %) | " + " | ".join(
             ("yes" if ref[k]["finest_error"] <= CONVERGED else "no")
             if ref[k]["extrapolated"] else "not extrapolated" for k in FIGURES) + " |")
-        lines.append("")
+        lines += ["", _saving(runs, solids[-1]), ""]
     lines.append(f"The shell study took {seconds:.0f} s (set-up included) on 1 rank.")
     return "\n".join(lines) + "\n"
+
+
+def _saving(runs: list[dict], solid: dict) -> str:
+    """What each shell level saves: its loop CPU (the whole plate) against the finest
+    solid's (a quarter, times SHARE for the whole plate: the cost goes with the cells)."""
+    whole = SHARE["solid"] * solid["cpu_seconds"]
+    shells = "; ".join(f"the {r['element_size'] * 1e3:.3g} mm shells {r['cpu_seconds']:.3g} s "
+                       f"for the whole plate ({whole / r['cpu_seconds']:.0f} times less)"
+                       for r in runs if r["kind"] == "shell")  # fmt: skip
+    return (f"What the shells save: the finest solid took {solid['cpu_seconds']:.3g} s of loop "
+            f"CPU for its quarter, about {whole:.3g} s for the whole plate; {shells}.")
 
 
 def read_rows(path: Path) -> list[dict]:
