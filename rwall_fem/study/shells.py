@@ -8,9 +8,10 @@ the skin it strikes: the solids' top face, the shells' mid-surface (walls act on
 shells' nodes, with no thickness offset). The shells are the whole plate in 5-point
 Belytschko-Lin-Tsay quadrilaterals with the Belytschko-Wong-Chiang warping correction; the
 solids a quarter of it (the planes x = 0 and y = 0 are planes of symmetry, held by u_x = 0
-on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahedra with the Flanagan-Belytschko stiffness hourglass control
-(coefficient 0.1), refined in the plane and through the thickness together, 5 mm x 2
-layers, 2.5 mm x 4 and 1.25 mm x 8 (the cells' aspect stays 5). The sphere's main node of
+on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahedra with
+the Flanagan-Belytschko stiffness hourglass control (coefficient 0.1), refined in the plane
+and through the thickness together, 5 mm x 2 layers, 2.5 mm x 4 and 1.25 mm x 8 (the
+cells' aspect stays 5). The sphere's main node of
 the quarter lies on both planes: its x and y velocity are held (``motion.held = "xy"``).
 Free, it drifted sideways as soon as the plastic plate wrapped round it (nodes off the axis
 touching it all push it away from the quarter); held, a quarter of the shells gives the
