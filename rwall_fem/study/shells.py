@@ -76,7 +76,11 @@ QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
 SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
 MASS = 1.0  # kg, the whole sphere's
 PEAK_WINDOW = 50e-6  # s, the peak force is the largest mean over this long
-SHARE = {"solid": 4, "shell": 1}  # the whole plate over the part that is run
+SHARE = {"solid": 4, "shell": 1, "thinning_shell": 1}  # the whole plate over the part run
+# kind -> its label; a "thinning_shell" is a shell whose thickness follows its membrane
+# strain (element.thickness_change, Radioss's Ithick 1), run at this size (m) under these loads
+MODELS = {"solid": "solid", "shell": "shell", "thinning_shell": "shell, thickness change"}
+THINNING = {"plastic": 2.5e-3}
 
 # The quarter plate in hexahedra: a structured box with its symmetry planes and its rim
 # as named face groups (the built-in plate names its sides only together).
@@ -108,17 +112,20 @@ def _quarter_geo(folder: Path, h: float, layers: int) -> Path:
 
 def plate_scene(load: str, kind: str, h: float, layers: int = 0,
                 folder: Path = Path(".")) -> dict:  # fmt: skip
-    """The scene of ``kind`` "shell" (the whole plate in quadrilaterals of ``h`` m) or
-    "solid" (its quarter in hexahedra, ``layers`` through the thickness, the mesh file in
-    ``folder``) under ``load`` (a key of :data:`LOADS`)."""
+    """The scene of ``kind`` "shell" (the whole plate in quadrilaterals of ``h`` m),
+    "thinning_shell" (the same, its thickness following its membrane strain) or "solid" (its
+    quarter in hexahedra, ``layers`` through the thickness, the mesh file in ``folder``)
+    under ``load`` (a key of :data:`LOADS`)."""
     material, speed, end_time = LOADS[load]
-    if kind == "shell":  # the whole plate
+    if kind != "solid":  # the whole plate
         mesh = {"shape": "plate", "origin": [-HALF, -HALF, -THICKNESS / 2],
                 "size": [2 * HALF, 2 * HALF, THICKNESS], "element_size": h,
                 "cell": "quadrilateral"}  # fmt: skip
         boundary = [{"group": side, "components": "xyz", "rotations": "xyz"}
                     for side in ("side_x0", "side_x1", "side_y0", "side_y1")]  # fmt: skip
         element, skin = {"points": 5}, 0.0  # the sphere acts on the mid-surface
+        if kind == "thinning_shell":
+            element["thickness_change"] = True
     else:
         mesh = {"file": str(_quarter_geo(folder, h, layers))}
         boundary = [
@@ -260,7 +267,7 @@ def report(rows: list[dict], seconds: float, cached: str = "") -> str:
             cells = [f"{r[k] * scale:.4g} ({100 * (r[k] / ref[k]['value'] - 1):+.2f} %)"
                      for k, (_, scale, _) in FIGURES.items()]  # fmt: skip
             layers = r["layers"] if r["kind"] == "solid" else "-"
-            lines.append(f"| {r['kind']} | {r['element_size'] * 1e3:.3g} | {layers} | "
+            lines.append(f"| {MODELS[r['kind']]} | {r['element_size'] * 1e3:.3g} | {layers} | "
                          f"{r['cells']:,} | {r['steps']:,} | {r['wall_seconds']:.3g} | "
                          f"{r['cpu_seconds']:.3g} | " + " | ".join(cells)
                          + f" | {r['balance_error']:.1e} |")  # fmt: skip
@@ -292,6 +299,9 @@ def _saving(runs: list[dict], solid: dict) -> str:
     shells = "; ".join(f"the {r['element_size'] * 1e3:.3g} mm shells {r['cpu_seconds']:.3g} s "
                        f"for the whole plate ({whole / r['cpu_seconds']:.0f} times less)"
                        for r in runs if r["kind"] == "shell")  # fmt: skip
+    shells += "".join(f"; with its thickness changing, {r['cpu_seconds']:.3g} s at "
+                      f"{r['element_size'] * 1e3:.3g} mm" for r in runs
+                      if r["kind"] == "thinning_shell")  # fmt: skip
     return (f"What the shells save: the finest solid took {solid['cpu_seconds']:.3g} s of loop "
             f"CPU for its quarter, about {whole:.3g} s for the whole plate; {shells}.")
 
@@ -315,7 +325,7 @@ def _run(plan, out: Path, comm, echo) -> list[dict]:
     """Each (load, kind, h, layers) of ``plan`` run in turn -> their rows."""
     rows = []
     for load, kind, h, layers in plan:
-        folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm"
+        folder = out / "runs" / f"{load}-{kind}-h{h * 1e3:.3g}mm-{layers}"
         row = run_plate(load, kind, h, layers, comm, folder)
         if row["status"] != "done":  # stopped (a signal, a limit): so is the study
             raise OutputError(f"study shells: {folder}: the run {row['status']}")
@@ -387,8 +397,11 @@ def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=Non
         solids, cached = _run(_solid_plan(loads, QUICK_SOLID), out, comm, echo), ""
     else:
         solids, cached = _cached_solids(loads, comm, out, echo)
-    shells = _run([(load, "shell", h, 0) for load in loads
-                   for h in (QUICK_SHELL if quick else SHELL_LEVELS)], out, comm, echo)  # fmt: skip
+    plan = [(load, "shell", h, 0) for load in loads
+            for h in (QUICK_SHELL if quick else SHELL_LEVELS)]  # fmt: skip
+    if not quick:
+        plan += [(load, "thinning_shell", THINNING[load], 0) for load in loads if load in THINNING]
+    shells = _run(plan, out, comm, echo)
     rows = [r for load in loads for r in solids + shells if r["load"] == load]
     seconds = comm.allreduce(time.perf_counter() - started, op=MPI.MAX)
     if comm.rank == 0:
