@@ -20,8 +20,9 @@ solid quarter the whole solid plate's to 3e-5 (the whole plate, meshed by the bu
 ``plate`` shape, takes a step 1e-3 longer).
 
 The reference of each figure is Richardson's extrapolation of the three solid levels
-(`richardson` in `rwall_fem/study/shells.py`): the observed order, the extrapolated value and its estimated error
-(Roache's grid convergence index, safety factor 1.25); the reference is converged when
+(`richardson` in `rwall_fem/study/shells.py`): the observed order, the extrapolated
+value and its estimated error (Roache's grid convergence index, safety factor 1.25); the
+reference is converged when
 the finest solid lies within 1 % of it. The solid rows are computed by
 ``python -m rwall_fem.study.shells --solids`` (hours on one rank) and kept in
 docs/study_shells_solids.csv, which ``rwall-fem study --shells`` reads, running its missing
