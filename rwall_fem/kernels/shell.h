@@ -65,6 +65,29 @@ INLINE int shell_any(ivec m)
 #endif
 }
 
+/* batch.h's gather of the 3 components of the npe nodes of the batch's cells into
+ * out[3 I + i][lane], node by node where the host has AVX-512 (VL): each lane's node as one
+ * masked load of its x, y, z (the lane past z is not read) and a 4 x 4 transpose. */
+INLINE void shell_gather(const int32_t *restrict cells, int npe, const batch_t *b,
+                         const double *restrict values, vec *restrict out)
+{
+#if defined(__AVX512VL__) && LANES == 4
+  for (int I = 0; I < npe; ++I)
+  {
+    __m256d r[4];
+    for (int k = 0; k < 4; ++k)
+      r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[k] * npe + I]);
+    const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
+    const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
+    out[3 * I] = (vec)_mm256_permute2f128_pd(t0, t2, 0x20);
+    out[3 * I + 1] = (vec)_mm256_permute2f128_pd(t1, t3, 0x20);
+    out[3 * I + 2] = (vec)_mm256_permute2f128_pd(t0, t2, 0x31);
+  }
+#else
+  gather(cells, npe, b, values, out);
+#endif
+}
+
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
 INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
 {
