@@ -427,6 +427,33 @@ typedef struct
   double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
 } surface_point;
 
+/* The squared distance (m^2) of p to the box of segment `seg`'s corners: a lower bound of
+ * its distance to the segment (which lies in the box), found with a few comparisons. */
+INLINE double box_distance2(const double p[3], const int64_t *seg, const double *x)
+{
+  const int corners = seg[3] >= 0 ? 4 : 3;
+  double d2 = 0.0;
+  for (int c = 0; c < 3; ++c)
+  {
+    double a = x[3 * seg[0] + c], b = a;
+    for (int k = 1; k < corners; ++k)
+    {
+      const double y = x[3 * seg[k] + c];
+      a = y < a ? y : a;
+      b = y > b ? y : b;
+    }
+    const double out = p[c] < a ? a - p[c] : (p[c] > b ? p[c] - b : 0.0);
+    d2 += out * out;
+  }
+  return d2;
+}
+
+/* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
+ * is then beyond the reach (it cannot be the closest) and beyond the band of any closest
+ * distance below the reach (d - best > 1e-6 reach > BAND best: its share would be < 0),
+ * with room for the round-off of both distances, so that skipping it changes nothing. */
+#define FAR (1.0 + 1e-6)
+
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
  * 0 if none is within reach.  `distance` holds to - from values (scratch).
  *
@@ -448,10 +475,18 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               surface_point *pt)
 {
   double best = INFINITY;
+  const double far2 = FAR * reach * FAR * reach;
   for (int64_t k = from; k < to; ++k)
   {
+    const int64_t *seg = segs + 4 * candidates[k];
+    if (box_distance2(xs, seg, x) > far2)
+    {
+      distance[k - from] = INFINITY; /* out of reach and out of any band: as the exact
+                                        distance would be (see FAR) */
+      continue;
+    }
     double q[3], w[4], n[3];
-    const double dk = closest_on_segment(xs, segs + 4 * candidates[k], x, q, w, n);
+    const double dk = closest_on_segment(xs, seg, x, q, w, n);
     distance[k - from] = dk;
     best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
   }
