@@ -12,9 +12,11 @@
    The contact's share is taken over the steps at or after ``--fold-time`` (folds in
    contact; the number of nodes in contact is given), as the median over blocks of
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
-   At 100,000 cells the press comes down at ``--fast`` times the speed with 1/fast^2 of the
-   mass (the same 5 kJ; the same folds, sooner), the run ends at ``--end`` / fast: that
-   run's time is what a rank can give it on this machine.
+   From ``--fast-from`` cells (100,000) the press comes down at ``--fast`` (8) times the
+   speed with 1/fast^2 of the mass (the same 5 kJ; folds in contact sooner), and the run
+   ends at ``--fast-end`` / fast (3.2 ms / 8; the fold window from ``--fold-time`` / fast):
+   6 ms at 10 m/s would be some 64,000 steps of 100,000 shells, more than a shared rank
+   can give it.
 2. **Search**: the bucket sort of ``kernels/contact.c`` as the interface calls it
    (``ContactInterface._sort``: one self-contact pass, all nodes secondary, own and
    neighbouring segments excluded) on a pleated sheet of n x n quadrilaterals of 1 mm
@@ -127,8 +129,15 @@ def slowest(values: np.ndarray) -> np.ndarray:
     return out
 
 
-def tube(cells: int, end: float, fold_time: float, fast: float, block: int) -> dict:
-    sc = tube_scene(cells, end, fast)
+def deck_scene(path: Path):
+    from rwall_fem.radioss import load_deck
+
+    scene = load_deck(path, (), comm, report=[])
+    return scene
+
+
+def tube(sc, fold_time: float, fast: float, block: int) -> dict:
+    """The timed run of scene ``sc``: its books and the contact's shares (see the top)."""
     sim = build_simulation(sc, comm, f"/tmp/rwall-bench-contact-{comm.size}", limits=False)
     clock = StepClock(sim)
     sim.run()
@@ -159,12 +168,14 @@ def tube(cells: int, end: float, fold_time: float, fast: float, block: int) -> d
     return {
         "cells": sim.info.get("cells"),
         "surface_nodes": contact.size,
-        "element_size_mm": sc.mesh.element_size * 1e3,
+        "element_size_mm": sc.mesh.element_size * 1e3 if sc.mesh.element_size else None,
         "press_speed": 10.0 * fast,
-        "end_ms": end / fast * 1e3,
+        "end_ms": sc.run.end_time * 1e3,
+        "loop_seconds": sim.wall_seconds,
         "steps": summary["steps"],
         "sorts": contact.sorts,
         "balance": summary.get("energy_balance"),
+        "all": window(t >= 0.0),
         "early": window(t < 1e-3 / fast),
         "folds": window(t >= fold_time / fast),
         "contacts_by_ms": [[float(a * 1e3), int(c)] for a, c in zip(t[::500], contacts[::500])],
@@ -277,40 +288,65 @@ def tube_lines(results: dict, fast_at: int, fast: float, before: str, after: str
     return lines
 
 
+def deck_lines(path: Path, r: dict, before: str, after: str) -> list[str]:
+    w, e = r["folds"], r["early"]
+    every = r["all"]
+    return [f"### The peer tube deck with self-contact ({path.name}), {comm.size} rank(s)", "",
+            f"Load average before {before}, after {after}: {r['steps']:,} cycles, a loop of "
+            f"{r['loop_seconds']:.1f} s (wall), {every['ms_per_step']:.2f} ms of processor "
+            f"time per cycle; the contact takes **{every['share']:.1%}** of the loop "
+            f"({e['share']:.1%} over the first ms, {w['share']:.1%} from "
+            f"{w['from_ms']:.1f} ms on, {w['contacts_mean']:.0f} nodes in contact on average "
+            f"there, {w['contacts_max']} at most); sort {every['sort_share']:.1%}, gather "
+            f"{every['gather_share']:.1%}; {r['sorts']} sorts.", ""]  # fmt: skip
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, help="write (1 rank) or append (N ranks) Markdown")
     p.add_argument("--quick", action="store_true", help="10k tube to 2.5 ms, search to 100k")
     p.add_argument("--tube-cells", type=int, nargs="*", default=[10_000, 100_000])
-    p.add_argument("--end", type=float, default=4.0e-3, help="s, at 10 m/s")
+    p.add_argument("--end", type=float, default=6.0e-3, help="s, at 10 m/s")
     p.add_argument("--fold-time", type=float, default=2.0e-3, help="s, at 10 m/s")
-    p.add_argument("--fast", type=float, default=4.0, help="press speed factor at 100k")
+    p.add_argument("--fast", type=float, default=8.0, help="press speed factor at 100k")
+    p.add_argument("--fast-end", type=float, default=3.2e-3, help="s at 10 m/s: --end of "
+                   "the fast runs (divided by --fast)")  # fmt: skip
     p.add_argument("--fast-from", type=int, default=50_000, help="cells from which --fast")
     p.add_argument("--block", type=int, default=500)
     p.add_argument("--search-nodes", type=int, nargs="*",
                    default=[10_000, 30_000, 100_000, 300_000, 1_000_000])  # fmt: skip
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--tube-only", action="store_true")
+    p.add_argument("--deck", type=Path, help="time this deck's run instead (the peer tube "
+                   "deck: gen_shell.py tube --h 2.5 --contact; its folds from --fold-time)")
     p.add_argument("--search-only", action="store_true")
     p.add_argument("--figure", type=Path, default=HERE.parent / "docs" / "contact_search.png")
     a = p.parse_args()
     if a.quick:
-        a.tube_cells, a.end, a.fold_time = [10_000], 2.5e-3, 2.0e-3
+        a.tube_cells, a.end = [10_000], 3.0e-3
         a.search_nodes = [10_000, 30_000, 100_000]
     record = {"ranks": comm.size}
     lines = []
-    if not a.search_only:
+    if not a.search_only and not a.deck:
         before = load_average()
         results = {}
         for cells in a.tube_cells:
             fast = a.fast if cells >= a.fast_from else 1.0
-            results[cells] = tube(cells, a.end, a.fold_time, fast, a.block)
+            sc = tube_scene(cells, a.end if fast == 1.0 else a.fast_end, fast)
+            results[cells] = tube(sc, a.fold_time, fast, a.block)
             if comm.rank == 0:
                 print(json.dumps({k: v for k, v in results[cells].items()
                                   if k != "contacts_by_ms"}), flush=True)  # fmt: skip
         record["tube"] = results
         lines += tube_lines(results, a.fast_from, a.fast, before, load_average())
-    if not a.tube_only and comm.size == 1:
+    if a.deck:
+        before = load_average()
+        r = tube(deck_scene(a.deck), a.fold_time, 1.0, a.block)
+        record["deck"] = r
+        if comm.rank == 0:
+            print(json.dumps({k: v for k, v in r.items() if k != "contacts_by_ms"}), flush=True)
+        lines += deck_lines(a.deck, r, before, load_average())
+    if not a.tube_only and not a.deck and comm.size == 1:
         before = load_average()
         rows = [search(n, a.repeats) for n in a.search_nodes]
         record["search"] = rows
