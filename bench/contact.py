@@ -12,11 +12,13 @@
    The contact's share is taken over the steps at or after ``--fold-time`` (folds in
    contact; the number of nodes in contact is given), as the median over blocks of
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
-   From ``--fast-from`` cells (100,000) the press comes down at ``--fast`` (8) times the
-   speed with 1/fast^2 of the mass (the same 5 kJ; folds in contact sooner), and the run
-   ends at ``--fast-end`` / fast (3.2 ms / 8; the fold window from ``--fold-time`` / fast):
-   6 ms at 10 m/s would be some 64,000 steps of 100,000 shells, more than a shared rank
-   can give it.
+   From ``--large-from`` cells (100,000) the tube is scaled up around and along (by
+   sqrt(cells / 10,000): 158 x 158 x 474 mm) at the 10k tube's element size of 1.73 mm, and
+   runs ``--large-end`` (0.15 ms, before any fold): the demo's tube in 0.55 mm shells has
+   its elements smaller than the 1.5 mm gap (the thickness), and its self-contact then
+   presses each flat wall on itself (nodes beyond the excluded neighbours but within the
+   gap); and the 6 ms of the crush would be some 50,000 steps of 100,000 shells, more
+   than a shared rank can give it.
 2. **Search**: the bucket sort of ``kernels/contact.c`` as the interface calls it
    (``ContactInterface._sort``: one self-contact pass, all nodes secondary, own and
    neighbouring segments excluded) on a pleated sheet of n x n quadrilaterals of 1 mm
@@ -35,6 +37,7 @@ import json
 import math
 import os
 import statistics
+import tempfile
 import time
 from pathlib import Path
 from types import SimpleNamespace
@@ -50,6 +53,7 @@ comm = MPI.COMM_WORLD
 HERE = Path(__file__).resolve().parent
 SCENE = HERE.parent / "demos" / "tube_crush.toml"
 PERIMETER, LENGTH = 0.2, 0.15  # m: the tube's mid-surface, 4 x 50 mm around, 150 mm long
+BASE_CELLS = 10_000  # the larger tubes keep this one's element size (1.73 mm)
 LEG, PLEAT = 10, 1.2e-3  # the search's sheet: elements per leg, lean of a leg (m)
 
 
@@ -60,13 +64,19 @@ def load_average() -> str:
 # -- 1. The tube ------------------------------------------------------------------------
 
 
-def tube_scene(cells: int, end: float, fast: float):
+def tube_scene(cells: int, end: float, large: bool):
+    """The demo's tube at ``cells`` quadrilaterals: its own size at the element size that
+    gives them, or (``large``) scaled up around and along at the element size of
+    BASE_CELLS (the shells no smaller than their thickness), the press's mass with it."""
     raw = read_toml(SCENE)
-    raw["mesh"]["element_size"] = math.sqrt(PERIMETER * LENGTH / cells)
-    raw["run"]["end_time"] = end / fast
-    press = raw["wall"][1]["motion"]
-    press["velocity"] = [v * fast for v in press["velocity"]]
-    press["mass"] = press["mass"] / fast**2
+    mesh = raw["mesh"]
+    scale = math.sqrt(cells / BASE_CELLS) if large else 1.0
+    base = BASE_CELLS if large else cells
+    mesh["element_size"] = math.sqrt(PERIMETER * LENGTH / base)
+    mesh["width"], mesh["length"] = mesh["width"] * scale, mesh["length"] * scale
+    raw["wall"][1]["point"][2] = raw["wall"][1]["point"][2] * scale
+    raw["wall"][1]["motion"]["mass"] *= scale**2
+    raw["run"]["end_time"] = end
     raw["output"] |= {"frames": 0, "plot": False}
     return parse_scene(raw, source=f"bench:contact tube {cells}")
 
@@ -136,9 +146,11 @@ def deck_scene(path: Path):
     return scene
 
 
-def tube(sc, fold_time: float, fast: float, block: int) -> dict:
+def tube(sc, fold_time: float, block: int) -> dict:
     """The timed run of scene ``sc``: its books and the contact's shares (see the top)."""
-    sim = build_simulation(sc, comm, f"/tmp/rwall-bench-contact-{comm.size}", limits=False)
+    folder = comm.bcast(tempfile.mkdtemp(prefix="rwall-bench-contact-") if comm.rank == 0
+                        else None)  # fmt: skip
+    sim = build_simulation(sc, comm, Path(folder) / "run", limits=False)
     clock = StepClock(sim)
     sim.run()
     t, step, phase, contacts = clock.arrays()
@@ -169,15 +181,16 @@ def tube(sc, fold_time: float, fast: float, block: int) -> dict:
         "cells": sim.info.get("cells"),
         "surface_nodes": contact.size,
         "element_size_mm": sc.mesh.element_size * 1e3 if sc.mesh.element_size else None,
-        "press_speed": 10.0 * fast,
+        "width_mm": sc.mesh.width * 1e3 if sc.mesh.width else None,
+        "status": sim.status,
         "end_ms": sc.run.end_time * 1e3,
         "loop_seconds": sim.wall_seconds,
         "steps": summary["steps"],
         "sorts": contact.sorts,
         "balance": summary.get("energy_balance"),
         "all": window(t >= 0.0),
-        "early": window(t < 1e-3 / fast),
-        "folds": window(t >= fold_time / fast),
+        "early": window(t < 1e-3),
+        "folds": window(t >= fold_time),
         "contacts_by_ms": [[float(a * 1e3), int(c)] for a, c in zip(t[::500], contacts[::500])],
     }
 
@@ -263,22 +276,22 @@ def figure(rows: list[dict], path: Path) -> None:
 # -- Report ---------------------------------------------------------------------------------
 
 
-def tube_lines(results: dict, fast_at: int, fast: float, before: str, after: str) -> list[str]:
+def tube_lines(results: dict, before: str, after: str) -> list[str]:
     ranks = f"{comm.size} rank{'s' if comm.size > 1 else ''}"
     lines = [f"### Tube crush with self-contact, {ranks}", "",
              f"Load average before {before}, after {after}; processor time per step (the "
              "slowest rank's), contact = the interface's `accelerate` (gather, sort when "
              "due, passes, nodal step, forces added).", "",
-             "| cells | press | steps | window | ms/step | internal force | **contact** | "
+             "| cells | tube (mm) | steps | window | ms/step | internal force | **contact** | "
              "of it sort | of it gather | nodes in contact (mean / max) |",
              "|---:|---|---:|---|---:|---:|---:|---:|---:|---|"]  # fmt: skip
     for cells, r in results.items():
-        for name, label in (("early", "first ms / fast (no fold)"), ("folds", "folds in contact")):
+        for name, label in (("early", "first ms (no fold)"), ("folds", "folds in contact")):
             w = r[name]
             if not w["steps"]:
                 continue
             lines.append(
-                f"| {r['cells']:,} | {r['press_speed']:g} m/s | {w['steps']:,} | {label}, "
+                f"| {r['cells']:,} | {r['width_mm']:.0f} | {w['steps']:,} | {label}, "
                 f"{w['from_ms']:.2f}-{w['to_ms']:.2f} ms | {w['ms_per_step']:.2f} | "
                 f"{w['internal_share']:.1%} | **{w['share']:.1%}** (median of {w['blocks']} "
                 f"blocks {w['share_median_of_blocks']:.1%}) | {w['sort_share']:.1%} | "
@@ -308,10 +321,9 @@ def main():
     p.add_argument("--tube-cells", type=int, nargs="*", default=[10_000, 100_000])
     p.add_argument("--end", type=float, default=6.0e-3, help="s, at 10 m/s")
     p.add_argument("--fold-time", type=float, default=2.0e-3, help="s, at 10 m/s")
-    p.add_argument("--fast", type=float, default=8.0, help="press speed factor at 100k")
-    p.add_argument("--fast-end", type=float, default=3.2e-3, help="s at 10 m/s: --end of "
-                   "the fast runs (divided by --fast)")  # fmt: skip
-    p.add_argument("--fast-from", type=int, default=50_000, help="cells from which --fast")
+    p.add_argument("--large-from", type=int, default=50_000,
+                   help="cells from which the tube is scaled up at 10k's element size")
+    p.add_argument("--large-end", type=float, default=1.5e-4, help="s: the end of those")
     p.add_argument("--block", type=int, default=500)
     p.add_argument("--search-nodes", type=int, nargs="*",
                    default=[10_000, 30_000, 100_000, 300_000, 1_000_000])  # fmt: skip
@@ -331,17 +343,17 @@ def main():
         before = load_average()
         results = {}
         for cells in a.tube_cells:
-            fast = a.fast if cells >= a.fast_from else 1.0
-            sc = tube_scene(cells, a.end if fast == 1.0 else a.fast_end, fast)
-            results[cells] = tube(sc, a.fold_time, fast, a.block)
+            large = cells >= a.large_from
+            sc = tube_scene(cells, a.large_end if large else a.end, large)
+            results[cells] = tube(sc, a.fold_time, a.block)
             if comm.rank == 0:
                 print(json.dumps({k: v for k, v in results[cells].items()
                                   if k != "contacts_by_ms"}), flush=True)  # fmt: skip
         record["tube"] = results
-        lines += tube_lines(results, a.fast_from, a.fast, before, load_average())
+        lines += tube_lines(results, before, load_average())
     if a.deck:
         before = load_average()
-        r = tube(deck_scene(a.deck), a.fold_time, 1.0, a.block)
+        r = tube(deck_scene(a.deck), a.fold_time, a.block)
         record["deck"] = r
         if comm.rank == 0:
             print(json.dumps({k: v for k, v in r.items() if k != "contacts_by_ms"}), flush=True)
