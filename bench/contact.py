@@ -12,7 +12,7 @@
    The contact's share is taken over the steps at or after ``--fold-time`` (folds in
    contact; the number of nodes in contact is given), as the median over blocks of
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
-   From ``--large-from`` cells (100,000) the tube is scaled up around and along (by
+   From ``--large-from`` cells (50,000: the 100k run) the tube is scaled up around and along (by
    sqrt(cells / 10,000): 158 x 158 x 474 mm) at the 10k tube's element size of 1.73 mm, and
    runs ``--large-end`` (0.15 ms, before any fold): the demo's tube in 0.55 mm shells has
    its elements smaller than the 1.5 mm gap (the thickness), and its self-contact then
