@@ -363,7 +363,7 @@ def main():
         rows = [search(n, a.repeats) for n in a.search_nodes]
         record["search"] = rows
         figure(rows, a.figure)
-        lines += [f"### Search per node, 1 rank", "",
+        lines += ["### Search per node, 1 rank", "",
                   f"Load average before {before}, after {load_average()}; medians of "
                   f"{a.repeats} calls, processor time; the figure: `{a.figure.name}`.", "",
                   "| nodes | segments | candidates | sort, ns/node | forces pass, ns/node |",
