@@ -131,7 +131,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 out.append(Pass(
                     np.searchsorted(nodes, sec.nodes).astype(np.int64),
                     np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
-                    scale * seg.stiffness, seg.depth.copy(), exclude,
+                    scale * seg.stiffness, _sized_depth(seg), exclude,
                 ))  # fmt: skip
             return out
 
@@ -229,12 +229,27 @@ def _gap_floor(sides, edge: float) -> float:
     return min(float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
 
 
+# A shell's share of a variable gap is at most this fraction of its shortest side (Radioss
+# TYPE7 Igap 3's default %mesh_size, i7sti3.F; LS-DYNA's automatic contacts alike): a
+# node then stays clear of its own flat sheet beyond its neighbouring segments.
+SIZE_SHARE = 0.4
+
+
+def _sized_depth(s: Surface) -> np.ndarray:
+    """The depths of the segments of ``s`` (m) with each shell's share of a variable gap
+    (-depth, half its thickness) at most :data:`SIZE_SHARE` x its shortest side."""
+    return np.where(s.depth < 0.0, np.maximum(s.depth, -SIZE_SHARE * s.edge), s.depth)
+
+
 def _node_gaps(nodes: np.ndarray, surfaces: list[Surface]) -> np.ndarray:
     """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
-    solid's)."""
-    out = np.zeros(len(nodes))
+    solid's), at most :data:`SIZE_SHARE` x the shortest side of the shells at it."""
+    out, size = np.zeros(len(nodes)), np.full(len(nodes), np.inf)
     for s in surfaces:
         half = np.repeat(np.maximum(-s.depth, 0.0), 4)
+        side = np.repeat(np.where(s.depth < 0.0, SIZE_SHARE * s.edge, np.inf), 4)
         ids = s.segments.ravel()
-        np.maximum.at(out, np.searchsorted(nodes, ids[ids >= 0]), half[ids >= 0])
-    return out
+        rows = np.searchsorted(nodes, ids[ids >= 0])
+        np.maximum.at(out, rows, half[ids >= 0])
+        np.minimum.at(size, rows, side[ids >= 0])
+    return np.minimum(out, size)
