@@ -10,7 +10,8 @@ parts meet the main ones one way (``symmetric = false``: TYPE7's nodes against s
 The gap: Igap 0 (1000) is constant, GAPmin or Radioss's default for it, the mean
 thickness of the main shells capped at half the shortest side of the main segments (0.1
 x that side without shells); Igap 1 (2, 3) leaves ``gap`` out: the scene's variable gap,
-half the sum of the thicknesses (:mod:`rwall_fem.contact`). Stfac is
+half the sum of the thicknesses, each shell's share at most 0.4 x its shortest side
+(Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`). Stfac is
 ``stiffness_scale``, Fric ``friction`` (Ifiltr, Xfreq its filter), VIS_S ``damping``.
 """
 

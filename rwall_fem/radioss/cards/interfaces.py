@@ -74,9 +74,10 @@ def _type7(deck: Deck, card: Card) -> None:
     if igap not in (0, 1, 2, 3, 1000):
         card.fail(f"Igap = {igap}: 0 or 1000 (a constant gap), 1, 2 or 3 (variable)",
                   card.lines[1])  # fmt: skip
-    if igap in (2, 3):
-        deck.warn(card, f"Igap = {igap}: read as Igap 1 (the variable gap without "
-                  "Fscalegap, Gap_max or the mesh size)", card.lines[1])  # fmt: skip
+    if igap == 2:
+        deck.warn(card, "Igap = 2: read as Igap 3 without Fscalegap and Gap_max (the "
+                  "variable gap, each shell's share at most 0.4 x its shortest side)",
+                  card.lines[1])  # fmt: skip
     if idel not in (0, 1000):
         deck.warn(card, f"Idel = {idel}: not honoured: contact bodies do not erode here, "
                   "so no segment is ever deleted", card.lines[1])  # fmt: skip
