@@ -14,11 +14,10 @@
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
    From ``--large-from`` cells (50,000: the 100k run) the tube is scaled up around and along (by
    sqrt(cells / 10,000): 158 x 158 x 474 mm) at the 10k tube's element size of 1.73 mm, and
-   runs ``--large-end`` (0.15 ms, before any fold): the demo's tube in 0.55 mm shells has
-   its elements smaller than the 1.5 mm gap (the thickness), and its self-contact then
-   presses each flat wall on itself (nodes beyond the excluded neighbours but within the
-   gap); and the 6 ms of the crush would be some 50,000 steps of 100,000 shells, more
-   than a shared rank can give it.
+   runs ``--large-end`` (0.15 ms, before any fold): the 6 ms of the crush would be some
+   50,000 steps of 100,000 shells, more than a shared rank can give it (the demo's tube
+   in 0.55 mm shells, finer than its 1.5 mm thickness, runs with ``--large-from`` above
+   its cells: its variable gap is capped by the shells' size, :mod:`rwall_fem.contact`).
 2. **Search**: the bucket sort of ``kernels/contact.c`` as the interface calls it
    (``ContactInterface._sort``: one self-contact pass, all nodes secondary, own and
    neighbouring segments excluded) on a pleated sheet of n x n quadrilaterals of 1 mm
