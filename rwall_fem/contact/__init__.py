@@ -118,14 +118,12 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
         if spec.gap is None and half > 0.0:
-            interface.vary_gap(node_gap)
+            interface.vary_gap(node_gap, nodes)
         interface.start(state)
         gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
-                ids = np.searchsorted(nodes, _total((name,)).nodes)
-                x = interface.x[ids]
-                extent = np.sort(x.max(axis=0) - x.min(axis=0))
+                extent = np.sort(interface.extent(_total((name,)).nodes))
                 # A flat sheet has no extent across: its width then
                 smallest = float(extent[1] if solid.shells else extent[0])
                 across, default = (("narrowest", "half the sum of the thicknesses")

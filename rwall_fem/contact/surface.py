@@ -20,8 +20,8 @@ segment's share of a variable gap), its stiffness Radioss's for a shell main seg
 thickness), its shortest edge the shortest side.
 
 Every rank gets every segment of the interface, in global node numbers, sorted by their
-nodes: every rank of a run computes the contact alike (:mod:`rwall_fem.contact.interface`;
-the global numbers, hence the order, depend on the partition).
+nodes (the same on every rank); the interface keeps each rank's share of them
+(:mod:`rwall_fem.contact.interface`).
 """
 
 from __future__ import annotations
