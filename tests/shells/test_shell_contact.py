@@ -84,7 +84,7 @@ class Clearance:
         n, m = len(self.ids), len(segments)
         holds = np.zeros((n, m), dtype=bool)  # node i is a corner of segment j
         for k in range(4):
-            holds[ps.segments[:, k], np.arange(m)] = True
+            holds[self.segments[:, k], np.arange(m)] = True
         near = (holds.astype(np.int32) @ holds.T.astype(np.int32)) > 0  # share a segment
         self.excluded = (near.astype(np.int32) @ holds.astype(np.int32)) > 0
         self.smallest = []
