@@ -526,6 +526,12 @@ def _add_recorders(
         schedule=cycle_schedule(scene.run.end_time, scene.output.print_interval),
     )  # fmt: skip
     sim.recorders.append(run_log)
+    loads = None
+    if sim.contacts:
+        from rwall_fem.output.contact_loads import ContactLoads
+
+        to_global = solid.V.dofmap.index_map.local_to_global
+        loads = ContactLoads(sim.contacts, sim.comm, to_global(owned))
     if scene.output.fields:
         from rwall_fem.output.fields import Fields
 
@@ -535,6 +541,7 @@ def _add_recorders(
             end_time=scene.run.end_time,
             V=solid.V,
             parts=solid.parts,
+            contact=loads,
         )
         sim.recorders.append(fields)
     if scene.output.frames:
@@ -543,6 +550,9 @@ def _add_recorders(
         from rwall_fem.scene.view import check_view
 
         color, fields = scene.output.color, sorted(sim.internal.cell_fields(sim.state))
+        if color == "contact_pressure" and loads is None:
+            raise SceneError(f"{scene.source}: output.color: 'contact_pressure' needs contact: "
+                             "add a [[contact]] table, or choose another colour")  # fmt: skip
         if color not in COLORS and color not in fields:
             models = ", ".join(sorted({part.material.model for part in solid.parts}))
             raise SceneError(
@@ -565,6 +575,7 @@ def _add_recorders(
             color=color,
             parts=[part.name for part in solid.parts] if scene.parts else (),
             view=view,
+            contact=loads if color == "contact_pressure" else None,
         )
         sim.recorders.append(frames)
 

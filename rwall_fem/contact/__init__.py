@@ -6,8 +6,9 @@ segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surf
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
 nodes against their own faces, each node kept off its own faces and their neighbours.
-In a body whose cells may erode, the surfaces of the solid parts that may erode follow
-the erosion (:mod:`~rwall_fem.contact.erosion`).
+In a body whose cells may erode, the surfaces of the parts that may erode follow the
+erosion (:mod:`~rwall_fem.contact.erosion`): faces of eroded solid cells leave and bared
+faces join; eroded shells leave.
 
 On a body of shells the segments are the shells, both sides active
 (:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
@@ -21,7 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from rwall_fem.contact.erosion import ErodingContact, ErodingSurface, may_erode
+from rwall_fem.contact.erosion import (
+    ErodingContact,
+    ErodingShells,
+    ErodingSurface,
+    may_erode,
+)
 from rwall_fem.contact.interface import ContactInterface, Pass
 from rwall_fem.contact.surface import Surface, part_surface, shell_surface
 
@@ -69,8 +75,9 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 k = names.index(name)
                 if name in surfaces or name in eroding:
                     continue
-                if not solid.shells and may_erode(scene, body.parts[k]):
-                    eroding[name] = ErodingSurface(body, k, comm, (internal or body).elements[k])
+                if may_erode(scene, body.parts[k]):
+                    follow = ErodingShells if solid.shells else ErodingSurface
+                    eroding[name] = follow(body, k, comm, (internal or body).elements[k])
                 else:
                     surfaces[name] = faces(body, k, comm)
             total = _total(parts)

@@ -1,6 +1,8 @@
 """Contact surfaces that follow erosion: the faces of eroded cells leave the main surface,
 the faces they bare join it, and the nodes left on no face leave the secondary set
-(``docs/theory.md``, "Contact between parts", erosion).
+(``docs/theory.md``, "Contact between parts", erosion). On shells, an eroded shell's
+segment leaves, and the nodes left with no live shell leave the secondary set
+(:class:`ErodingShells`: a shell bares no face).
 
 :class:`ErodingSurface` keeps the boundary faces of one solid part whose cells may erode:
 every face of the rank's cells (:func:`~rwall_fem.contact.surface.cell_faces`, from the
@@ -36,9 +38,15 @@ from collections.abc import Callable
 import numpy as np
 
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, boundary_faces, cell_faces
+from rwall_fem.contact.surface import (
+    Surface,
+    boundary_faces,
+    cell_faces,
+    once,
+    shell_segments,
+)
 
-__all__ = ["ErodingContact", "ErodingSurface", "may_erode"]
+__all__ = ["ErodingContact", "ErodingShells", "ErodingSurface", "may_erode"]
 
 
 def may_erode(scene, part) -> bool:
@@ -117,6 +125,39 @@ class ErodingSurface:
         """The steps in which some rank eroded cells of the part's force, so far."""
         e = self.force.erosion
         return 0 if e is None else e.detachments
+
+
+class ErodingShells(ErodingSurface):
+    """The shells of part ``k`` of ``body`` (a :class:`~rwall_fem.shells.body.ShellBody`)
+    as segments (:func:`~rwall_fem.contact.surface.shell_surface`) as the cells of
+    ``force`` (the part's shell force in the step) erode: an eroded shell's segment leaves
+    the surface, which stays sorted by the segments' keys, equal to the surface of the live
+    shells built from scratch."""
+
+    def __init__(self, body, k: int, comm, force):
+        self.force, self.comm = force, comm
+        self.ids, self.values = shell_segments(body, k)
+        self.alive = np.ones(len(self.ids), dtype=bool)  # as of the latest update
+        self.surface = once(self.ids, self.values, comm)
+        self.nodes = self.surface.nodes
+
+    def update(self) -> bool:
+        """Drop the segments of the shells eroded since the latest update; whether the
+        surface changed (collective, the same on every rank)."""
+        alive = self._alive_now()
+        (eroded,) = _gather(self.comm, np.sort(self.ids[self.alive & ~alive], axis=1))
+        if not len(eroded):
+            return False
+        self.alive = alive.copy()
+        s = self.surface
+        keep = ~np.isin(_rows(np.sort(s.segments, axis=1)), _rows(eroded.reshape(-1, 4)))
+        self.surface = Surface(s.segments[keep], s.stiffness[keep], s.depth[keep], s.edge[keep])
+        return True
+
+    def rebuild(self) -> None:
+        """The segments of the live shells from scratch (collective): after a resume."""
+        self.alive = self._alive_now().copy()
+        self.surface = once(self.ids[self.alive], self.values[self.alive], self.comm)
 
 
 class ErodingContact(ContactInterface):

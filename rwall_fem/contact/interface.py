@@ -458,6 +458,16 @@ class ContactInterface:
         self._pending = True
         self._previous_dt = s.dt_previous
 
+    def nodal_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What the latest pass added to the accelerations: the state rows of this rank's
+        owned surface nodes, the force on each (N, rows of 3), and the segments of every
+        pass (rows of 4 global node numbers, -1 as the 4th of a triangle; the same on every
+        rank: each rank's own, gathered), for the outputs
+        (:mod:`rwall_fem.output.contact_loads`; collective)."""
+        mine = np.concatenate([sh.segments for sh in self.shares]).reshape(-1, 4)
+        segments = np.concatenate(self.comm.allgather(mine)).reshape(-1, 4)
+        return self.mine, self._owned_force, segments
+
     def energies(self) -> dict[str, float]:
         """This rank's share of the books (J) after the update of step n: -W - D on its
         nodes (W up to the first half of step n, as the kinetic energy K^n has it), D of

@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface", "shell_surface"]
+__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface", "once",
+           "shell_segments", "shell_surface"]
 
 # The faces of DOLFINx's reference cells as cycles of their vertices.
 _FACES = {
@@ -138,7 +139,7 @@ def boundary_faces(ids: np.ndarray, key: np.ndarray, values: np.ndarray, comm) -
     return Surface(ids[keep], *values[keep].T.copy())
 
 
-def _once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:
+def once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:
     """The segments ``ids`` (global numbers) with their stiffness, depth and edge
     (``values``, rows of 3) of every rank, in the order of their sorted nodes."""
     gathered = comm.allgather((ids, values))
@@ -152,6 +153,13 @@ def _once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:
 def shell_surface(body, k: int, comm) -> Surface:
     """The shells of part ``k`` of ``body`` (a :class:`~rwall_fem.shells.body.ShellBody`)
     as two-sided segments, the same on every rank of ``comm`` (collective)."""
+    return once(*shell_segments(body, k), comm)
+
+
+def shell_segments(body, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """This rank's shells of part ``k`` of ``body`` as segments, cell after cell: their 4
+    global node numbers (-1 as a triangle's 4th) and their k0 (N/m), depth (m) and
+    shortest side (m)."""
     force = body.elements[k]
     cells, X = force.cells, force.X
     thickness = force.kernel.thickness
@@ -168,4 +176,4 @@ def shell_surface(body, k: int, comm) -> Surface:
     ids = np.where(local >= 0, to_global(np.where(local >= 0, local, 0).ravel().astype(np.int32))
                    .reshape(-1, 4), -1)  # fmt: skip
     values = np.column_stack([float(material.young) * thickness, -0.5 * thickness, edge])
-    return _once(ids, values, comm)
+    return ids, values

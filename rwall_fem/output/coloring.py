@@ -5,9 +5,9 @@ the run stored (e.g. ``plastic_strain``), or by part (``part``: one colour per
 part of a body of ``[[part]]``, labelled with their names). One range serves every frame and
 fits the scene: a nodal quantity spans the 95th percentile of its magnitude
 over all nodes and frames (the spikes at a wave front or under a ball
-saturate, the bulk of the motion spans the range), velocities at least the
-initial speed; a cell field spans its maximum (plastic strain is often zero
-but in a few cells, which are the point), up to its physical bound (damage
+saturate, the bulk of the motion spans the range; the contact pressure: of the nodes in
+contact), velocities at least the initial speed; a cell field spans its maximum (plastic
+strain is often zero but in a few cells, which are the point), up to its physical bound (damage
 ends at 1: :data:`BOUNDS`). The range is rounded up to a round number, in a
 unit with a prefix that keeps the labels short (``µm``, ``MPa``), and its labels
 fall on round values written with one format. This module needs neither DOLFINx nor
@@ -24,8 +24,11 @@ import numpy as np
 __all__ = ["COLORS", "Coloring", "colour_table", "coloring", "fixed_range", "rgb", "round_range"]
 
 # Nodal colourings: the velocity along the first wall's normal at each node (m/s, signed;
-# without walls, the upward velocity), the speed (m/s), the magnitude of the displacement (m).
-COLORS = ("normal_velocity", "speed", "displacement")
+# without walls, the upward velocity), the speed (m/s), the magnitude of the displacement
+# (m), the contact pressure (Pa: rwall_fem.output.contact_loads; stored by a run with
+# contact whose frames show it).
+COLORS = ("normal_velocity", "speed", "displacement", "contact_pressure")
+UNITS = {"displacement": "m", "contact_pressure": "Pa"}  # of the nodal colourings; else m/s
 
 # Names and units of the cell fields this module knows; others are shown by their name.
 CELL_FIELDS = {
@@ -107,13 +110,16 @@ def coloring(
             fmt="",
             names=tuple(parts),
         )
+    if color == "contact_pressure" and color not in frames[0]:
+        raise ValueError(f"color {color!r}: the run stored no contact pressure (it needs "
+                         "[[contact]] and output.color = 'contact_pressure')")  # fmt: skip
     if color in COLORS:
         values = [_nodal(color, f, points, walls, up) for f in frames]
         if color == "normal_velocity":
             name = "velocity along the wall normal" if walls else "upward velocity"
         else:
-            name = color
-        unit = "m" if color == "displacement" else "m/s"
+            name = color.replace("_", " ")
+        unit = UNITS.get(color, "m/s")
     else:
         stored = sorted(k.removeprefix("cell_") for k in frames[0] if k.startswith("cell_"))
         if color not in stored:
@@ -128,6 +134,8 @@ def coloring(
     if color not in COLORS:
         top = min(float(everything.max(initial=0.0)), BOUNDS.get(color, math.inf))
     else:
+        if color == "contact_pressure":  # the nodes in contact, a few of all
+            everything = everything[everything > 0.0]
         top = float(np.percentile(everything, 95)) if everything.size else 0.0
         if unit == "m/s":
             top = max(top, speed)
@@ -203,5 +211,7 @@ def _nodal(color: str, frame: dict, points: np.ndarray, walls, up: np.ndarray) -
             return frame["v"] @ up
         normals = walls[0].normals(points + frame["u"], frame["offsets"][0])
         return np.sum(frame["v"] * normals, axis=-1)
+    if color == "contact_pressure":
+        return np.asarray(frame[color], dtype=float)
     field = frame["v"] if color == "speed" else frame["u"]
     return np.linalg.norm(field, axis=1)

@@ -6,6 +6,8 @@ the equivalent plastic strain, and the part of each cell of a body of parts) as
 piecewise constants (DG0). The von Mises stress (Pa) of the elastic parts is
 computed here from the Cauchy stress: Hooke's law for linear elasticity,
 sigma = P F^T / J for the hyperelastic models; the elasto-plastic parts give theirs.
+With contact, each snapshot also holds the nodal contact force (N) and contact pressure
+(Pa) of the step (:mod:`rwall_fem.output.contact_loads`).
 
 DOLFINx writes the data collectively (XDMF with HDF5), so parallel runs give
 one file; its XML, though, holds one time series per function, and DOLFINx
@@ -48,15 +50,19 @@ DOLFINX_POINTER = (
 class Fields:
     """Recorder that writes ``count`` field snapshots of the body (space ``V``, its
     ``parts``: :class:`~rwall_fem.body.Part`) at times spread evenly over
-    [0, ``end_time``] (s), into ``directory``."""
+    [0, ``end_time``] (s), into ``directory``; ``contact``: the run's
+    :class:`~rwall_fem.output.contact_loads.ContactLoads`, or None without contact."""
 
-    def __init__(self, directory: Path, *, count: int, end_time: float, V, parts):
+    def __init__(self, directory: Path, *, count: int, end_time: float, V, parts,
+                 contact=None):  # fmt: skip
         self.steps = Times(count, end_time)
         self.path = Path(directory) / "fields.xdmf"
         msh = V.mesh
         self.u, self.v = fem.Function(V), fem.Function(V)
         self.u.name, self.v.name = "displacement", "velocity"
         self._Q = _compat.scalar_space(msh)
+        self._contact = contact
+        self._loads = ()  # the contact force and pressure, made at the first snapshot
         num_cells = msh.topology.index_map(msh.topology.dim).size_local
         self._cell_dofs = _compat.cell_nodes(self._Q)[:num_cells, 0]  # owned cell -> DG0 dof
         # The elastic parts' von Mises stress, from the displacement: (cells' DG0 dofs,
@@ -96,8 +102,26 @@ class Fields:
             field.x.scatter_forward()
         if self._elastic:
             self._elastic_mises()
-        for field in (self.u, self.v, *self._cells.values()):
+        if self._contact is not None:
+            self._contact_loads(s)
+        for field in (self.u, self.v, *self._loads, *self._cells.values()):
             self._file.write_function(field, s.t)
+
+    def _contact_loads(self, s) -> None:
+        """The nodal contact force (N) and contact pressure (Pa) of the step."""
+        if not self._loads:
+            V = self.u.function_space
+            nodal = _compat.scalar_space(V.mesh, "Lagrange", 1)
+            force, pressure = fem.Function(V), fem.Function(nodal)
+            force.name, pressure.name = "contact_force", "contact_pressure"
+            self._loads = (force, pressure)
+        force, pressure = self._loads
+        values = self._contact.force()
+        force.x.array[: values.size] = values.ravel()
+        values = self._contact.pressure(s)
+        pressure.x.array[: values.size] = values
+        for field in self._loads:
+            field.x.scatter_forward()
 
     def _elastic_mises(self) -> None:
         """The von Mises stress of the elastic parts' cells, from the displacement."""

@@ -5,7 +5,8 @@ internal force to rank 0 (connectivity offset by the points already received);
 rank 0 stores them in ``frames/data``: ``mesh.npz`` once, then
 ``frame_NNNN.npz`` per frame (``t``, ``u``, ``v``, the walls' ``offsets`` and
 ``cell_<name>`` for each cell field; when cells can erode, ``cell_eroded`` and
-``detached``, 1 at the nodes no live cell holds).
+``detached``, 1 at the nodes no live cell holds; when the frames are coloured by it,
+``contact_pressure``, Pa, at the nodes: :mod:`rwall_fem.output.contact_loads`).
 Each file is written whole (:mod:`rwall_fem.output.atomic`). Pictures are drawn by a
 separate process, ``python -m rwall_fem.output.render DIR``, which never loads DOLFINx:
 VTK's wheels crash when they render in a process that holds DOLFINx's C++ libraries (a
@@ -45,7 +46,9 @@ class Frames:
     :data:`rwall_fem.output.coloring.COLORS` or a cell field of the internal force;
     ``parts``, the names of the parts of a body of ``[[part]]`` (the ``part`` colouring);
     ``view``: the scene's [output.view] (:class:`rwall_fem.scene.view.ViewSpec`), or
-    None, stored with the body for the renderer.
+    None, stored with the body for the renderer; ``contact``: the run's
+    :class:`~rwall_fem.output.contact_loads.ContactLoads` when the frames show the contact
+    pressure (computed at the frames only).
     """
 
     def __init__(
@@ -61,12 +64,14 @@ class Frames:
         color: str = "normal_velocity",
         parts: tuple[str, ...] = (),
         view=None,
+        contact=None,
     ):
         self.steps = Times(count, end_time)
         self.directory = Path(directory)
         self.data = self.directory / "frames" / "data"
         self.comm = V.mesh.comm
         self.walls, self.color, self.parts, self.view = walls, color, tuple(parts), view
+        self.contact = contact
         self._field = fem.Function(V)
         self._count = 0
         self._failed = False  # a frame could not be written (rank 0): no more are
@@ -139,6 +144,11 @@ class Frames:
             flags[erosion.detached] = 1.0
             detached = self._nodal(flags)
             cells["detached"] = None if detached is None else detached[:, 0]
+        if self.contact is not None:
+            values = np.zeros_like(s.u)
+            values[:, 0] = self.contact.pressure(s)
+            pressure = self._nodal(values)
+            cells["contact_pressure"] = None if pressure is None else pressure[:, 0]
         if self.comm.rank == 0 and not self._failed:
             try:
                 if not self._count:

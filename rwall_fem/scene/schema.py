@@ -1380,10 +1380,12 @@ class Output:
         default_doc="about 20 lines over the run",
     )
     color: str = key(
-        Choice(("normal_velocity", "speed", "displacement", "plastic_strain", "damage", "part")),
+        Choice(("normal_velocity", "speed", "displacement", "plastic_strain", "damage", "part",
+                "contact_pressure")),
         "normal_velocity",
         doc="what colours the frames (plastic_strain: elasto-plastic bodies; damage: bodies "
-        "with a failure criterion; part: a body of [[part]], one colour each)",
+        "with a failure criterion; part: a body of [[part]], one colour each; "
+        "contact_pressure: a scene with [[contact]], Pa)",
     )
     view: ViewSpec | None = key(
         Sub(ViewSpec),

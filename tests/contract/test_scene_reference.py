@@ -113,6 +113,7 @@ BEYOND = {
     "104_wall_points_overflow",
     "207_erode_below_a_dt_min_above_the_step",
     "208_damage_colour_without_failure",  # the cell fields are the body's
+    "334_contact_pressure_colour_without_contact",  # the contacts are the scene's tables
     "220_erode_below_a_dt_min_above_the_step_of_one_part",
     "221_mass_scaling_that_would_add_the_body_mass_at_rest",
     "222_mesh_file_with_the_same_cells_in_two_regions",

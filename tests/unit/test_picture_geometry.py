@@ -102,6 +102,24 @@ def test_damage_ranges_up_to_failure_at_most():
         assert paint.clim == (0.0, top) and paint.title == "damage D"
 
 
+def test_contact_pressure_ranges_over_the_nodes_in_contact():
+    """400 nodes, 40 of them in contact at 1-39 MPa and one at 400 MPa (a rim's spike): the
+    range spans the 95th percentile of the nodes in contact (38.05 MPa, to 40), not of all
+    nodes (20 MPa: the nodes out of contact would halve it); without stored pressure, one
+    line."""
+    points, u = np.zeros((400, 3)), np.zeros((400, 3))
+    pressure = np.zeros(400)
+    pressure[:40] = np.arange(1, 41) * 1e6
+    pressure[39] = 400e6
+    frames = [{"u": u, "v": u, "offsets": np.zeros((0, 3)), "contact_pressure": pressure}]
+    paint = coloring("contact_pressure", frames, points, [], UP, 0.0)
+    assert paint.title == "contact pressure (MPa)" and paint.clim == (0.0, 40.0)
+    assert paint.cmap == "viridis" and not paint.per_cell
+    assert np.allclose(paint.values[0], pressure / 1e6)
+    with pytest.raises(ValueError, match="stored no contact pressure"):
+        coloring("contact_pressure", _frames([u], [u]), points, [], UP, 0.0)
+
+
 @pytest.mark.parametrize(
     "end, unit", [(6e-5, "µs"), (3e-3, "ms"), (0.45, "ms"), (2.0, "s"), (0.0, "µs")]
 )
