@@ -99,7 +99,7 @@ def element_table(deck: Deck, pid: int, cell: str, material: dict, cells) -> tup
     if shells:
         from rwall_fem.radioss.cards.shells import shell_element
 
-        return shell_element(deck, pid, cell)
+        return shell_element(deck, pid, cell, material["poisson"])
     head = f"property: /PROP/SOLID/{pid} Isolid {p['isolid']} ({p['where']})"
     if cell == "tetrahedron":
         if p["itetra4"]:  # the column is Irot of bricks before version 12

@@ -147,7 +147,7 @@ def scene_of(deck: Deck) -> SceneParts:
     if gravity is not None:
         raw["gravity"] = {"acceleration": list(gravity)}
         facts.append(f"gravity: {_vec(gravity)} m/s^2")
-    boundaries, wall_velocity = _boundaries(deck, atoms, mains)
+    boundaries, wall_velocity, wall_held = _boundaries(deck, atoms, mains)
     _held_rotations(deck, boundaries, cell)
     if boundaries:
         raw["boundary"] = boundaries
@@ -157,7 +157,8 @@ def scene_of(deck: Deck) -> SceneParts:
     tables, lines = load_tables(deck, cell, cells, atoms, body_nodes)
     raw |= tables
     facts += lines
-    walls = [_wall(deck, w, atoms, by_parts, wall_velocity.get(w.main_node)) for w in deck.walls]
+    walls = [_wall(deck, w, atoms, by_parts, wall_velocity.get(w.main_node),
+                   wall_held.get(w.main_node, "")) for w in deck.walls]  # fmt: skip
     if walls:
         raw["wall"] = walls
         for w, table in zip(deck.walls, walls, strict=True):
@@ -399,17 +400,22 @@ def _table(deck: Deck, items: list[Prescribed]) -> tuple[list[list[float]], str]
 
 
 def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
-    """The [[boundary]] tables of /BCS and of /IMPVEL on body nodes, and the prescribed
-    velocities of walls' main nodes (main node -> list of /IMPVEL)."""
+    """The [[boundary]] tables of /BCS and of /IMPVEL on body nodes, the prescribed
+    velocities of walls' main nodes (main node -> list of /IMPVEL) and the components a
+    /BCS holds on walls' main nodes (main node -> "xyz" letters)."""
     out = []
+    held_mains: dict[int, set[str]] = {}
     for components, gid, where in deck.clamps:
         g = _group(deck, gid, where, "/BCS: grnd_ID")
-        if set(g.nodes.tolist()) & mains:
-            raise DeckError(f"{where}: /BCS: group {gid} holds the main node of a /RWALL: fix "
-                            "a wall by giving it no node_ID")  # fmt: skip
         rotations = deck.held_rotations.get(where)
+        on_mains = set(g.nodes.tolist()) & mains
+        for main in on_mains:  # Radioss zeroes their accelerations: motion.held
+            held_mains.setdefault(main, set()).update(components)
+        if on_mains and rotations:
+            deck.warnings.append(f"{where}: /BCS: rotation codes on the main node of a /RWALL "
+                                 "are not used (a wall translates, never rotates)")  # fmt: skip
         held = {"rotations": rotations, "where": where} if rotations else {}
-        out += [{"group": a, "components": components} | held for a in atoms.of[gid]]
+        out += [{"group": a, "components": components} | held for a in atoms.of.get(gid, [])]
     on_walls: dict[int, list[Prescribed]] = {}
     by_group: dict[int, list[Prescribed]] = {}
     for p in deck.velocities:
@@ -426,7 +432,8 @@ def _boundaries(deck: Deck, atoms: FaceGroups, mains: set[int]):
     for gid, items in by_group.items():
         rows, components = _table(deck, items)
         out += [{"group": a, "velocity": rows, "components": components} for a in atoms.of[gid]]
-    return out, on_walls
+    held = {main: "".join(sorted(c)) for main, c in held_mains.items()}
+    return out, on_walls, held
 
 
 def _held_rotations(deck: Deck, boundaries: list[dict], cell: str) -> None:
@@ -445,7 +452,7 @@ def _held_rotations(deck: Deck, boundaries: list[dict], cell: str) -> None:
 
 
 def _wall(deck: Deck, w: Wall, atoms: FaceGroups, by_parts: dict[int, list[str]],
-          imposed: list[Prescribed] | None) -> dict:  # fmt: skip
+          imposed: list[Prescribed] | None, held: str) -> dict:  # fmt: skip
     name = f"/RWALL/{w.kind}/{w.id}"
     where = f"{w.where}: {name}"
     table: dict = {"kind": _SHAPE[w.kind]}
@@ -495,8 +502,13 @@ def _wall(deck: Deck, w: Wall, atoms: FaceGroups, by_parts: dict[int, list[str]]
     if w.main_node:
         if imposed:
             rows, components = _table(deck, imposed)
+            both = "".join(c.upper() for c in held if c in components)
+            if both:
+                raise DeckError(f"{where}: its node has both a /BCS and an /IMPVEL along "
+                                f"{both}: give one")  # fmt: skip
             free = [i for i, c in enumerate("xyz") if c not in components]
-            _free_components_unloaded(w, free, where)
+            # a /BCS keeps a component at VX0..VZ0, as rwall_fem does with the free ones
+            _free_components_unloaded(w, [i for i in free if "xyz"[i] not in held], where)
             for i in free:
                 for row in rows:
                     row[1 + i] = float(w.velocity[i])
@@ -506,6 +518,8 @@ def _wall(deck: Deck, w: Wall, atoms: FaceGroups, by_parts: dict[int, list[str]]
                 raise DeckError(f"{where}: Mass = {w.mass:g} kg: a moving wall needs a mass > 0 "
                                 "(or an /IMPVEL on its node)")  # fmt: skip
             table["motion"] = {"mass": w.mass, "velocity": list(w.velocity)}
+            if held:
+                table["motion"]["held"] = held
     return table
 
 

@@ -416,3 +416,18 @@ def test_a_deck_of_version_9_with_units_lines_reads(shared_dir):
         lines[line_of(lines, "/BEGIN") + 2] = f"{90:10d}{0:10d}"
 
     assert read_deck(written(good(), shared_dir, edit)).version == 90
+
+
+def test_bcs_and_impvel_along_one_axis_of_a_main_node_is_one_line(shared_dir):
+    """A /BCS holds a main node's component at VX0..VZ0 (motion.held), an /IMPVEL
+    prescribes it: both along Z are refused in one line naming the /RWALL."""
+    d = good()
+    d.extra_nodes.append((901, (0.0, 0.0, 0.003)))
+    d.group(5, "NODE", [901])
+    d.function(7, [(0, 1), (10, 1)])
+    d.imposed_velocity(1, 7, "Z", 5, 1e-5, -2.0)
+    d.clamp(3, "   001 000", 5)
+    d.wall("PLANE", 2, node=901, m1=(0.0, 0.0, 1.0), dsearch=1.0)
+    refused_in_one_line(written(d, shared_dir), "/RWALL",
+                        r"/RWALL/PLANE/2: its node has both a /BCS and an /IMPVEL along Z: give "
+                        r"one")  # fmt: skip

@@ -11,6 +11,7 @@ import pytest
 from mpi4py import MPI
 
 from rwall_fem import build_simulation, parse_scene
+from rwall_fem.output.wall_table import WALL_COLUMNS
 from rwall_fem.radioss import convert, load_deck
 from rwall_fem.scene import load_scene
 
@@ -222,6 +223,26 @@ WALLS = {
             ]
         },
     ),
+    "sphere on a main node, sideways held by /BCS": (
+        lambda d: (
+            d.extra_nodes.append((902, (0.001, 0.001, -0.0031))),
+            d.group(7, "NODE", [902]),
+            d.clamp(2, "   110 111", 7),
+            d.wall("SPHER", node=902, diameter=0.006, dsearch=1.0, mass=0.01,
+                   velocity=(0.3, -0.2, 1.0)),  # fmt: skip
+        ),
+        {
+            "wall": [
+                {
+                    "kind": "sphere",
+                    "point": [0.001, 0.001, -0.0031],
+                    "diameter": 0.006,
+                    "secondary": {"search_distance": 1.0},
+                    "motion": {"mass": 0.01, "velocity": [0.3, -0.2, 1.0], "held": "xy"},
+                }
+            ]
+        },
+    ),
     "parallelogram fixed, friction in steps, /BCS": (
         lambda d: (
             d.group(6, "NODE", d.face_nodes(d.nz)),
@@ -287,3 +308,27 @@ def test_convert_round_trips(shared_dir):
     b = run(load_scene(toml), shared_dir / "toml")
     same_run(a, b)
     assert np.array_equal(a.history.energy, b.history.energy)
+
+
+def test_bcs_on_a_main_node_holds_its_translations(shared_dir):
+    """/BCS 110 111 on a sphere wall's main node: Radioss zeroes the node's x and y
+    accelerations (bcs2.F), so the wall keeps VX0 and VY0 exactly while the bar's impact
+    changes VZ; the rotation codes are said to be unused, in one line."""
+    d = BarDeck(units="kg-mm-ms", nz=4, end_time=3e-5)
+    elastic(d)
+    d.group(1, "PART", [1])
+    d.initial_velocity((0.4, 0.2, -8.0), 1)
+    WALLS["sphere on a main node, sideways held by /BCS"][0](d)
+    report = []
+    path = d.write(shared_dir) if MPI.COMM_WORLD.rank == 0 else None
+    path = MPI.COMM_WORLD.bcast(path, root=0)
+    scene = load_deck(path, report=report)
+    assert scene.walls[0].motion.held == "xy"
+    said = [w for w in report[0].warnings if "rotation codes on the main node" in w]
+    assert len(said) == 1
+    sim = run(scene, shared_dir / "held")
+    rows = sim.history.wall(0)
+    velocity = rows[:, [WALL_COLUMNS.index(f"velocity_{c}") for c in "xyz"]]
+    assert np.array_equal(velocity[:, 0], np.full(len(rows), 0.3))
+    assert np.array_equal(velocity[:, 1], np.full(len(rows), -0.2))
+    assert velocity[-1, 2] < 1.0 - 0.1  # the bar slowed the wall down along z

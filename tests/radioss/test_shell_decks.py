@@ -12,6 +12,7 @@ import copy
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -89,14 +90,16 @@ def written(d, directory, edit=None) -> Path:
 def test_a_shell_deck_runs_as_its_scene(shared_dir):
     deck = load_deck(written(plate_deck(), shared_dir))
     assert deck.element.thickness == pytest.approx(1e-3, rel=1e-15)
-    assert deck.element.formulation == "bt" and deck.element.points == 5
+    assert deck.element.formulation == "bwc" and deck.element.points == 5
+    hk = 3 * 0.5 * 0.01 * (1 - 0.3**2)  # Radioss's CHVIS3 elastic hourglass forces
     raw = {
         "run": {"end_time": 6e-5},
         "mesh": {"shape": "plate", "origin": [0, 0, 1e-4 - 5e-4], "size": [0.04, 0.02, 1e-3],
                  "element_size": 5e-3, "cell": "quadrilateral"},
         "material": {"model": "linear_elastic", "density": 7850.0, "young": 210e9,
                      "poisson": 0.3},
-        "element": {"thickness": 1e-3, "formulation": "bt", "points": 5},
+        "element": {"thickness": 1e-3, "formulation": "bwc", "points": 5,
+                    "hourglass_stiffness": hk},
         "initial": {"velocity": [0.0, 0.0, -5.0]},
         "wall": [{"kind": "plane", "point": [0, 0, 0], "normal_point": [0, 0, 1]}],
         "output": {"frames": 0, "plot": False},
@@ -162,6 +165,67 @@ def test_ithick_and_p_thickfail_map_onto_the_element(shared_dir):
     assert load_deck(written(plate_deck(), shared_dir)).element.thickness_change is None
 
 
+def test_ishell_1_hourglass_stiffness_stores_radioss_elastic_hourglass_energy():
+    """Ishell 1's hourglass forces in OpenRadioss are elastic (CHVIS3, engine/source/
+    elements/shell/coque/chvis3.F): per step HOUR += (HELAS hm E t / 4) dt hg with
+    hg = sum GAMA_I v_I (GAMA = +-1 on a parallelogram, HELAS = 0.5, radioss2.F), force
+    HOUR GAMA_I on node I, power HOUR hg. A square cell driven slowly through the in-plane
+    hourglass mode u_I = G_I d: the kernel with the deck's hk = 3 HELAS hm (1 - nu^2) (and
+    no viscosity) stores the energy 1/2 K hg^2 of that update, to 1e-9, and its nodes
+    carry its forces HOUR GAMA_I (to 1e-3: the cell's shape changes by d / a)."""
+    from rwall_fem.radioss.cards.shells import HELAS
+    from rwall_fem.shells.elements import ShellKernel, ShellTechnology
+
+    E, nu, t, a, hm = 210e9, 0.3, 1.5e-3, 2.5e-3, 0.01
+    material = SimpleNamespace(model="linear_elastic", plastic=False, young=E, poisson=nu,
+                               density=7850.0)  # fmt: skip
+    hk = 3 * HELAS * hm * (1 - nu**2)
+    technology = ShellTechnology.choose("quadrilateral", "bwc", hourglass=(0.0, 0.0, 0.0),
+                                        hourglass_stiffness=hk)  # fmt: skip
+    X = np.array([[0.0, 0.0, 0.0], [a, 0.0, 0.0], [a, a, 0.0], [0.0, a, 0.0]])
+    kernel = ShellKernel(material, technology, np.array([[0, 1, 2, 3]], np.int32), t)
+    G = np.array([1.0, -1.0, 1.0, -1.0])
+    d, steps, dt = 1e-7, 200, 1e-7
+    energy, hour, reference = np.zeros(4), 0.0, 0.0
+    rate = np.zeros_like(X)
+    rate[:, 0] = G * d / (steps * dt)
+    for n in range(1, steps + 1):
+        f, m = np.zeros_like(X), np.zeros_like(X)
+        kernel.run(dt, X, rate * n * dt, rate, np.zeros_like(X), f, m, energy=energy)
+        hg = G @ rate[:, 0]
+        hour += HELAS * hm * E * t / 4 * dt * hg
+        reference += dt * hour * hg
+    exact = 2 * HELAS * hm * E * t * d**2  # 1/2 K hg^2, which that sum reaches as dt -> 0
+    assert reference == pytest.approx(exact, rel=1.0 / steps)
+    assert energy[1] == pytest.approx(exact, rel=1e-9)
+    # the forces HOUR GAMA_I, to the cell's change of shape (d / a = 4e-5: gamma at x)
+    np.testing.assert_allclose(np.abs(f[:, 0]), hour, rtol=1e-3)
+    assert np.abs(f[:, 1:]).max() <= 1e-3 * hour
+
+
+def test_blank_ishell_and_iplas_take_openradioss_defaults(shared_dir):
+    """A blank Ishell is 1 (Belytschko-Tsay: OpenRadioss's starter, defaults_mod.F90
+    init_def_elem, gives /DEF_SHELL's Ishell 1 outside /IMPLICIT; hm_read_prop01.F takes
+    it for a blank field); a blank Iplas is Radioss's radial return for LAW2 (cgrtails.F
+    keeps 0, m2cplr.F scales the trial stress), read as the exact return with one warning;
+    Iplas 1 gives none."""
+
+    def blank(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, " " * 10)
+        k = lines.index("/PROP/SHELL/1") + 4
+        lines[k] = lines[k][:80]
+
+    said = []
+    scene = load_deck(written(plate_deck(), shared_dir, blank), report=said)
+    assert scene.element.formulation == "bwc"
+    assert any("Ishell = 1: read as" in w for w in said[0].warnings)
+    warned = [w for w in said[0].warnings if "Iplas = 0 (blank)" in w]
+    assert len(warned) == 1 and "exact one of Iplas 1" in warned[0]
+    said = []
+    load_deck(written(plate_deck(), shared_dir), report=said)
+    assert not [w for w in said[0].warnings if "Iplas" in w]
+
+
 @pytest.mark.parametrize("ishell, idrill", [(1, 1), (3, 0), (3, 2)])
 def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, shared_dir):
     """Idrill 1: drilling springs of 0.01 G t A per node (2 or blank: none); Ishell 3 (the
@@ -173,13 +237,13 @@ def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, 
 
     scene = load_deck(written(plate_deck(), shared_dir, edit))
     drilling = 0.01 if idrill == 1 else None
-    hourglass = 0.5 if ishell == 3 else None
+    hourglass = 0.5 if ishell == 3 else pytest.approx(3 * 0.5 * 0.01 * (1 - 0.3**2), rel=1e-15)
     assert (scene.element.drilling_stiffness, scene.element.hourglass_stiffness) == (
         drilling, hourglass)  # fmt: skip
-    assert scene.element.formulation == ("bwc" if ishell == 3 else "bt")
+    assert scene.element.formulation == "bwc"
     sim = build_simulation(scene, comm, shared_dir)
     compiled = sim.internal.elements[0].kernel.shell
-    assert (compiled.kd, compiled.hk) == (drilling or 0.0, hourglass or 0.0)
+    assert (compiled.kd, compiled.hk) == (drilling or 0.0, scene.element.hourglass_stiffness)
 
 
 def test_idrill_other_than_1_and_2_is_refused(shared_dir):

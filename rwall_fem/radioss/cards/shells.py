@@ -1,14 +1,17 @@
 """Shell elements and their property: /SHELL, /SH3N and /PROP/SHELL (/PROP/TYPE1), whose
 blank fields take /DEF_SHELL's values (read at the end, wherever the cards are).
 
-Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): 1, 2 and 4
-(Belytschko-Tsay with viscous hourglass control) to ``"bt"``; 3 (the elasto-plastic
-hourglass stiffness, orthogonal to the rigid modes) to ``"bwc"`` with
-``hourglass_stiffness`` :data:`HOURGLASS_STIFFNESS` (elastic: a warning says so); 24
-(QEPH, Belytschko-Leviathan's physical stabilisation) and 12 to ``"bwc"``
-(Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and viscous
-hourglass control), with a warning that QEPH's physical stabilisation is not there. Ish3n
-1 and 2 (the C0 triangle) to ``"bsc"``. Idrill 1 gives the quadrilaterals drilling
+Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): every Ishell to
+``"bwc"`` (Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and
+viscous hourglass control hm, hf, hr) with an elastic ``hourglass_stiffness``: 1, 2 and 4
+(Radioss's Belytschko-Tsay, whose hourglass forces are elastic, CHVIS3) and 24 and 12
+(QEPH, Belytschko-Leviathan's physical stabilisation, read the same way) hk = 3
+:data:`HELAS` hm (1 - nu^2), the same stiffness on a square cell's membrane hourglass
+mode; 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
+:data:`HOURGLASS_STIFFNESS`; a warning says what each is read as; a
+blank Ishell is 1, as in OpenRadioss's starter. Ish3n 1 and 2 (the C0 triangle) to
+``"bsc"``. Iplas 0 (blank) or 2, Radioss's radial return for LAW2, is read as the exact
+plane-stress return (Iplas 1), with a warning. Idrill 1 gives the quadrilaterals drilling
 springs, ``drilling_stiffness`` :data:`DRILLING_STIFFNESS` (2 or blank: none). N, Thick, Ashear and hm, hf, hr become the [element] keys ``points``,
 ``thickness``, ``shear_factor`` and ``hourglass_coefficients`` (Radioss's defaults where
 blank: N 5, Ashear 5/6, hm hf hr 0.01); P_thickfail becomes ``failed_share`` (blank: 1,
@@ -23,16 +26,21 @@ from rwall_fem.radioss.cards.base import card_units, ident
 from rwall_fem.radioss.model import Body, Deck
 from rwall_fem.radioss.reader import Card, fixed_table, read_fields
 
-__all__ = ["DRILLING_STIFFNESS", "HOURGLASS_STIFFNESS", "ISHELL", "STARTER", "finish",
-           "shell_element"]
+__all__ = ["DRILLING_STIFFNESS", "HELAS", "HOURGLASS_STIFFNESS", "ISHELL", "STARTER",
+           "finish", "shell_element"]
 
 # Ishell -> the scene's formulation of quadrilaterals.
-ISHELL = {1: "bt", 2: "bt", 3: "bwc", 4: "bt", 12: "bwc", 24: "bwc"}
+ISHELL = {1: "bwc", 2: "bwc", 3: "bwc", 4: "bwc", 12: "bwc", 24: "bwc"}
 _ISHELL_TEXT = "1, 2, 3, 4 (Belytschko-Tsay), 12 and 24 (read as Belytschko-Lin-Tsay with the " \
     "warping correction)"  # fmt: skip
 # Ishell 3's elastic hourglass stiffness and Idrill 1's drilling springs (a G t A per node):
 # the constants with which the twisted beam passes (docs/theory.md, "Warping").
 HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
+# OpenRadioss's hourglass forces of Ishell 1, 2 and 4 (CHVIS3) are elastic, HELAS hm E t / 4
+# per unit hourglass mode (HELAS = 0.5, engine/radioss2.F), with a quadratic viscosity
+# beside them (no linear one: HVLIN = 0); the kernel's elastic hourglass stiffness of a
+# square cell is hk E t / (12 (1 - nu^2)) on the same mode, so hk = 3 HELAS hm (1 - nu^2).
+HELAS = 0.5
 # The [element] keys of the quadrilaterals only, left out for triangles.
 _QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness")
 
@@ -97,7 +105,9 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     first = next(li for li in card.lines if li.where == raw["first"])
     third = next(li for li in card.lines if li.where == raw["third"])
     value = {k: v or deck.shell_defaults.get(k, 0) for k, v in raw["given"].items()}
-    ishell = value["ishell"] or 24  # Radioss's default (QEPH)
+    # a blank Ishell (and /DEF_SHELL's) is 1 in OpenRadioss's starter (defaults_mod.F90,
+    # init_def_elem: 24 only with /IMPLICIT, which is not read here)
+    ishell = value["ishell"] or 1
     ish3n = value["ish3n"] or 2
     if ishell not in ISHELL:
         card.fail(f"Ishell = {ishell}: supported: {_ISHELL_TEXT}", first)
@@ -139,20 +149,31 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
         element["failed_share"] = raw["thickfail"]
     if value["ithick"] == 1:
         element["thickness_change"] = True
-    if ishell in (12, 24):
+    if value["iplas"] in (0, 2):
+        deck.warn(card, f"Iplas = {value['iplas']}{' (blank)' if not value['iplas'] else ''}: "
+                  "Radioss returns a LAW2 material's plane stress radially (a scaled trial "
+                  "stress, cgrtails.F and m2cplr.F); rwall_fem's return is the exact one of "
+                  "Iplas 1", third)  # fmt: skip
+    if ishell != 3:
+        what = ("QEPH's physical stabilisation" if ishell in (12, 24) else
+                "Radioss's elastic hourglass forces (HELAS hm, with a quadratic viscosity)")
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
-                  "warping correction and viscous hourglass control hm, hf, hr (QEPH's "
-                  "physical stabilisation is not there)", first)  # fmt: skip
+                  f"warping correction, {what} as the elastic hourglass stiffness "
+                  "3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr",
+                  first)  # fmt: skip
     return {"kind": "shell", "ishell": ishell, "ish3n": ish3n, "where": card.header.where,
             "line": first.where, "element": element}  # fmt: skip
 
 
-def shell_element(deck: Deck, pid: int, cell: str) -> tuple[dict, str]:
-    """The [element] table of /PROP/SHELL ``pid`` for ``cell`` cells, and the line saying
-    what it became."""
+def shell_element(deck: Deck, pid: int, cell: str, poisson: float) -> tuple[dict, str]:
+    """The [element] table of /PROP/SHELL ``pid`` for ``cell`` cells of a material of
+    Poisson's ratio ``poisson``, and the line saying what it became."""
     p = deck.properties[pid]
     element = dict(p["element"])
     element["formulation"] = "bsc" if cell == "triangle" else ISHELL[p["ishell"]]
+    if p["ishell"] != 3:  # Radioss's elastic hourglass forces (CHVIS3), QEPH read alike
+        hm = element["hourglass_coefficients"][0]
+        element["hourglass_stiffness"] = 3.0 * HELAS * hm * (1.0 - poisson**2)
     if cell == "triangle":
         for name in _QUADRILATERAL_KEYS:
             element.pop(name, None)
