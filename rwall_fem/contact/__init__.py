@@ -188,9 +188,7 @@ def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray
         np.bitwise_or.at(on, rows[here], bits[here])
     count = sum((on >> c) & 1 for c in range(3))
     share = np.ascontiguousarray(0.5**count, dtype=np.float64)
-    interface.mirrored = (share, on)  # kept alive for the kernel's pointers
-    interface._params.share = interface.ffi.from_buffer("double[]", share)
-    interface._params.planes = interface.ffi.from_buffer("int8_t[]", on)
+    interface.mirror(share, on, nodes)
 
 
 def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:

@@ -141,6 +141,7 @@ class ContactInterface:
         self._params.damping = damping
         self.damping = damping
         self.half_thickness = None  # m per owned surface node (vary_gap)
+        self.mirrored = None  # the owned surface nodes' shares and planes (mirror)
         self.dt_limit = math.inf  # the nodal stable step of the latest pass on this rank, s
         self.sorts = 0
         self.sent = 0  # bytes this rank sent for the search (sorts); the ghosts count theirs
@@ -249,6 +250,15 @@ class ContactInterface:
         self._params.reach = self.reach
         self._sorted_at = None
 
+    def mirror(self, share: np.ndarray, planes: np.ndarray, nodes: np.ndarray) -> None:
+        """A model cut by symmetry planes (``kernels/contact.c``, mirror): per surface node
+        ``nodes``, the share of the whole node it holds and the bits of its planes; the rank
+        keeps its owned nodes' and reads its ghosts' shares at each sort."""
+        rows = np.searchsorted(nodes, self.ids)
+        self.mirrored = (np.ascontiguousarray(share[rows], dtype=np.float64),
+                         np.ascontiguousarray(planes[rows], dtype=np.int8))  # fmt: skip
+        self._sorted_at = None
+
     def extent(self, ids: np.ndarray) -> np.ndarray:
         """The extent (m, per axis) of the surface nodes ``ids`` (global numbers) now, from
         every rank (collective)."""
@@ -305,6 +315,13 @@ class ContactInterface:
         if self.half_thickness is not None:
             self._local_half[: self.n] = self.half_thickness
             self._params.half_thickness = self._pointer(self._local_half)
+        if self.mirrored is not None:
+            share, planes = self.mirrored
+            self._local_share, self._local_planes = np.ones(n), np.zeros(n, dtype=np.int8)
+            self._local_share[: self.n], self._local_planes[: self.n] = share, planes
+            self._ghosts.forward(share.reshape(-1, 1), self._local_share[self.n :].reshape(-1, 1))
+            self._params.share = self._pointer(self._local_share)
+            self._params.planes = self._pointer(self._local_planes, "int8_t[]")
 
     def _to_local(self, ids: np.ndarray) -> np.ndarray:
         """Local indices of global numbers ``ids`` (owned surface nodes or ghosts; -1
