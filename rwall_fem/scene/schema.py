@@ -1652,7 +1652,7 @@ def _element_fits_shells_or_solids(v, raw, fail):
     """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor, ...)
     for surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
     volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles;
-    hourglass_stiffness and drilling_stiffness on quadrilaterals only. (For a
+    hourglass_stiffness, drilling_stiffness and step_length on quadrilaterals only. (For a
     mesh file the cells are known when the body is built.)"""
     mesh = v["mesh"]
     if mesh is None or mesh.shape is None:
