@@ -268,6 +268,15 @@ def test_ishell_24_takes_qeph_step_length(ishell, shared_dir):
     factor = square * (math.sqrt(1 + 0.015**2) - 0.015) if qeph else 1.0
     assert side == pytest.approx(factor * 5e-3, rel=1e-9)  # the deck's 5 mm squares
 
+    def other_dn(lines):
+        edit(lines)
+        _replace(lines, "/PROP/SHELL/1", 3, f20(0.0) * 4 + f20(0.02))
+
+    said = []
+    load_deck(written(plate_deck(), shared_dir, other_dn), report=said)
+    warned = [w for w in said[0].warnings if "dn = 0.02" in w]
+    assert len(warned) == int(qeph) and all("takes dn = 0.015" in w for w in warned)
+
 
 def test_idrill_other_than_1_and_2_is_refused(shared_dir):
     def edit(lines):
