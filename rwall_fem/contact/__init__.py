@@ -16,11 +16,18 @@ variable, as Radioss's Igap 1: a node against a segment gets half the thickness 
 thickest shell at the node plus half the segment's (half the sum of the thicknesses),
 floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side). A given
 ``gap`` is constant (Radioss Igap 0).
+
+The faces of solid parts on a symmetry plane (a plane x_c = const whose nodes a
+``[[boundary]]`` holds at zero velocity in c) are left out of the surfaces
+(:func:`~rwall_fem.contact.surface.held_plane_faces`); their nodes stay secondary nodes.
 """
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
+from mpi4py import MPI
 
 from rwall_fem.contact.erosion import (
     ErodingContact,
@@ -29,7 +36,7 @@ from rwall_fem.contact.erosion import (
     may_erode,
 )
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, part_surface, shell_surface
+from rwall_fem.contact.surface import Surface, held_plane_faces, part_surface, shell_surface
 
 __all__ = ["build_contacts"]
 
@@ -52,6 +59,9 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     surfaces: dict[str, Surface] = {}
     eroding: dict[str, ErodingSurface] = {}  # the parts whose cells may erode
     interfaces = []
+    held = None if solid.shells else _held_at_rest(scene, solid)
+    cut: dict[str, Surface] = {}  # the faces of each part left out, on symmetry planes
+    axes: dict[str, np.ndarray] = {}  # and the axes of their planes
 
     def _total(parts: tuple[str, ...]) -> Surface:
         """The faces of ``parts`` now, part after part."""
@@ -76,10 +86,19 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 if name in surfaces or name in eroding:
                     continue
                 if may_erode(scene, body.parts[k]):
-                    follow = ErodingShells if solid.shells else ErodingSurface
-                    eroding[name] = follow(body, k, comm, (internal or body).elements[k])
+                    force = (internal or body).elements[k]
+                    if solid.shells:
+                        eroding[name] = ErodingShells(body, k, comm, force)
+                    else:
+                        eroding[name] = ErodingSurface(body, k, comm, force, held)
+                    if held is not None:
+                        cut[name], axes[name] = eroding[name].cut, eroding[name].axes
                 else:
                     surfaces[name] = faces(body, k, comm)
+                    if held is not None:
+                        axis = held_plane_faces(surfaces[name], *held)
+                        cut[name], axes[name] = surfaces[name].select(axis >= 0), axis[axis >= 0]
+                        surfaces[name] = surfaces[name].select(axis < 0)
             total = _total(parts)
             if not len(total.segments):
                 raise SceneError(f"{where}.{key}: the parts {', '.join(parts)} have no "
@@ -94,7 +113,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
             main, secondary = spec.main, spec.secondary
             side("main", main), side("secondary", secondary)
             sides = [(secondary, main, False)] + ([(main, secondary, False)] if spec.symmetric else [])
-        parts = {name: None for pair in sides for name in pair[0] + pair[1]}
+        parts = {name: None for pair in sides for name in pair[0] + pair[1]}  # both sides
         here = [eroding[name] for name in parts if name in eroding]
         start = [(_total(a), _total(b), exclude) for a, b, exclude in sides]
         nodes = np.unique(np.concatenate([s.nodes for pair in start for s in pair[:2]]
@@ -127,6 +146,13 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         if spec.gap is None and half > 0.0:
             interface.vary_gap(node_gap)
         interface.start(state)
+        left_out = {name: len(cut[name].segments) for name in parts
+                    if name in cut and len(cut[name].segments)}  # fmt: skip
+        if left_out:
+            _mirror(interface, nodes, [(cut[name], axes[name]) for name in left_out])
+            logging.getLogger("rwall_fem").info(
+                "%s: faces on symmetry planes left out of the surface: %s", interface.name,
+                ", ".join(f"{n} {name}" for name, n in left_out.items()))  # fmt: skip
         gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
@@ -146,6 +172,52 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                     )
         interfaces.append(interface)
     return interfaces
+
+
+def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray]]) -> None:
+    """Let ``interface`` (over the surface nodes ``nodes``) act as in the whole model of a
+    model cut by symmetry planes: each node of the faces left out (``planes``: the faces
+    and the axes of their planes) is on those planes, and holds 1/2 of the whole node per
+    plane (``kernels/contact.c``, mirror)."""
+    on = np.zeros(len(nodes), dtype=np.int8)
+    for faces, axis in planes:
+        ids = faces.segments
+        bits = np.repeat((1 << axis).astype(np.int8), 4)
+        ids, bits = ids.ravel(), bits[ids.ravel() >= 0]
+        ids = ids[ids >= 0]
+        rows = np.minimum(np.searchsorted(nodes, ids), len(nodes) - 1)
+        here = nodes[rows] == ids
+        np.bitwise_or.at(on, rows[here], bits[here])
+    count = sum((on >> c) & 1 for c in range(3))
+    share = np.ascontiguousarray(0.5**count, dtype=np.float64)
+    interface.mirrored = (share, on)  # kept alive for the kernel's pointers
+    interface._params.share = interface.ffi.from_buffer("double[]", share)
+    interface._params.planes = interface.ffi.from_buffer("int8_t[]", on)
+
+
+def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The nodes that ``[[boundary]]`` tables hold at zero velocity in some component, the
+    same on every rank: their global numbers (sorted), positions (m) and held components
+    (rows of 3 booleans); None without such a table."""
+    from rwall_fem.meshing import group_nodes
+
+    held = np.zeros((solid.owned, 3), dtype=bool)
+    for spec in scene.boundaries:
+        v = np.asarray(spec.velocity, dtype=float)
+        rest = np.all(v[:, 1:] == 0.0, axis=0) if v.ndim == 2 else v == 0.0
+        nodes = group_nodes(solid.V, solid.body, spec.group)
+        nodes = nodes[nodes < solid.owned]
+        for c in spec.components:
+            held[nodes, "xyz".index(c)] |= bool(rest["xyz".index(c)])
+    if not solid.comm.allreduce(bool(held.any()), op=MPI.LOR):
+        return None
+    mine = np.flatnonzero(held.any(axis=1))
+    ids = solid.V.dofmap.index_map.local_to_global(mine.astype(np.int32))
+    pieces = solid.comm.allgather((ids, solid.X[mine], held[mine]))
+    ids = np.concatenate([p[0] for p in pieces])
+    order = np.argsort(ids)
+    return (ids[order], np.concatenate([p[1] for p in pieces]).reshape(-1, 3)[order],
+            np.concatenate([p[2] for p in pieces]).reshape(-1, 3)[order])  # fmt: skip
 
 
 def _gap_floor(sides, edge: float) -> float:

@@ -42,6 +42,7 @@ from rwall_fem.contact.surface import (
     Surface,
     boundary_faces,
     cell_faces,
+    held_plane_faces,
     once,
     shell_segments,
 )
@@ -72,13 +73,13 @@ class ErodingSurface:
     cells of ``force`` (the part's element force in the step, the same cells) erode;
     :attr:`surface`, the same on every rank (collective construction)."""
 
-    def __init__(self, body, k: int, comm, force):
-        self.force, self.comm = force, comm
+    def __init__(self, body, k: int, comm, force, held=None):
+        self.force, self.comm, self.held = force, comm, held
         self.ids, self.key, self.values = cell_faces(body, k)
         cells = self.force.cells
         self.per = len(self.ids) // max(len(cells), 1)  # faces per cell
         self.alive = np.ones(len(cells), dtype=bool)  # as of the latest update
-        self.surface = boundary_faces(self.ids, self.key, self.values, comm)
+        self.surface = self._uncut(boundary_faces(self.ids, self.key, self.values, comm))
         to_global = body.V.dofmap.index_map.local_to_global
         mine = np.unique(cells).astype(np.int32)
         self.nodes = np.unique(_gather(comm, to_global(mine).astype(np.int64))[0])
@@ -117,8 +118,20 @@ class ErodingSurface:
         """The surface of the live cells from scratch (collective): after a resume."""
         self.alive = self._alive_now().copy()
         live = np.repeat(self.alive, self.per)
-        self.surface = boundary_faces(self.ids[live], self.key[live], self.values[live],
-                                      self.comm)  # fmt: skip
+        self.surface = self._uncut(boundary_faces(self.ids[live], self.key[live],
+                                                  self.values[live], self.comm))  # fmt: skip
+
+    def _uncut(self, surface: Surface) -> Surface:
+        """``surface`` without its faces on symmetry planes (``held``: the nodes held at
+        rest, :func:`~rwall_fem.contact.surface.held_plane_faces`); those of the start are
+        :attr:`cut`, the axes of their planes :attr:`axes`. (Erosion bares no such face:
+        a face on the plane belongs to one cell from the start.)"""
+        if self.held is None:
+            return surface
+        axis = held_plane_faces(surface, *self.held)
+        if not hasattr(self, "cut"):
+            self.cut, self.axes = surface.select(axis >= 0), axis[axis >= 0]
+        return surface.select(axis < 0)
 
     @property
     def detachments(self) -> int:

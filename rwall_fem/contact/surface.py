@@ -19,6 +19,12 @@ segment's share of a variable gap), its stiffness Radioss's for a shell main seg
 ``k0 = stiffness_scale x E t`` (N/m: E Young's modulus of the shell's material, t its
 thickness), its shortest edge the shortest side.
 
+A face on a symmetry plane is not a segment (:func:`held_plane_faces`): a solid's boundary
+face lying in a plane x_c = const (c = x, y or z) all of whose nodes a boundary condition
+holds at zero velocity in c: the body goes on beyond it (its mirror image, or whatever
+holds it), so nothing can come at it from outside, and a node of another body cut by the
+same plane, sliding in that plane, would be taken as a whole gap inside it.
+
 Every rank gets every segment of the interface, in global node numbers, sorted by their
 nodes: every rank of a run computes the contact alike (:mod:`rwall_fem.contact.interface`;
 the global numbers, hence the order, depend on the partition).
@@ -30,8 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Surface", "boundary_faces", "cell_faces", "part_surface", "once",
-           "shell_segments", "shell_surface"]
+__all__ = ["Surface", "boundary_faces", "cell_faces", "held_plane_faces", "part_surface",
+           "once", "shell_segments", "shell_surface"]
 
 # The faces of DOLFINx's reference cells as cycles of their vertices.
 _FACES = {
@@ -60,6 +66,10 @@ class Surface:
         return Surface(*(np.concatenate([a, b]) for a, b in zip(
             (self.segments, self.stiffness, self.depth, self.edge),
             (other.segments, other.stiffness, other.depth, other.edge), strict=True)))  # fmt: skip
+
+    def select(self, keep: np.ndarray) -> Surface:
+        """The segments where ``keep`` (a mask) is true."""
+        return Surface(self.segments[keep], self.stiffness[keep], self.depth[keep], self.edge[keep])
 
 
 def _area_vector(p: np.ndarray, triangle: np.ndarray) -> np.ndarray:
@@ -137,6 +147,27 @@ def boundary_faces(ids: np.ndarray, key: np.ndarray, values: np.ndarray, comm) -
     _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
     keep = first[counts == 1]  # np.unique sorts by key: the same order on every rank
     return Surface(ids[keep], *values[keep].T.copy())
+
+
+def held_plane_faces(surface: Surface, nodes: np.ndarray, x: np.ndarray,
+                     held: np.ndarray) -> np.ndarray:
+    """The axis c (0, 1, 2; -1 for none) of the symmetry plane each segment of ``surface``
+    lies on: a plane x_c = const (its corners' x_c within 1e-9 of its shortest edge of each
+    other) whose every node is held in c, and not every node in all three (a clamped face
+    stays). ``nodes`` are sorted global numbers, ``x`` their positions (m, rows of 3),
+    ``held`` their components held at zero velocity (rows of 3 booleans); a node not in
+    ``nodes`` is free."""
+    ids = surface.segments
+    if not len(nodes):
+        return np.full(len(ids), -1)
+    ids = np.where(ids >= 0, ids, ids[:, :1])  # a triangle's 4th corner is its 1st
+    rows = np.minimum(np.searchsorted(nodes, ids), len(nodes) - 1)
+    found = (nodes[rows] == ids)[:, :, None]
+    corners, fixed = x[rows], held[rows] & found  # (segments, 4, 3)
+    spread = corners.max(axis=1) - corners.min(axis=1)
+    flat = spread <= 1e-9 * surface.edge[:, None]
+    on = flat & fixed.all(axis=1) & ~fixed.all(axis=(1, 2))[:, None]
+    return np.where(on.any(axis=1), np.argmax(on, axis=1), -1)
 
 
 def once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:

@@ -151,6 +151,8 @@ void largest_components(int64_t n, const int64_t *nodes, const double *v, const 
 typedef struct {
   double gap, cap, friction, damping, alpha, dt, reach;
   const double *half_thickness;
+  const double *share;
+  const int8_t *planes;
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,

@@ -23,6 +23,8 @@
  * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
  * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
  * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
+ * With `share` and `planes`, a model cut by symmetry planes acts as the whole model would
+ * (see mirror).
  */
 #include <stdlib.h>
 
@@ -40,6 +42,10 @@ typedef struct
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
   const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
                                   a constant gap (see pair_gap) */
+  const double *share;          /* per surface node, or NULL (all 1): the share of the whole
+                                  node a model cut by symmetry planes holds (see mirror) */
+  const int8_t *planes;         /* per surface node, or NULL: bit c set on a symmetry plane
+                                  normal to axis c */
 } contact_params;
 
 INLINE double cdot(const double x[3], const double y[3])
@@ -522,6 +528,34 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   return 1;
 }
 
+/* A model cut by symmetry planes: a secondary node s on such planes meets, in the whole
+ * model, its segment and the segment's mirror images at one distance; their blend puts the
+ * point on the planes, so the normal lies in them: its components normal to the planes go.
+ * The node holds share[s] of the whole node's mass (1/2 on a plane, 1/4 on two), so its
+ * pair takes that share of the whole pair's stiffness (hence of its force, energy and
+ * friction); the damping sees the whole nodes' masses, mass / share; the velocity
+ * relative to the point loses its components normal to the planes, as the blend of the
+ * mirror images averages them away. */
+INLINE double mirror(const contact_params *prm, int64_t s, surface_point *pt)
+{
+  if (!prm->share)
+    return 1.0;
+  const int8_t planes = prm->planes[s];
+  if (planes)
+  {
+    double size = 0.0;
+    for (int c = 0; c < 3; ++c)
+    {
+      pt->normal[c] = (planes >> c) & 1 ? 0.0 : pt->normal[c];
+      size += pt->normal[c] * pt->normal[c];
+    }
+    size = sqrt(size);
+    for (int c = 0; c < 3; ++c)
+      pt->normal[c] = size > 0.0 ? pt->normal[c] / size : 0.0;
+  }
+  return prm->share[s];
+}
+
 /* Nodes that start inside the gap (Radioss TYPE7 Inacti = 6): a node at distance d0 < gap
  * from the surface at the start gets its own gap 0.95 d0 (Radioss: gap0 = Gap - P0 - 5 %
  * of (Gap - P0), P0 = Gap - d0 the initial penetration), so that it is not pushed out at
@@ -611,7 +645,8 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       continue;
     }
     const double g = grown_gap(node_gap + i, pt.d, pair_gap(prm, s, pt.depth));
-    const double k0 = pt.k0;
+    const double share = mirror(prm, s, &pt);
+    const double k0 = share * pt.k0;
     if (!(g > 0.0 && pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
     {
       /* Near but not in contact: its spring's stiffness counts in the step all the same,
@@ -634,13 +669,17 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
       w[c] = v[3 * s + c];
     for (int m = 0; m < pt.n; ++m)
     {
-      main_mass += pt.weight[m] * mass[pt.node[m]];
+      main_mass += pt.weight[m] * mass[pt.node[m]] / (prm->share ? prm->share[pt.node[m]] : 1.0);
       for (int c = 0; c < 3; ++c)
         w[c] -= pt.weight[m] * v[3 * pt.node[m] + c];
     }
+    if (prm->planes) /* the whole model's blend: the mirror images' velocities averaged */
+      for (int c = 0; c < 3; ++c)
+        w[c] = (prm->planes[s] >> c) & 1 ? 0.0 : w[c];
     const double *normal = pt.normal;
     const double wn = cdot(w, normal);
-    const double reduced = mass[s] * main_mass / (mass[s] + main_mass);
+    const double whole = mass[s] / share; /* the whole node's */
+    const double reduced = share * whole * main_mass / (whole + main_mass);
     const double viscous = 2.0 * prm->damping * sqrt(kt * reduced);
     double damper = -viscous * wn;
     damper = damper > spring ? spring : (damper < -spring ? -spring : damper);
