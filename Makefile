@@ -260,6 +260,9 @@ bench: venv-0.5
 	    --out bench/shell_kernels.md
 	$(RUN_ENV) OMP_NUM_THREADS=1 $(MPIRUN_0.5) -n 2 $(VENV)/bin/python bench/shell_kernels.py \
 	    --out bench/shell_kernels.md
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(VENV)/bin/python bench/contact.py --out bench/contact.md
+	$(RUN_ENV) OMP_NUM_THREADS=1 $(MPIRUN_0.5) -n 2 $(VENV)/bin/python bench/contact.py \
+	    --tube-only --tube-cells 10000 --out bench/contact.md
 
 clean:
 	rm -rf $(VENV) $(VENV011) .pytest_cache *.egg-info docs/_build docs/tutorials

@@ -110,7 +110,7 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
     offsets[i] = 0;
   if (nsec == 0 || nseg == 0)
     return 0;
-  /* The grid: cubes of the largest widened segment box, over the secondary nodes' box. */
+  /* The grid over the secondary nodes' box, from the largest widened segment box. */
   double low[3] = {INFINITY, INFINITY, INFINITY}, high[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int64_t i = 0; i < nsec; ++i)
     for (int c = 0; c < 3; ++c)
@@ -134,6 +134,9 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
       }
       h = b - a + 2.0 * reach[j] > h ? b - a + 2.0 * reach[j] : h;
     }
+  /* Cubes of half that: a segment overlaps at most 3 of them each way, and tests about
+   * half the nodes that cubes of the whole box would give it (bench/contact.py). */
+  h *= 0.5;
   int64_t dims[3];
   for (;;)
   {
@@ -170,6 +173,12 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
     fill[b] = start[b];
   for (int64_t i = 0; i < nsec; ++i)
     order[fill[bucket_of[i]]++] = i;
+  /* The nodes' positions in bucket order: a bucket's nodes are read from one stretch of
+   * memory, wherever their rows are (the sort's time per node then holds on large meshes). */
+  double *xb = (double *)malloc(3 * (nsec > 0 ? nsec : 1) * sizeof(double));
+  for (int64_t m = 0; m < nsec; ++m)
+    for (int c = 0; c < 3; ++c)
+      xb[3 * m + c] = x[3 * secondary[order[m]] + c];
   /* The pairs (segment, node) in segment order, then sorted by node (stable). */
   int64_t *pair_node = work + 2 * nsec, *pair_seg = pair_node + capacity;
   int64_t count = 0;
@@ -202,12 +211,13 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
           const int64_t bucket = (p * dims[1] + q) * dims[2] + r;
           for (int64_t m = start[bucket]; m < start[bucket + 1]; ++m)
           {
-            const int64_t i = order[m], s = secondary[i];
+            const double *xm = xb + 3 * m;
             int inside = 1;
             for (int c = 0; c < 3; ++c)
-              inside &= x[3 * s + c] >= a[c] && x[3 * s + c] <= b[c];
+              inside &= xm[c] >= a[c] && xm[c] <= b[c];
             if (!inside)
               continue;
+            const int64_t i = order[m], s = secondary[i];
             int own = 0;
             for (int k = 0; k < 4; ++k)
               own |= seg[k] == s;
@@ -224,6 +234,7 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
   }
   free(start);
   free(fill);
+  free(xb);
   if (count > capacity)
     return count;
   for (int64_t k = 0; k < count; ++k)
@@ -433,6 +444,33 @@ typedef struct
   double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
 } surface_point;
 
+/* The squared distance (m^2) of p to the box of segment `seg`'s corners: a lower bound of
+ * its distance to the segment (which lies in the box), found with a few comparisons. */
+INLINE double box_distance2(const double p[3], const int64_t *seg, const double *x)
+{
+  const int corners = seg[3] >= 0 ? 4 : 3;
+  double d2 = 0.0;
+  for (int c = 0; c < 3; ++c)
+  {
+    double a = x[3 * seg[0] + c], b = a;
+    for (int k = 1; k < corners; ++k)
+    {
+      const double y = x[3 * seg[k] + c];
+      a = y < a ? y : a;
+      b = y > b ? y : b;
+    }
+    const double out = p[c] < a ? a - p[c] : (p[c] > b ? p[c] - b : 0.0);
+    d2 += out * out;
+  }
+  return d2;
+}
+
+/* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
+ * is then beyond the reach (it cannot be the closest) and beyond the band of any closest
+ * distance below the reach (d - best > 1e-6 reach > BAND best: its share would be < 0),
+ * with room for the round-off of both distances, so that skipping it changes nothing. */
+#define FAR (1.0 + 1e-6)
+
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
  * 0 if none is within reach.  `distance` holds to - from values (scratch).
  *
@@ -454,10 +492,18 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               surface_point *pt)
 {
   double best = INFINITY;
+  const double far2 = FAR * reach * FAR * reach;
   for (int64_t k = from; k < to; ++k)
   {
+    const int64_t *seg = segs + 4 * candidates[k];
+    if (box_distance2(xs, seg, x) > far2)
+    {
+      distance[k - from] = INFINITY; /* out of reach and out of any band: as the exact
+                                        distance would be (see FAR) */
+      continue;
+    }
     double q[3], w[4], n[3];
-    const double dk = closest_on_segment(xs, segs + 4 * candidates[k], x, q, w, n);
+    const double dk = closest_on_segment(xs, seg, x, q, w, n);
     distance[k - from] = dk;
     best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
   }

@@ -67,6 +67,29 @@ INLINE int shell_any(ivec m)
 #endif
 }
 
+/* batch.h's gather of the 3 components of the npe nodes of the batch's cells into
+ * out[3 I + i][lane], node by node where the host has AVX-512 (VL): each lane's node as one
+ * masked load of its x, y, z (the lane past z is not read) and a 4 x 4 transpose. */
+INLINE void shell_gather(const int32_t *restrict cells, int npe, const batch_t *b,
+                         const double *restrict values, vec *restrict out)
+{
+#if defined(__AVX512VL__) && LANES == 4
+  for (int I = 0; I < npe; ++I)
+  {
+    __m256d r[4];
+    for (int k = 0; k < 4; ++k)
+      r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[k] * npe + I]);
+    const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
+    const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
+    out[3 * I] = (vec)_mm256_permute2f128_pd(t0, t2, 0x20);
+    out[3 * I + 1] = (vec)_mm256_permute2f128_pd(t1, t3, 0x20);
+    out[3 * I + 2] = (vec)_mm256_permute2f128_pd(t0, t2, 0x31);
+  }
+#else
+  gather(cells, npe, b, values, out);
+#endif
+}
+
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
 INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
 {
@@ -218,41 +241,70 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
                        || (p->rate_coefficient == 0.0 && !p->thermal);
   const double cap = p->max_flow_stress > 0.0 ? p->max_flow_stress : INFINITY;
   const double lowest = p->yield_stress < cap ? p->yield_stress : cap;
-  /* the points that flow in some lane, and what their iterations need */
+  /* Each stage below runs over all the points that need it before the next stage starts,
+   * so that the points' dependency chains (square roots, divisions, the law's series)
+   * overlap in the processor instead of running one after the other. */
   int m = 0, which[SHELL_MAX_POINTS], near[SHELL_MAX_POINTS];
-  vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
-  vec y0[SHELL_MAX_POINTS], power0[SHELL_MAX_POINTS], inv_e0[SHELL_MAX_POINTS];
-  vec factor[SHELL_MAX_POINTS], g[SHELL_MAX_POINTS], lo[SHELL_MAX_POINTS], hi[SHELL_MAX_POINTS];
-  vec tolerance[SHELL_MAX_POINTS];
-  ivec plastic[SHELL_MAX_POINTS];
+  vec q2[SHELL_MAX_POINTS], factor[SHELL_MAX_POINTS], q_trial[SHELL_MAX_POINTS];
+  vec y0[SHELL_MAX_POINTS], slope[SHELL_MAX_POINTS], power0[SHELL_MAX_POINTS];
+  vec inv_e0[SHELL_MAX_POINTS];
+  ivec maybe[SHELL_MAX_POINTS], plastic[SHELL_MAX_POINTS];
+  /* the elastic checks: the points that may flow in some lane */
   for (int j = 0; j < n; ++j)
   {
     d[j] = flow[j] = VZERO;
-    const vec q2 = von_mises_squared(sig[j]);
-    const vec f = flow_factor(p, rate[j], T[j]);
-    ivec maybe = q2 == q2; /* every lane */
+    q2[j] = von_mises_squared(sig[j]);
+    factor[j] = flow_factor(p, rate[j], T[j]);
+    maybe[j] = q2[j] == q2[j]; /* every lane */
     if (p->hardening != HARDENING_TABLE)
     {
-      const vec floor = lowest * f;
-      maybe &= q2 > floor * floor;
+      const vec floor = lowest * factor[j];
+      maybe[j] &= q2[j] > floor * floor;
     }
     if (of_eps_p)
-      maybe &= q2 > q_old2[j];
-    if (!shell_any(maybe))
-      continue;
-    const vec q_trial = vsqrt(q2);
-    vec slope, power, inverse;
-    const vec y = flow_stress_power(p, eps_p[j], f, &slope, &power, &inverse);
-    flow[j] = y;
-    const ivec flowing = maybe & (q_trial > y);
+      maybe[j] &= q2[j] > q_old2[j];
+    if (shell_any(maybe[j]))
+      which[m++] = j;
+  }
+  if (m == 0)
+    return;
+  /* the law at eps_p of those points, and their trial von Mises stresses */
+  for (int a = 0; a < m; ++a)
+  {
+    const int j = which[a];
+    q_trial[a] = vsqrt(q2[j]);
+    y0[a] = flow_stress_power(p, eps_p[j], factor[j], &slope[a], &power0[a], &inv_e0[a]);
+    flow[j] = y0[a];
+  }
+  /* the points that flow in some lane, packed in front */
+  int flowing_points = 0;
+  for (int a = 0; a < m; ++a)
+  {
+    const int j = which[a];
+    const ivec flowing = maybe[j] & (q_trial[a] > y0[a]);
     if (!shell_any(flowing))
       continue;
-    const int a = m++;
-    which[a] = j;
-    plastic[a] = flowing;
-    factor[a] = f;
-    y0[a] = y;
-    power0[a] = power;
+    const int b = flowing_points++;
+    which[b] = j;
+    plastic[b] = flowing;
+    factor[b] = factor[j];
+    q_trial[b] = q_trial[a];
+    y0[b] = y0[a];
+    slope[b] = slope[a];
+    power0[b] = power0[a];
+    inv_e0[b] = inv_e0[a];
+  }
+  m = flowing_points;
+  if (m == 0)
+    return;
+  vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
+  vec g[SHELL_MAX_POINTS], lo[SHELL_MAX_POINTS], hi[SHELL_MAX_POINTS];
+  vec tolerance[SHELL_MAX_POINTS];
+  for (int a = 0; a < m; ++a)
+  {
+    const int j = which[a];
+    const ivec flowing = plastic[a];
+    const vec y = y0[a];
     pp[a] = sig[j][0] + sig[j][1];
     dd[a] = sig[j][1] - sig[j][0];
     P1[a] = 0.25 * pp[a] * pp[a];
@@ -262,30 +314,29 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
      * step's: iterate until it is itself at round-off */
     tolerance[a] = vselect(virgin, VZERO + 1e-13, VZERO + 1e-7);
     near[a] = power_law && !shell_any(virgin);
-    inv_e0[a] = inverse;
-    const vec safe_q = vselect(flowing, q_trial, VZERO + 1.0);
+    const vec safe_q = vselect(flowing, q_trial[a], VZERO + 1.0);
     lo[a] = VZERO;
     hi[a] = (safe_q / vmax(y, VZERO + 1e-300) - 1.0) * (1.0 / k1);
-    vec start = slope;
+    vec start = slope[a];
     if (shell_any(virgin))
     {
       const vec d0 = vmax((safe_q - y) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
       vec unused;
-      const vec secant = (capped_flow_stress(p, eps_p[j] + d0, f, &unused) - y) / d0;
-      start = vselect(eps_p[j] <= 0.0, secant, slope);
+      const vec secant = (capped_flow_stress(p, eps_p[j] + d0, factor[a], &unused) - y) / d0;
+      start = vselect(eps_p[j] <= 0.0, secant, slope[a]);
     }
     const vec g0 = (safe_q - y) * (safe_q * safe_q)
                    / ((P1[a] * k1 + P2[a] * g2) * y
                       + (2.0 / 3.0) * vmax(start, VZERO) * (safe_q * safe_q * safe_q));
     g[a] = vselect(flowing, vmin(vmax(g0, VZERO), hi[a]), VZERO);
   }
-  if (m == 0)
-    return;
   double binomial[BINOMIAL_TERMS];
   binomial_coefficients(p->hardening_exponent, binomial);
   for (int iteration = 0; iteration < 50; ++iteration)
   {
-    int more = 0;
+    vec q[SHELL_MAX_POINTS], dq[SHELL_MAX_POINTS], rq[SHELL_MAX_POINTS];
+    vec increment[SHELL_MAX_POINTS], y[SHELL_MAX_POINTS], h[SHELL_MAX_POINTS];
+    int all_near = 1, use_series[SHELL_MAX_POINTS];
     for (int a = 0; a < m; ++a)
     {
       /* q = sqrt(W) / (A1 B1), W = P1 B1^2 + P2 A1^2: one division */
@@ -293,20 +344,30 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       const vec root = vsqrt(P1[a] * B1 * B1 + P2[a] * A1 * A1);
       const vec inv = 1.0 / (root * AB);
       const vec r = root * inv, ra = B1 * r, rb = A1 * r; /* 1 / A1, 1 / B1 */
-      const vec rq = AB * AB * inv, q = root * r;
-      const vec dq = -(P1[a] * k1 * ra * ra * ra + P2[a] * g2 * rb * rb * rb) * rq;
-      const vec increment = (2.0 / 3.0) * g[a] * q;
-      const int j = which[a];
-      vec y, h;
-      if (near[a] && !shell_any(plastic[a] & (increment > 0.05 * eps_p[j])))
-        y = near_flow_stress(p, binomial, power0[a], inv_e0[a], increment * inv_e0[a],
-                             factor[a], &h);
-      else
-        y = capped_flow_stress(p, eps_p[j] + increment, factor[a], &h);
-      const vec R = y * rq - 1.0;
+      rq[a] = AB * AB * inv;
+      q[a] = root * r;
+      dq[a] = -(P1[a] * k1 * ra * ra * ra + P2[a] * g2 * rb * rb * rb) * rq[a];
+      increment[a] = (2.0 / 3.0) * g[a] * q[a];
+      use_series[a] = near[a] && !shell_any(plastic[a] & (increment[a] > 0.05 * eps_p[which[a]]));
+      all_near &= use_series[a];
+    }
+    if (all_near)
+      for (int a = 0; a < m; ++a)
+        y[a] = near_flow_stress(p, binomial, power0[a], inv_e0[a], increment[a] * inv_e0[a],
+                                factor[a], &h[a]);
+    else
+      for (int a = 0; a < m; ++a)
+        y[a] = use_series[a] ? near_flow_stress(p, binomial, power0[a], inv_e0[a],
+                                          increment[a] * inv_e0[a], factor[a], &h[a])
+                       : capped_flow_stress(p, eps_p[which[a]] + increment[a], factor[a], &h[a]);
+    int more = 0;
+    for (int a = 0; a < m; ++a)
+    {
+      const vec R = y[a] * rq[a] - 1.0;
       lo[a] = vselect(R < 0.0, g[a], lo[a]);
       hi[a] = vselect(R > 0.0, g[a], hi[a]);
-      const vec dR = rq * (vmax(h, VZERO) * (2.0 / 3.0) * (q + g[a] * dq) - y * rq * dq);
+      const vec dR = rq[a] * (vmax(h[a], VZERO) * (2.0 / 3.0) * (q[a] + g[a] * dq[a])
+                              - y[a] * rq[a] * dq[a]);
       vec next = g[a] - R / dR;
       /* outside the bracket: its midpoint, geometric while it spans decades (the root of
        * a power law's infinite slope at eps_p = 0 may be many decades below the start) */

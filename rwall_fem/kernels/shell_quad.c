@@ -429,10 +429,10 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
   {
     const batch_t b = batch_at(p->live, k0, num_cells);
     vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
-    gather(cells, 4, &b, X, Xe);
-    gather(cells, 4, &b, u, ue);
-    gather(cells, 4, &b, v, ve);
-    gather(cells, 4, &b, w, we);
+    shell_gather(cells, 4, &b, X, Xe);
+    shell_gather(cells, 4, &b, u, ue);
+    shell_gather(cells, 4, &b, v, ve);
+    shell_gather(cells, 4, &b, w, we);
     for (int i = 0; i < 12; ++i)
     {
       x[i] = Xe[i] + ue[i];
@@ -525,7 +525,7 @@ void shell_quad_sizes(const shell_params *s, int64_t n, const int32_t *cells, co
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
   {
     const batch_t b = batch_at(NULL, k0, n);
-    gather(cells, 4, &b, x, xe);
+    shell_gather(cells, 4, &b, x, xe);
     quad_frame_t g;
     quad_frame(xe, &g);
     const vec l = quad_length(s, &g);

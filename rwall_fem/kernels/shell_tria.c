@@ -178,10 +178,10 @@ INLINE void shell_tria(int plastic, int64_t num_cells, const int32_t *restrict c
     /* initialised: gather fills them lane by lane */
     vec Xe[9] = {VZERO}, ue[9] = {VZERO}, ve[9] = {VZERO}, we[9] = {VZERO}, x[9], xm[9], fe[18],
         du[18];
-    gather(cells, 3, &b, X, Xe);
-    gather(cells, 3, &b, u, ue);
-    gather(cells, 3, &b, v, ve);
-    gather(cells, 3, &b, w, we);
+    shell_gather(cells, 3, &b, X, Xe);
+    shell_gather(cells, 3, &b, u, ue);
+    shell_gather(cells, 3, &b, v, ve);
+    shell_gather(cells, 3, &b, w, we);
     for (int i = 0; i < 9; ++i)
     {
       x[i] = Xe[i] + ue[i];
@@ -255,7 +255,7 @@ void shell_tria_sizes(const shell_params *s, int64_t n, const int32_t *cells, co
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
   {
     const batch_t b = batch_at(NULL, k0, n);
-    gather(cells, 3, &b, x, xe);
+    shell_gather(cells, 3, &b, x, xe);
     tria_frame_t g;
     tria_frame(xe, &g);
     const vec l = tria_length(&g);
