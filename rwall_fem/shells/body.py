@@ -69,6 +69,7 @@ class ShellSection:
                  if t.hourglass_stiffness > 0.0 else "")  # fmt: skip
         extra += (f", drilling springs {t.drilling_stiffness:g} G t A"
                   if t.drilling_stiffness > 0.0 else "")  # fmt: skip
+        extra += ", QEPH's step length" if t.step_length == "qeph" else ""
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
                 f"{self.thickness:g} m{change}{share}{extra}")  # fmt: skip
 

@@ -76,6 +76,7 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             shear_factor=element.shear_factor or SHEAR_FACTOR,
             hourglass_stiffness=element.hourglass_stiffness or 0.0,
             drilling_stiffness=element.drilling_stiffness or 0.0,
+            step_length=element.step_length or "bt",
         )
     except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
         said = str(err)

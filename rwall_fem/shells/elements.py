@@ -45,6 +45,11 @@ POINT_SLOTS = 5  # per point through the thickness: sxx, syy, sxy, eps_p, temper
 MAX_POINTS = 10
 FORMULATIONS = {"quadrilateral": ("bwc", "bt"), "triangle": ("bsc",)}
 FAMILY = {"quadrilateral": "quad", "triangle": "tria"}
+# The quadrilaterals' characteristic lengths of the step: "bt", Radioss's for its
+# Belytschko-Tsay shells (CDLEN3); "qeph", QEPH's (CZCORC1) with its default numerical
+# damping dn = QEPH_DN (the length times sqrt(1 + dn^2) - dn, cndt3.F).
+STEP_LENGTHS = ("bt", "qeph")
+QEPH_DN = 0.015
 # DOLFINx's quadrilateral vertices (0,0), (1,0), (0,1), (1,1): counter-clockwise order.
 _CCW = [0, 1, 3, 2]
 
@@ -65,6 +70,8 @@ typedef struct {
   double kd;
   int drill_slot;
   double *new_thickness;
+  int qeph_step;
+  double qeph_dn;
 } shell_params;
 """
     + "".join(
@@ -76,8 +83,8 @@ typedef struct {
         for law in ("elastic", "plastic")
     )
     + "".join(
-        f"void shell_{family}_sizes(int64_t n, const int32_t *cells, const double *x,"
-        " double *area, double *length);\n"
+        f"void shell_{family}_sizes(const shell_params *s, int64_t n, const int32_t *cells,"
+        " const double *x, double *area, double *length);\n"
         for family in ("quad", "tria")
     )
     + """
@@ -196,12 +203,14 @@ class ShellTechnology:
     hourglass_stiffness: float = 0.0
     # drilling stiffness over G t A (quadrilaterals; 0: none, shell_quad.c)
     drilling_stiffness: float = 0.0
+    # the characteristic length of the step (quadrilaterals, STEP_LENGTHS; shell_quad.c)
+    step_length: str = "bt"
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
                hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
                hourglass_stiffness: float = 0.0,
-               drilling_stiffness: float = 0.0) -> ShellTechnology:
+               drilling_stiffness: float = 0.0, step_length: str = "bt") -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -228,10 +237,13 @@ class ShellTechnology:
             raise ValueError(
                 f"element.drilling_stiffness: must be >= 0, got {drilling_stiffness}"
             )
+        if step_length not in STEP_LENGTHS:
+            raise ValueError(f"element.step_length: {step_length!r}; allowed: {STEP_LENGTHS}")
         quad = cell == "quadrilateral"
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
                    float(hourglass_stiffness) if quad else 0.0,
-                   float(drilling_stiffness) if quad else 0.0)  # fmt: skip
+                   float(drilling_stiffness) if quad else 0.0,
+                   step_length if quad else "bt")  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -240,7 +252,8 @@ class ShellTechnology:
         name = "Belytschko-Lin-Tsay quadrilaterals"
         warp = " with the BWC warping correction" if self.formulation == "bwc" else ""
         hm, hf, hr = self.hourglass
-        return f"{name}{warp}, viscous hourglass hm {hm:g} hf {hf:g} hr {hr:g}"
+        step = ", QEPH's step length" if self.step_length == "qeph" else ""
+        return f"{name}{warp}, viscous hourglass hm {hm:g} hf {hf:g} hr {hr:g}{step}"
 
 
 class ShellKernel:
@@ -312,6 +325,7 @@ class ShellKernel:
             s.points = 0
             self.history = np.zeros((8, n))
         s.hk = technology.hourglass_stiffness
+        s.qeph_step, s.qeph_dn = int(technology.step_length == "qeph"), QEPH_DN
         self.thickness_change = bool(thickness_change)
         if self.thickness_change:
             s.new_thickness = ffi.cast("double *", self.thickness.ctypes.data)
@@ -407,7 +421,7 @@ class ShellKernel:
         x = np.ascontiguousarray(x, dtype=np.float64)
         ffi = self.ffi
         getattr(self.lib, f"shell_{self.family}_sizes")(
-            self.num_cells, ffi.cast("int32_t *", self.cells.ctypes.data),
+            self.shell, self.num_cells, ffi.cast("int32_t *", self.cells.ctypes.data),
             ffi.cast("double *", x.ctypes.data), ffi.cast("double *", area.ctypes.data),
             ffi.cast("double *", length.ctypes.data),
         )  # fmt: skip
