@@ -232,13 +232,13 @@ def test_a_cache_that_cannot_be_written_gives_way_to_a_private_one(tmp_path, mon
     blocked = tmp_path / "file"
     blocked.write_text("not a folder")
 
-    def compile_(name, flags, work):
+    def compile_(extension, name, flags, work):
         library = work / f"{name}.so"
         library.write_bytes(b"built")
         return library
 
     monkeypatch.setattr(kernels, "_compile", compile_)
-    final, private = kernels._build("_rwall_kernels_x", [], blocked / "kernels")
+    final, private = kernels._build(kernels.ELEMENTS, "_rwall_kernels_x", [], blocked / "kernels")
     assert private is not None and final.parent == private and final.read_bytes() == b"built"
     shutil.rmtree(private)
 
