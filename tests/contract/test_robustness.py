@@ -257,11 +257,13 @@ def test_a_cache_that_cannot_be_written_gives_way_to_a_private_one(tmp_path, mon
 
 @pytest.mark.serial
 def test_processes_starting_together_share_one_kernel_cache(tmp_path):
-    """Two processes (ranks starting together) load the shell kernels into an empty cache
-    at once, through the one loader of :mod:`rwall_fem.kernels`: both load, the cache then
+    """Two processes (ranks starting together) load an extension into an empty cache at
+    once, through the one loader of :mod:`rwall_fem.kernels` (the solids' and the shells'
+    kernels take it; a small extension here, quick to compile): both load, the cache then
     holds whole libraries of one key only (no build folder left), and a later process
     loads what is there without publishing anything new."""
-    code = "from rwall_fem.shells.elements import load; load()"
+    code = ("from rwall_fem import kernels; kernels.load(kernels.Extension('_rwall_probe', "
+            "('batch.h',), '', 'a probe'))")  # fmt: skip
     env = _env(RWALL_FEM_CACHE=str(tmp_path))
     both = [subprocess.Popen([sys.executable, "-c", code], env=env, stderr=subprocess.PIPE,
                              text=True) for _ in range(2)]  # fmt: skip
