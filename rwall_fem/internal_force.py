@@ -77,9 +77,9 @@ class InternalForce:
     """The internal force of some cells of a body, computed by a compiled kernel: what
     every element family does alike.
 
-    A subclass sets ``V`` (the function space), ``v`` (the velocity field),
-    ``cells`` (rows of node indices) and ``num_cells``, ``params``
-    (``element_params``) and ``ffi``, ``history`` (the state: rows of slots, columns of
+    A subclass sets ``V`` (the function space), ``v`` (the velocity field), ``cells``
+    (rows of node indices) and ``num_cells``, ``params`` (``element_params``) and ``ffi``,
+    ``plastic`` (an elasto-plastic law), ``history`` (the state: rows of slots, columns of
     cells; None without one) and ``points`` (integration points per cell), ``step`` (what
     the kernels note, ``STEP_SLOTS``) and ``_energy`` (stored elastic, hourglass, plastic
     dissipation, internal energy of eroded cells: J), ``erosion`` (None until cells may
