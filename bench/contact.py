@@ -95,7 +95,8 @@ class StepClock:
         self._wrap(internal, "accelerate", "internal", first=True)
         self._wrap(contact, "accelerate", "contact")
         self._wrap(contact, "_sort", "sort")
-        self._wrap(contact, "_gather", "gather")
+        self._wrap(contact, "_read", "gather")
+        self._wrap(contact, "_read_ghosts", "gather")
         self.contact = contact
 
     def _wrap(self, owner, attribute, name, first=False):
@@ -226,7 +227,7 @@ def search(nodes: int, repeats: int) -> dict:
     interface = ContactInterface("bench", np.arange(n, dtype=np.int64), [ps], gap=gap,
                                  friction=0.0, alpha=1.0, margin=margin, state=state,
                                  comm=MPI.COMM_SELF, owned_global=np.arange(n))  # fmt: skip
-    interface._gather(state)
+    interface._read(state)
     interface._sort()  # the candidate arrays grown to size
     sorts, passes = [], []
     lib, arguments = interface.lib, interface._passes[0]
@@ -241,7 +242,7 @@ def search(nodes: int, repeats: int) -> dict:
     return {
         "nodes": n,
         "segments": len(quads),
-        "candidates": int(ps.offsets[-1]),
+        "candidates": int(interface.passes[0].offsets[-1]),
         "sort_ns_per_node": statistics.median(sorts) / n * 1e9,
         "pass_ns_per_node": statistics.median(passes) / n * 1e9,
         "sort_all": sorts,

@@ -39,6 +39,7 @@ from rwall_fem.kernels import STEP_SLOTS
 __all__ = [
     "Body",
     "Part",
+    "PartedBody",
     "PartError",
     "part_masses",
     "parts_of",
@@ -51,13 +52,14 @@ __all__ = [
 @dataclass
 class Part:
     """A part: its ``name``, the local indices of its owned ``cells``, its ``material`` (a
-    :class:`~rwall_fem.scene.Material`), element ``technology`` and initial ``velocity``
-    (m/s)."""
+    :class:`~rwall_fem.scene.Material`), element ``technology`` (a solid's
+    :class:`~rwall_fem.elements.Technology`, a shell's
+    :class:`~rwall_fem.shells.body.ShellSection`) and initial ``velocity`` (m/s)."""
 
     name: str
     cells: np.ndarray
     material: object
-    technology: Technology
+    technology: object
     velocity: tuple[float, float, float]
 
 
@@ -131,7 +133,107 @@ def parts_of(specs, body_mesh, technologies: list[Technology], comm) -> list[Par
     return parts
 
 
-class Body(ErodingBody):
+class PartedBody(ErodingBody):
+    """What a body of parts does alike, of solids (:class:`Body`) or of shells
+    (:class:`~rwall_fem.shells.body.ShellBody`): over its ``parts`` (each with the local
+    indices of its owned ``cells``) on the space ``V``, their element forces ``elements``
+    (in the order of the parts) and ``part_masses`` ((owned nodes, parts), kg); ``step``
+    (what the kernels noted of the stable steps) and ``explicit`` (the scene gave its
+    parts)."""
+
+    def _combine_steps(self) -> None:
+        """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index
+        among the owned cells) and place, the inverted cells."""
+        best = min(range(len(self.elements)), key=lambda k: self.elements[k].step[0])
+        self.controlling_part = best
+        step, mine = self.step, self.elements[best].step
+        step[:5] = mine[:5]
+        if mine[1] >= 0:
+            step[1] = self.parts[best].cells[int(mine[1])]
+        step[5], step[6], step[10], step[11] = 0.0, -1.0, 0.0, 0.0
+        for part, force in zip(self.parts, self.elements, strict=True):
+            if force.step[5] and not step[5]:
+                step[6] = part.cells[int(force.step[6])]
+                step[7:10] = force.step[7:10]
+            step[5] += force.step[5]
+            step[10] += force.step[10]
+            step[11] += force.step[11]
+
+    def _locate(self, cell: int) -> tuple[int, int]:
+        for k, part in enumerate(self.parts):
+            where = np.flatnonzero(part.cells == cell)
+            if len(where):
+                return k, int(where[0])
+        raise KeyError(cell)
+
+    def steps_at_rest(self) -> np.ndarray:
+        """Every owned cell's stable step estimate at rest (s), part after part."""
+        return np.concatenate([force.steps_at_rest() for force in self.elements])
+
+    @property
+    def plastic_work(self) -> float:
+        """Plastic dissipation (J) of this rank's cells so far."""
+        return sum(force.plastic_work for force in self.elements)
+
+    def plastic_strains(self) -> np.ndarray:
+        """The equivalent plastic strain of every integration point of the plastic parts."""
+        return np.concatenate(
+            [f.plastic_strains().ravel() for f in self.elements if f.plastic] or [np.zeros(0)]
+        )
+
+    def part_momenta(self, state) -> np.ndarray:
+        """(parts, 3): this rank's share of each part's momentum (kg m/s) at v^{n+1/2}, by
+        the parts' shares of the nodes' masses."""
+        return self.shares(state).T @ (state.mass[:, None] * state.v)
+
+    def shares(self, state) -> np.ndarray:
+        """(owned nodes, parts): each part's share of each node's mass."""
+        return self.part_masses / state.mass[:, None]
+
+    def part_kinetic(self, state) -> np.ndarray:
+        """Each part's share of the shadow kinetic energy K^n (J, this rank), after the
+        update of step n (v^{n-1/2} = v^{n+1/2} - dt^n a^n)."""
+        v_old = state.v - state.dt_velocity * state.a
+        per_node = 0.5 * state.mass * np.einsum("ij,ij->i", v_old, state.v)
+        return per_node @ self.shares(state)
+
+    def cell_fields(self, state) -> dict[str, np.ndarray]:
+        """Values per owned cell for the outputs: the parts' cell fields (zero on the cells
+        of parts without them; the plane stresses of a shell surface, (3, cells) in its
+        local frame, Pa, as ``<name>_xx``, ``_yy``, ``_xy``) and, for a body of parts,
+        ``"part"``, the part's index."""
+        owned = self.V.mesh.topology.index_map(self.V.mesh.topology.dim).size_local
+        fields: dict[str, np.ndarray] = {}
+        for part, force in zip(self.parts, self.elements, strict=True):
+            for name, values in force.cell_fields(state).items():
+                if values.ndim == 2:
+                    for component, row in zip(("xx", "yy", "xy"), values, strict=True):
+                        fields.setdefault(f"{name}_{component}", np.zeros(owned))[
+                            part.cells] = row  # fmt: skip
+                else:
+                    fields.setdefault(name, np.zeros(owned))[part.cells] = values
+        if self.explicit:
+            index = np.zeros(owned)
+            for k, part in enumerate(self.parts):
+                index[part.cells] = k
+            fields["part"] = index
+        return fields
+
+    def _element_states(self) -> dict[str, np.ndarray]:
+        """Each part's element force's checkpoint arrays, named ``part<k>_<name>``."""
+        arrays = {}
+        for k, force in enumerate(self.elements):
+            arrays |= {f"part{k}_{name}": a for name, a in force.checkpoint_state().items()}
+        return arrays
+
+    def _restore_elements(self, arrays: dict[str, np.ndarray]) -> None:
+        for k, force in enumerate(self.elements):
+            prefix = f"part{k}_"
+            mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
+            force.restore_state(mine)
+
+
+class Body(PartedBody):
     """The internal force of the body's ``parts`` (:class:`Part`) on the vector space ``V``,
     with the displacement and velocity fields ``u`` and ``v``: an effect that *sets*
     ``state.a``. ``explicit``: the scene gave its parts (the outputs report them).
@@ -282,24 +384,6 @@ class Body(ErodingBody):
             else:
                 self._done[k] += 0.5 * dt_v * second
 
-    def _combine_steps(self) -> None:
-        """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index
-        among the owned cells) and place, the inverted cells."""
-        best = min(range(len(self.elements)), key=lambda k: self.elements[k].step[0])
-        self.controlling_part = best
-        step, mine = self.step, self.elements[best].step
-        step[:5] = mine[:5]
-        if mine[1] >= 0:
-            step[1] = self.parts[best].cells[int(mine[1])]
-        step[5], step[6], step[10], step[11] = 0.0, -1.0, 0.0, 0.0
-        for part, force in zip(self.parts, self.elements, strict=True):
-            if force.step[5] and not step[5]:
-                step[6] = part.cells[int(force.step[6])]
-                step[7:10] = force.step[7:10]
-            step[5] += force.step[5]
-            step[10] += force.step[10]
-            step[11] += force.step[11]
-
     # --- parts that share nodes --------------------------------------------------------
 
     def _interfaces(self) -> np.ndarray:
@@ -405,48 +489,6 @@ class Body(ErodingBody):
         hourglass = ("hourglass",) if "hourglass" in force.energy_names else ()
         return ("kinetic", "internal", *hourglass, *(("plastic_work",) if force.plastic else ()))
 
-    def part_momenta(self, state) -> np.ndarray:
-        """(parts, 3): this rank's share of each part's momentum (kg m/s) at v^{n+1/2}, by
-        the parts' shares of the nodes' masses."""
-        return self.shares(state).T @ (state.mass[:, None] * state.v)
-
-    def shares(self, state) -> np.ndarray:
-        """(owned nodes, parts): each part's share of each node's mass."""
-        return self.part_masses / state.mass[:, None]
-
-    def part_kinetic(self, state) -> np.ndarray:
-        """Each part's share of the shadow kinetic energy K^n (J, this rank), after the
-        update of step n (v^{n-1/2} = v^{n+1/2} - dt^n a^n)."""
-        v_old = state.v - state.dt_velocity * state.a
-        per_node = 0.5 * state.mass * np.einsum("ij,ij->i", v_old, state.v)
-        return per_node @ self.shares(state)
-
-    def cell_fields(self, state) -> dict[str, np.ndarray]:
-        """Values per owned cell for the outputs: the parts' cell fields (zero on the cells
-        of parts without them) and, for a body of parts, ``"part"``, the part's index."""
-        owned = self.V.mesh.topology.index_map(self.V.mesh.topology.dim).size_local
-        fields: dict[str, np.ndarray] = {}
-        for part, force in zip(self.parts, self.elements, strict=True):
-            for name, values in force.cell_fields(state).items():
-                fields.setdefault(name, np.zeros(owned))[part.cells] = values
-        if self.explicit:
-            index = np.zeros(owned)
-            for k, part in enumerate(self.parts):
-                index[part.cells] = k
-            fields["part"] = index
-        return fields
-
-    def plastic_strains(self) -> np.ndarray:
-        """The equivalent plastic strain of every integration point of the plastic parts."""
-        return np.concatenate(
-            [f.plastic_strains().ravel() for f in self.elements if f.plastic] or [np.zeros(0)]
-        )
-
-    @property
-    def plastic_work(self) -> float:
-        """Plastic dissipation (J) of this rank's cells so far."""
-        return sum(force.plastic_work for force in self.elements)
-
     # --- the stable step, through the parts ---------------------------------------------
 
     @property
@@ -469,10 +511,6 @@ class Body(ErodingBody):
     def calibration(self) -> float:
         return self.elements[0].params.calibration
 
-    def steps_at_rest(self) -> np.ndarray:
-        """Every owned cell's stable step estimate at rest (s), part after part."""
-        return np.concatenate([force.steps_at_rest() for force in self.elements])
-
     def cell_position(self, cell: int) -> np.ndarray:
         """The centroid (m) of the owned ``cell`` (its local index) at X + u."""
         part, local = self._locate(cell)
@@ -483,13 +521,6 @@ class Body(ErodingBody):
         part, local = self._locate(cell)
         said = self.elements[part].describe_cell(local)
         return f"of part {self.parts[part].name}, {said}" if self.explicit else said
-
-    def _locate(self, cell: int) -> tuple[int, int]:
-        for k, part in enumerate(self.parts):
-            where = np.flatnonzero(part.cells == cell)
-            if len(where):
-                return k, int(where[0])
-        raise KeyError(cell)
 
     def forces(self, u: np.ndarray) -> np.ndarray:
         """Internal forces (N) on the owned nodes for a displacement ``u`` (owned, (n, 3)),
@@ -508,9 +539,7 @@ class Body(ErodingBody):
             arrays["part_masses"] = self.part_masses
         if self._interface_force is not None:
             arrays["interface_force"] = self._interface_force
-        for k, force in enumerate(self.elements):
-            arrays |= {f"part{k}_{name}": a for name, a in force.checkpoint_state().items()}
-        return arrays
+        return arrays | self._element_states()
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         count = len(self.elements)
@@ -523,15 +552,13 @@ class Body(ErodingBody):
             self.part_masses[:] = arrays["part_masses"]
         if self._interface_force is not None:
             self._interface_force[...] = arrays["interface_force"]
-        for k, force in enumerate(self.elements):
-            prefix = f"part{k}_"
-            mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
-            force.restore_state(mine)
+        self._restore_elements(arrays)
 
 
-def held_nodes(V, forces: list[ElementForce]) -> np.ndarray:
+def held_nodes(V, forces: list) -> np.ndarray:
     """(owned + ghost nodes, parts): how many cells of each part hold each node, on any
-    rank (collective)."""
+    rank (collective), from the parts' element forces ``forces`` (their ``cells``: rows of
+    node indices of their owned cells), solid or shell."""
     count = len(forces)
     held = la.vector(V.dofmap.index_map, count)
     rows = held.array.reshape(-1, count)

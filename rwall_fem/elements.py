@@ -34,12 +34,10 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.erosion import ErodedCells
-from rwall_fem.kernels import FAILURE, HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
+from rwall_fem.internal_force import InternalForce, set_failure, set_flow_stress
+from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
-
-# The flow-stress laws of the kernels (kernels/plasticity.h).
-HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
 
 CELLS = ("tetrahedron", "hexahedron")
 # Default hourglass coefficient of each form: 1 reproduces full integration (physical) for
@@ -148,7 +146,7 @@ class GhostedField:
             _compat.scatter_reverse_add(self._vector)
 
 
-class ElementForce:
+class ElementForce(InternalForce):
     """Internal force f_int(u) (N) of one material and element technology over some cells,
     cell by cell (a part of the body, :mod:`rwall_fem.body`; all the owned cells unless
     ``cells``, their local indices, is given).
@@ -227,14 +225,13 @@ class ElementForce:
         self.params.volume0 = ffi.cast("double *", self.volume0.ctypes.data)
         self.estimate_every_step = model != "linear_elastic"
         self.step = np.zeros(STEP_SLOTS)
-        self._estimated = False
         # stored elastic, hourglass, plastic dissipation, internal energy of eroded cells (J)
         self._energy = np.zeros(4)
         self.erosion: ErodedCells | None = None
         self._computed: np.ndarray | None = None  # the cells computed, when some are not
         if self.failure is not None:
             self._erode()
-        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
+        self._rebind()
         self._accelerate = None
 
     def deactivate(self, cells: np.ndarray) -> None:
@@ -248,7 +245,7 @@ class ElementForce:
         keep[cells] = False
         self._computed = np.flatnonzero(keep).astype(np.int32)
         self.params.live = self.ffi.cast("int32_t *", self._computed.ctypes.data)
-        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
+        self._rebind()
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -259,14 +256,6 @@ class ElementForce:
         if t.integration == "reduced" and t.hourglass != "none":
             names += ("hourglass",)
         return names + (("eroded_internal",) if self.erosion is not None else ())
-
-    @property
-    def energy_parts(self) -> tuple[str, ...]:
-        """Parts of the energies reported beside them but not added to the balance: the
-        elastic energy and plastic work of an elasto-plastic body, the kinetic energy of
-        detached nodes when cells can erode."""
-        parts = ("elastic", "plastic_work") if self.plastic else ()
-        return parts + (("eroded_kinetic",) if self.erosion is not None else ())
 
     def cell_sizes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The volume (m^3) and characteristic length (m) of every owned cell with its nodes
@@ -304,83 +293,16 @@ class ElementForce:
         self.params.calibration = min(1.0, ratio)
         return ratio
 
-    def list_cells_below(self, floor: float, factor: np.ndarray) -> None:
-        """From now on, scale each cell's step estimate by ``factor`` (per owned cell,
-        sqrt of its mass over its mass at rest), estimate it every step, and list the cells
-        whose scaled step is below ``floor`` (s) in :attr:`below` and :attr:`below_step`
-        (their steps before scaling), the first ``int(step[10])`` entries: mass scaling."""
-        self.estimate_every_step = True
-        self.below = np.zeros(self.num_cells, dtype=np.int32)
-        self.below_step = np.zeros(self.num_cells)
-        self._factor = factor
-        p, ffi = self.params, self.ffi
-        p.step_factor = ffi.cast("double *", factor.ctypes.data)
-        p.step_floor = floor
-        p.below = ffi.cast("int32_t *", self.below.ctypes.data)
-        p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
-
-    def erode_below(self, floor: float) -> None:
-        """From now on, erode the cells whose step estimate falls below ``floor`` (s), and
-        inverted ones (``run.dt_min_action = "erode"``; the estimates are made every step)."""
-        self.estimate_every_step = True
-        self.params.erode_step = floor
-        if self.erosion is None:
-            self._erode()
-            self._kernel = self._bind(
-                self.u.array, self.v.array, self.f.array, self._energy, self.step
-            )
-
-    def _erode(self) -> None:
-        """Let the kernels erode cells: room for the cells they list, the work of every cell
-        so far, the velocities an eroded cell needs to leave the energy books (collective)."""
-        self.erosion = e = ErodedCells(self.V, self.cells)
-        p, ffi = self.params, self.ffi
-        p.erode = 1
-        p.eroded = ffi.cast("int32_t *", e.listed.ctypes.data)
-        p.cell_work = ffi.cast("double *", e.work.ctypes.data)
-        p.cell_stride = self.num_cells
-        p.velocity = ffi.cast("double *", self.v.array.ctypes.data)
-
     def _set_plasticity(self, material) -> None:
         """The flow-stress law's constants, and the state per integration point: the stress
         (Pa), the equivalent plastic strain and the temperature (K) of each point, then the
         hourglass forces (N) of a one-point hexahedron, then with a failure criterion the
         damage of each point."""
-        p = self.params
-        law = material.hardening if material.model == "elastic_plastic" else "johnson_cook"
-        p.hardening = HARDENING[law]
-        p.yield_stress = material.yield_stress or 0.0
-        p.hardening_modulus = material.hardening_modulus or 0.0
-        p.hardening_coefficient = material.hardening_coefficient or 0.0
-        p.hardening_exponent = material.hardening_exponent or 0.0
-        p.rate_coefficient = material.strain_rate_coefficient
-        p.reference_rate = material.reference_strain_rate
-        p.max_flow_stress = material.max_flow_stress or 0.0  # 0: no cap
-        if material.hardening_curve is not None:
-            p.table_size = len(material.hardening_curve)
-            for i, (strain, stress) in enumerate(material.hardening_curve):
-                p.table_strain[i], p.table_stress[i] = strain, stress
-        heating = material.heating
-        room = 0.0
-        if heating is not None:
-            p.thermal = 1
-            p.thermal_exponent = heating.softening_exponent
-            p.melting_temperature = heating.melting_temperature
-            p.room_temperature = room = heating.room_temperature
-            p.specific_heat = heating.specific_heat
-            p.taylor_quinney = heating.taylor_quinney
+        room = set_flow_stress(self.params, material)
+        self.params.max_flow_stress = material.max_flow_stress or 0.0  # 0: no cap
         slots = self.points * POINT_SLOTS + (12 if self.technology.integration == "reduced" else 0)
-        failure = self.failure
-        if failure is not None:  # the damage of each point, after the other slots
-            p.failure = FAILURE[failure.criterion]
-            p.damage_slot = slots
-            if failure.criterion == "plastic_strain":
-                p.failure_strain = failure.plastic_strain
-            else:
-                constants = (failure.d1, failure.d2, failure.d3, failure.d4, failure.d5)
-                for i, value in enumerate(constants):
-                    p.damage_constants[i] = value
-                p.damage_reference_rate = failure.reference_strain_rate
+        if self.failure is not None:  # the damage of each point, after the other slots
+            set_failure(self.params, self.failure, slots)
             slots += self.points
         self.history = np.zeros((slots, self.num_cells))
         self.history[POINT_SLOTS - 1 : self.points * POINT_SLOTS : POINT_SLOTS] = room
@@ -414,37 +336,8 @@ class ElementForce:
             return functools.partial(kernel, *common, ptr(v), *rest)
         return functools.partial(getattr(self.lib, f"{family}_{model}"), *common, *rest)
 
-    @property
-    def stored_energy(self) -> float:
-        """Elastic energy (J) of this rank's cells at the latest force computation."""
-        return float(self._energy[0])
-
-    @property
-    def hourglass_energy(self) -> float:
-        """Hourglass energy (J) of this rank's cells: stored, or the hourglass work so far."""
-        return float(self._energy[1])
-
-    @property
-    def plastic_work(self) -> float:
-        """Plastic dissipation (J) of this rank's cells so far."""
-        return float(self._energy[2])
-
-    @property
-    def eroded_energy(self) -> float:
-        """Internal energy (J) the eroded cells of this rank took with them so far."""
-        return float(self._energy[3])
-
-    @property
-    def smallest_step(self) -> float:
-        """The smallest stable step estimate (s) of this rank's cells at the latest force
-        computation (scaled by the mass-scaling factors), inf if it has no cell."""
-        return float(self.step[0])
-
-    @property
-    def inverted_cells(self) -> int:
-        """How many owned cells were found inverted (a volume <= 0 at an integration point,
-        or at a corner of a hexahedron) by the latest force computation."""
-        return int(self.step[5])
+    def _rebind(self) -> None:
+        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
 
     def cell_position(self, cell: int) -> np.ndarray:
         """The centroid (m) of its ``cell`` (an index into its cells) at X + u."""
@@ -488,36 +381,9 @@ class ElementForce:
             fields["eroded"] = (~self.erosion.alive).astype(float)
         return fields
 
-    @property
-    def damage(self) -> np.ndarray:
-        """The damage D of every integration point (rows) of its cells (columns)."""
-        start = self.params.damage_slot
-        return self.history[start : start + self.points]
-
     def plastic_strains(self) -> np.ndarray:
         """The equivalent plastic strain of every integration point of the owned cells."""
         return self.history[POINT_SLOTS - 2 : self.points * POINT_SLOTS : POINT_SLOTS]
-
-    def compute(self, state) -> None:
-        """Add the internal force f_int(u^n) of its cells into :attr:`f` (owned and ghost
-        rows, before the reverse scatter); estimate the cells' stable steps and find the
-        inverted cells on the way (:attr:`step`). ``u`` (and ``v``) must be scattered
-        forward."""
-        # The step just taken, dt^{n-1/2}: the elasto-plastic increment u^n - u^{n-1} is
-        # dt^{n-1/2} v^{n-1/2} (0 at the first step: the state is the initial one).
-        self.params.dt = state.dt_previous
-        if self.conservative:
-            self._energy[1] = 0.0
-        self._energy[0] = 0.0
-        estimate = self.estimate_every_step or not self._estimated
-        self.params.estimate = estimate
-        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        if estimate:
-            self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
-            self._estimated = True
-        self._kernel()
-        if self.step[11]:
-            self._remove_eroded()
 
     def accelerate(self, state) -> None:
         """A force alone: set ``state.a = -f_int(u^n) / m`` on the owned nodes."""
@@ -536,18 +402,6 @@ class ElementForce:
                 self.ffi.cast("double *", state.a.ctypes.data),
             )
         self._accelerate()
-
-    def _remove_eroded(self) -> None:
-        """Compute the cells the latest pass eroded no more."""
-        e = self.erosion
-        e.remove(int(self.step[11]))
-        self.params.live = self.ffi.cast("int32_t *", e.live.ctypes.data)
-        self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
-
-    def detach_nodes(self) -> None:
-        """Count the live cells of the nodes again after a step in which some rank eroded
-        cells (collective)."""
-        self.erosion.detach()
 
     def forces(self, u: np.ndarray) -> np.ndarray:
         """Internal forces (N) on the owned nodes for a displacement ``u`` (owned, (n, 3)), in
@@ -588,36 +442,6 @@ class ElementForce:
         if not self.conservative:
             hourglass = 0.0
         return tuple(self.V.mesh.comm.allreduce(np.array([elastic, hourglass])))
-
-    def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The energies of the latest force computation (J: the viscous hourglass form and
-        the elasto-plastic kernels accumulate theirs), what it noted of the cells' steps,
-        the elasto-plastic state per integration point, and which cells have eroded."""
-        arrays = {"energy": self._energy, "step": self.step}
-        if self.plastic:
-            arrays["history"] = self.history
-        if self.erosion is not None:
-            arrays |= {f"erosion_{k}": v for k, v in self.erosion.checkpoint_state().items()}
-        return arrays
-
-    def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
-        self._energy[:] = arrays["energy"]
-        self.step[:] = arrays["step"]
-        self._estimated = True
-        if self.plastic:
-            self.history[...] = arrays["history"]
-        if self.erosion is not None:
-            e, prefix = self.erosion, "erosion_"
-            e.restore_state(
-                {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
-            )
-            live = (
-                self.ffi.NULL if e.live is None else self.ffi.cast("int32_t *", e.live.ctypes.data)
-            )
-            self.params.live = live
-            self._kernel = self._bind(
-                self.u.array, self.v.array, self.f.array, self._energy, self.step
-            )
 
 
 # Node permutations that turn a cell inside out: a mirror of its reference cell.

@@ -111,8 +111,8 @@ class _StepSize:
         self.records = StepRecords(self.comm)
         self.stop_reason: str | None = None
         self.limit = math.inf  # the smallest (calibrated) estimate at the latest step, s
-        self._local = np.zeros(4)
-        self._total = np.zeros(4)
+        self._local = np.zeros(5)
+        self._total = np.zeros(5)
         self._reductions = 0  # steps reduced so far: the cache key of controlling_cell
         self._cells: dict = {}  # what controlling_cell found at this step, by its key
         self.contacts = []  # contact interfaces: their nodal stable steps (s) bound the step
@@ -122,17 +122,18 @@ class _StepSize:
         of listed (mass-scaling) cells on a rank, from the latest kernel pass; after a pass
         that eroded cells on some rank, the nodes they held are counted again."""
         step = self.force.step
+        # Each contact interface's nodal step on this rank's nodes.
+        contact = min((c.dt_limit for c in self.contacts), default=math.inf)
         if self.comm.size == 1:
             smallest, inverted, listed, eroded = (float(step[0]), -float(step[5]),
                                                   -float(step[10]), -float(step[11]))  # fmt: skip
         else:
-            self._local[:] = (step[0], -step[5], -step[10], -step[11])
+            self._local[:] = (step[0], -step[5], -step[10], -step[11], contact)
             self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
-            smallest, inverted, listed, eroded = self._total.tolist()
-        if self.contacts:  # the same on every rank: no reduction
+            smallest, inverted, listed, eroded, contact = self._total.tolist()
+        if self.contacts:
             # A node held by cells and contact springs: 1/dt^2 adds up (conservatively,
             # with the smallest cell's step).
-            contact = min(c.dt_limit for c in self.contacts)
             if math.isfinite(contact):
                 smallest = 1.0 / math.sqrt(1.0 / smallest**2 + 1.0 / contact**2)
         self._reductions += 1

@@ -144,7 +144,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
         if spec.gap is None and half > 0.0:
-            interface.vary_gap(node_gap)
+            interface.vary_gap(node_gap, nodes)
         interface.start(state)
         left_out = {name: len(cut[name].segments) for name in parts
                     if name in cut and len(cut[name].segments)}  # fmt: skip
@@ -156,9 +156,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
             for name in parts:
-                ids = np.searchsorted(nodes, _total((name,)).nodes)
-                x = interface.x[ids]
-                extent = np.sort(x.max(axis=0) - x.min(axis=0))
+                extent = np.sort(interface.extent(_total((name,)).nodes))
                 # A flat sheet has no extent across: its width then
                 smallest = float(extent[1] if solid.shells else extent[0])
                 across, default = (("narrowest", "half the sum of the thicknesses")
@@ -190,9 +188,7 @@ def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray
         np.bitwise_or.at(on, rows[here], bits[here])
     count = sum((on >> c) & 1 for c in range(3))
     share = np.ascontiguousarray(0.5**count, dtype=np.float64)
-    interface.mirrored = (share, on)  # kept alive for the kernel's pointers
-    interface._params.share = interface.ffi.from_buffer("double[]", share)
-    interface._params.planes = interface.ffi.from_buffer("int8_t[]", on)
+    interface.mirror(share, on, nodes)
 
 
 def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:

@@ -21,8 +21,8 @@ runs only in the steps after some rank eroded cells (the eroded cells'
 update: a pass's secondary nodes are the nodes of its secondary side's faces (a node whose
 cells all eroded is on no face), its segments the main side's faces; the friction force of
 a node that stays secondary is kept. Its surface nodes are every node of the eroding
-parts, so that bared nodes are gathered too: the price of an interface with erosion is
-that every rank gathers those parts whole at every step.
+parts, so that bared nodes are among them (each rank still reads only the nodes near its
+own secondary nodes: :mod:`~rwall_fem.contact.interface`).
 
 The contact acts one step after the erosion (the step's kernel pass erodes; the ranks
 learn it when the step is chosen, after the contact forces): Radioss too updates its
@@ -181,6 +181,7 @@ class ErodingContact(ContactInterface):
     def __init__(self, name, nodes, surfaces: list[ErodingSurface],
                  passes: Callable[[], list[Pass]], **interface):  # fmt: skip
         self.surfaces, self._build = surfaces, passes
+        self._nodes = nodes
         super().__init__(name, nodes, passes(), **interface)
         self._seen = self._detachments()
         self.updates = 0  # the updates that changed a surface
@@ -196,18 +197,7 @@ class ErodingContact(ContactInterface):
                 s.rebuild()
         elif not any([s.update() for s in self.surfaces]):
             return
-        passes = self._build()
-        for old, new in zip(self.passes, passes, strict=True):
-            at = np.searchsorted(old.secondary, new.secondary)
-            at = np.minimum(at, max(len(old.secondary) - 1, 0))
-            kept = old.secondary[at] == new.secondary if len(old.secondary) else at < 0
-            new.tangential[kept] = old.tangential[at[kept]]
-            new.gaps[kept] = old.gaps[at[kept]]
-        self.passes = passes
-        self.reach = max([self.gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
-        self._params.reach = self.reach
-        self._passes = [self._pass_pointers(ps) for ps in passes]
-        self._sorted_at = None  # sort again at this step
+        self.use(self._build(), self._nodes)  # sorts again at this step
         self.updates += 1
 
     def accelerate(self, s) -> None:
@@ -219,28 +209,15 @@ class ErodingContact(ContactInterface):
         super().accelerate(s)
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The interface's, with each pass's friction forces and own gaps over all its
-        surface nodes (zero and inf off the secondary set), whose number erosion does not
-        change."""
-        arrays = super().checkpoint_state()
-        for k, ps in enumerate(self.passes):
-            every = np.zeros((self.size, 3))
-            every[ps.secondary] = ps.tangential
-            arrays[f"tangential{k}"] = every
-            gaps = np.full(self.size, np.inf)
-            gaps[ps.secondary] = ps.gaps
-            arrays[f"gaps{k}"] = gaps
-        return arrays | {"updates": np.array([self.updates])}
+        """The interface's (each pass's friction forces and own gaps per owned surface
+        node, whose number erosion does not change), and the updates so far."""
+        return super().checkpoint_state() | {"updates": np.array([self.updates])}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         """The surfaces of the cells alive at the checkpoint, then the interface's state."""
         self._follow(rebuild=True)
         self._seen = self._detachments()
         self.updates = int(arrays["updates"][0])
-        arrays = dict(arrays)
-        for k, ps in enumerate(self.passes):
-            arrays[f"tangential{k}"] = arrays[f"tangential{k}"][ps.secondary]
-            arrays[f"gaps{k}"] = arrays[f"gaps{k}"][ps.secondary]
         super().restore_state(arrays)
 
     def summary(self) -> dict:

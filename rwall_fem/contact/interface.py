@@ -2,19 +2,29 @@
 /INTER/TYPE7; ``docs/theory.md``, "Contact between parts").
 
 :class:`ContactInterface` is a force of the step, after the internal force and before the
-step size is chosen (its stiffness enters the stable step). Each step it
+step size is chosen (its stiffness enters the stable step). Each rank treats the secondary
+nodes it owns, against the segments that can reach them; each step it
 
-1. gathers the positions x^n, velocities v^{n-1/2} and masses of the interface's surface
-   nodes from every rank (one ``Allgatherv``), in the order of their global numbers;
-2. sorts the secondary nodes' candidate segments again (buckets, ``kernels/contact.c``)
-   when some node moved more than half the margin since the last sort;
+1. reads x^n, v^{n-1/2} and the masses of the surface nodes it owns from the state, and
+   those of its ghosts (the other ranks' nodes of the segments near its secondary nodes)
+   from their owners (:class:`~rwall_fem.contact.exchange.Ghosts`, one ``Alltoallv``
+   between neighbours);
+2. sorts again when some surface node moved more than half the margin since the last sort
+   (one ``Allreduce`` of the largest move): every rank sends the segments it owns (those
+   of its lowest-numbered node) whose box, widened by the reach and the margin, meets the
+   box of another rank's secondary nodes to that rank, and lists its ghosts again; then it
+   sorts its secondary nodes' candidate segments (buckets, ``kernels/contact.c``);
 3. runs its passes (secondary nodes against main segments; two, each side against the
-   other, by default) in compiled code, on every rank alike: each rank then adds the forces
-   of its own nodes to a^n. The global numbers depend on the partition, and so does the
-   element forces' round-off: the forces agree to round-off on any number of ranks since
-   they are continuous in the nodal state (``docs/theory.md``, "MPI" of the contact); the
-   price is that every rank treats the whole contact surface (fine up to some 10^5 surface
-   nodes; a partitioned search is for later).
+   other, by default) in compiled code over its own secondary nodes, adds the forces on
+   its own nodes to a^n, and sends those on its ghosts back to their owners, who add them
+   (the same ``Alltoallv`` the other way).
+
+A rank thus holds and exchanges its share of the surface: its secondary nodes, the
+segments near them and their nodes. The segments are ordered by their place in the whole
+surface, so that each node's candidates come in the same order on any number of ranks: a
+node's force from its segments is the same to the bit; the sums of the forces on a segment
+node from several ranks, and the books, agree to round-off (``docs/theory.md``, "MPI" of
+the contact).
 
 Books (J), like every force's, at mid-step velocities: the work W of the contact forces,
 1/2 f^n . (v^{n-1/2} + v^{n+1/2}) dt^n summed over the steps, is split into the work that
@@ -25,7 +35,8 @@ potential at step n, ``penalty_energy`` (k0 g^2 ((1 - x) ln(1 - x) + x) summed, 
 plus ``|f_t|^2 / 2 k0``): the two differ by the error of a penalty spring integrated by
 central differences, at most about k0 (w dt)^2 / 2 per node that comes into or out of
 contact at a normal speed w within a step (the spring is switched on or off between two
-steps), and they agree again once the bodies have separated.
+steps), and they agree again once the bodies have separated. Each rank books its own
+secondary nodes' share; the rows and the summary sum them over the ranks.
 """
 
 from __future__ import annotations
@@ -34,7 +45,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from mpi4py import MPI
 
+from rwall_fem.contact.exchange import Ghosts, Owners, send_rows
 from rwall_fem.kernels import load
 
 __all__ = ["CONTACT_COLUMNS", "ContactInterface", "Pass"]
@@ -52,9 +65,10 @@ CONTACT_COLUMNS = (
 
 @dataclass
 class Pass:
-    """Secondary nodes (indices into the interface's surface nodes) against segments
-    (rows of 4 indices, -1 as the 4th of a triangle) with their stiffness k0 (N/m) and
-    depth (m); ``exclude``: a node is kept off its own segments' neighbours (self-contact).
+    """Secondary nodes (indices into the interface's surface nodes, or a rank's local
+    nodes) against segments (rows of 4 indices, -1 as the 4th of a triangle) with their
+    stiffness k0 (N/m) and depth (m); ``exclude``: a node is kept off its own segments'
+    neighbours (self-contact).
     """
 
     secondary: np.ndarray
@@ -83,48 +97,61 @@ class Pass:
         self.out = np.zeros(11)
 
 
+@dataclass
+class _Share:
+    """This rank's share of a pass, kept from sort to sort: its secondary nodes (global
+    numbers, sorted) with their friction force (N) and own gap (m), and the segments it
+    owns (global numbers), with their places in the whole pass, stiffness and depth."""
+
+    secondary: np.ndarray
+    tangential: np.ndarray
+    gaps: np.ndarray
+    segments: np.ndarray
+    places: np.ndarray
+    stiffness: np.ndarray
+    depth: np.ndarray
+    exclude: bool
+
+
 class ContactInterface:
     """The contact ``name`` (``contact[i]``) over the surface nodes ``nodes`` (global
-    numbers, sorted) with its ``passes``; ``gap`` (m), Coulomb's ``friction`` and the
-    filter's ``alpha``; ``margin`` (m) is how far nodes may move between sorts (half of it
-    each). ``owned_global`` are the global numbers of this rank's owned nodes, whose rows
-    ``state`` holds."""
+    numbers, sorted) with its ``passes`` (the whole surface's, the same on every rank: the
+    rank keeps its share); ``gap`` (m), Coulomb's ``friction`` and the filter's ``alpha``;
+    ``margin`` (m) is how far nodes may move between sorts (half of it each).
+    ``owned_global`` are the global numbers of this rank's owned nodes (a contiguous
+    range), whose rows ``state`` holds. :attr:`passes` are this rank's passes as of the
+    latest sort, over its local nodes (its owned surface nodes, then its ghosts)."""
 
     def __init__(self, name, nodes, passes, *, gap, friction, alpha, margin, state, comm,
                  owned_global, damping=0.05):  # fmt: skip
-        self.name, self.passes, self.comm, self.state = name, passes, comm, state
+        self.name, self.comm, self.state = name, comm, state
         self.gap, self.friction, self.alpha, self.margin = gap, friction, alpha, margin
         self.ffi, self.lib = load()
-        n = len(nodes)
-        self.size, self.nodes = n, nodes
-        position = np.searchsorted(nodes, owned_global)
-        position = np.minimum(position, max(n - 1, 0))
-        hit = (nodes[position] == owned_global) if n else np.zeros(len(owned_global), bool)
-        self.mine = np.flatnonzero(hit)  # owned rows of the state on the surface
-        self.where = position[self.mine]  # their surface indices
-        pieces = comm.allgather(self.where)
-        self.counts = np.array([len(p) for p in pieces])
-        self.order = np.concatenate(pieces) if pieces else np.zeros(0, np.int64)
-        self._send = np.zeros((len(self.mine), 7))
-        self._receive = np.zeros((n, 7))
-        self.x, self.v, self.mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
-        self.force = np.zeros((n, 3))
-        self.stiffness = np.zeros(n)
-        self._sorted_at = None  # positions of the latest sort
+        self.owners = Owners(comm, np.asarray(owned_global, dtype=np.int64))
+        self.size = len(nodes)  # surface nodes, over all ranks
+        self.ids = np.ascontiguousarray(nodes[self.owners.mine(nodes)], dtype=np.int64)
+        self.n = len(self.ids)  # the rank's owned surface nodes: the first local nodes
+        self.mine = self.ids - self.owners.start  # their rows of the state
+        self.where = np.arange(self.n, dtype=np.int64)  # their local indices
+        self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed)
+        self._sorted_at = None  # positions of the owned surface nodes at the latest sort
         self._params = self.ffi.new("contact_params *")
         self._params.gap, self._params.cap = gap, CAP
         self._params.friction, self._params.alpha = friction, alpha
         self._params.damping = damping
-        # The segments within this distance of a node compete for it, whatever their own
-        # depth, so that the closest (the best aligned) decides; the sort finds them all.
-        self.reach = max([gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
-        self._params.reach = self.reach
         self.damping = damping
-        self.dt_limit = math.inf  # the nodal stable step of the latest pass, s
+        self.half_thickness = None  # m per owned surface node (vary_gap)
+        self.mirrored = None  # the owned surface nodes' shares and planes (mirror)
+        self.dt_limit = math.inf  # the nodal stable step of the latest pass on this rank, s
         self.sorts = 0
-        # The books: stored energies of the latest pass, the friction's dissipation and the
-        # impulses so far (J, J, N s), the latest force on the secondary side and normal
-        # force sum (N), and the contacts of the latest pass.
+        self.sent = 0  # bytes this rank sent for the search (sorts); the ghosts count theirs
+        self._ghosts = Ghosts(self.owners, np.zeros(0, dtype=np.int64), self.ids)
+        self._box_ghosts = self._ghosts
+        self._ghost_bytes = 0  # what earlier ghost lists sent
+        # The books, of this rank's secondary nodes: stored energies of the latest pass,
+        # the friction's dissipation and the impulses so far (J, J, N s), the latest force
+        # on the secondary side and normal force sum (N), and the contacts of the latest
+        # pass.
         self.energy, self.dissipated = 0.0, 0.0
         self.impulse = np.zeros(3)
         self.latest = np.zeros(3)
@@ -132,29 +159,69 @@ class ContactInterface:
         # The work of the forces on this rank's nodes over the finished steps (J); the
         # latest pass's force on them (N) and f . v^{n-1/2} (W), and dt^{n-1/2} (s).
         self.work = 0.0
-        self._owned_force = np.zeros((len(self.mine), 3))
+        self._owned_force = np.zeros((self.n, 3))
         self._first = 0.0
         self._pending = False
         self._previous_dt = 0.0
-        # Pointers for the compiled passes (the state's arrays never move).
         p = self._pointer
-        self.mine, self.where = self.mine.astype(np.int64), self.where.astype(np.int64)
-        self.order = self.order.astype(np.int64)
         self._state = [p(x) for x in (state.X, state.u, state.v, state.mass, state.a)]
-        self._rows = (p(self.mine, "int64_t[]"), p(self.where, "int64_t[]"),
-                      p(self.order, "int64_t[]"))  # fmt: skip
-        self._surface = [p(x) for x in (self.x, self.v, self.mass, self.force, self.stiffness,
-                                        self._send, self._receive, self._owned_force)]  # fmt: skip
-        self._passes = [self._pass_pointers(ps) for ps in passes]
+        self._rows = (p(self.mine, "int64_t[]"), p(self.where, "int64_t[]"))
+        self.shares: list[_Share] = []
+        self.use(passes, nodes)
+        self._local(np.zeros(0, dtype=np.int64))
         self.gap_max = gap  # the largest pair gap (vary_gap)
         self.starting_inside = (0, 0, 0.0)  # nodes within the gap at the start, of them
         # behind the surface, and the deepest initial penetration (m)
 
+    def use(self, passes: list[Pass], nodes: np.ndarray) -> None:
+        """Take this rank's share of ``passes`` (the whole surface's, over the surface
+        nodes ``nodes``, global numbers), keeping the friction force and own gap of each
+        secondary node it had; the next step sorts again (collective)."""
+        old = dict(enumerate(self.shares))
+        self.shares = shares = [self._share(ps, nodes, old.get(k)) for k, ps in enumerate(passes)]
+        # The interface-wide figures (the same on every rank).
+        self.segments_total = sum(len(ps.segments) for ps in passes)
+        k0 = np.concatenate([ps.stiffness for ps in passes])
+        self.k0_range = (float(k0.min(initial=np.inf)), float(k0.max(initial=0.0)))
+        self.shell_half = max(-float(ps.depth.min(initial=0.0)) for ps in passes)
+        # The segments within this distance of a node compete for it, whatever their own
+        # depth, so that the closest (the best aligned) decides; the sort finds them all.
+        self.reach = max([self.gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
+        if self.half_thickness is not None:
+            self.reach = max(self.reach, self.gap_max)
+        self._params.reach = self.reach
+        # The other ranks' nodes of the segments this rank owns: their boxes at a sort.
+        ids = np.concatenate([sh.segments.ravel() for sh in shares])
+        ids = np.unique(ids[ids >= 0])
+        self.sent += self._box_ghosts.sent
+        self._box_ghosts = Ghosts(self.owners, ids[~self.owners.mine(ids)], self.ids)
+        self._sorted_at = None
+
+    def _share(self, ps: Pass, nodes: np.ndarray, old: _Share | None) -> _Share:
+        """This rank's share of pass ``ps`` over the surface nodes ``nodes``; the friction
+        state of the nodes ``old`` had."""
+        owners = self.owners
+        secondary = nodes[ps.secondary]
+        mine = owners.mine(secondary)
+        secondary = np.ascontiguousarray(secondary[mine], dtype=np.int64)
+        tangential, gaps = np.zeros((len(secondary), 3)), np.full(len(secondary), np.inf)
+        if old is not None and len(old.secondary) and len(secondary):
+            at = np.minimum(np.searchsorted(old.secondary, secondary), len(old.secondary) - 1)
+            kept = old.secondary[at] == secondary
+            tangential[kept] = old.tangential[at[kept]]
+            gaps[kept] = old.gaps[at[kept]]
+        segments = np.where(ps.segments >= 0, nodes[np.maximum(ps.segments, 0)], -1)
+        lowest = np.where(segments >= 0, segments, np.iinfo(np.int64).max).min(axis=1)
+        owned = owners.mine(lowest)
+        return _Share(secondary, tangential, gaps, segments[owned].astype(np.int64),
+                      np.flatnonzero(owned).astype(np.int64), ps.stiffness[owned].copy(),
+                      ps.depth[owned].copy(), ps.exclude)  # fmt: skip
+
     def start(self, s) -> None:
         """The gaps of the nodes that start inside the gap (Radioss TYPE7 Inacti = 6,
         ``kernels/contact.c``): each such node's gap is 0.95 of its distance, and grows
-        back as it moves away; from the state ``s`` at the start."""
-        self._gather(s)
+        back as it moves away; from the state ``s`` at the start (collective)."""
+        self._read(s)
         self._sort()
         out = np.zeros(3)
         inside, behind, deepest = 0, 0, 0.0
@@ -167,19 +234,39 @@ class ContactInterface:
             )  # fmt: skip
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
-        self.starting_inside = (inside, behind, deepest)
+        inside, behind = self.comm.allreduce(np.array([inside, behind]))
+        deepest = self.comm.allreduce(deepest, op=MPI.MAX)
+        self.starting_inside = (int(inside), int(behind), deepest)
 
-    def vary_gap(self, half_thickness: np.ndarray) -> None:
+    def vary_gap(self, half_thickness: np.ndarray, nodes: np.ndarray) -> None:
         """A variable gap (Radioss Igap 1): node s against a segment gets the larger of
         :attr:`gap` (the floor) and ``half_thickness[s]`` plus the segment's half thickness
         (a shell's: -depth; 0 for a solid's face); ``half_thickness`` (m) per surface node
-        (half its thickest shell)."""
-        self.half_thickness = np.ascontiguousarray(half_thickness, dtype=np.float64)
-        self._params.half_thickness = self._pointer(self.half_thickness)
-        shells = [-ps.depth.min(initial=0.0) for ps in self.passes]
-        self.gap_max = max(self.gap, float(self.half_thickness.max(initial=0.0)) + max(shells))
+        ``nodes`` (half its thickest shell; the rank keeps its owned nodes')."""
+        self.half_thickness = np.ascontiguousarray(
+            half_thickness[np.searchsorted(nodes, self.ids)], dtype=np.float64)
+        self.gap_max = max(self.gap, float(half_thickness.max(initial=0.0)) + self.shell_half)
         self.reach = max(self.reach, self.gap_max)
         self._params.reach = self.reach
+        self._sorted_at = None
+
+    def mirror(self, share: np.ndarray, planes: np.ndarray, nodes: np.ndarray) -> None:
+        """A model cut by symmetry planes (``kernels/contact.c``, mirror): per surface node
+        ``nodes``, the share of the whole node it holds and the bits of its planes; the rank
+        keeps its owned nodes' and reads its ghosts' shares at each sort."""
+        rows = np.searchsorted(nodes, self.ids)
+        self.mirrored = (np.ascontiguousarray(share[rows], dtype=np.float64),
+                         np.ascontiguousarray(planes[rows], dtype=np.int8))  # fmt: skip
+        self._sorted_at = None
+
+    def extent(self, ids: np.ndarray) -> np.ndarray:
+        """The extent (m, per axis) of the surface nodes ``ids`` (global numbers) now, from
+        every rank (collective)."""
+        x = self.x[: self.n][np.isin(self.ids, ids)]
+        low, high = x.min(axis=0, initial=np.inf), -x.max(axis=0, initial=-np.inf)
+        self.comm.Allreduce(MPI.IN_PLACE, low, op=MPI.MIN)
+        self.comm.Allreduce(MPI.IN_PLACE, high, op=MPI.MIN)
+        return -high - low
 
     def _pointer(self, array, kind="double[]"):
         return self.ffi.from_buffer(kind, array)
@@ -195,22 +282,114 @@ class ContactInterface:
             stiffness, p(ps.out),
         )  # fmt: skip
 
-    def _gather(self, s) -> None:
-        """x^n, v^{n-1/2} and masses of the surface nodes, from every rank."""
+    def _read(self, s) -> None:
+        """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state."""
         X, u, v, mass, _ = self._state
-        mine, _, order = self._rows
-        send, receive = self._surface[5:7]
-        self.lib.contact_pack(len(self.mine), mine, X, u, v, mass, send)
-        if self.comm.size > 1:
-            self.comm.Allgatherv(self._send, [self._receive, self.counts * 7])
-            send = receive
-        x, v, mass = self._surface[:3]
-        self.lib.contact_unpack(self.size, order, send, x, v, mass)
+        self.lib.contact_pack(self.n, self._rows[0], X, u, v, mass, self._packed)
+        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
+
+    def _read_ghosts(self) -> None:
+        """x^n, v^{n-1/2} and masses of the ghosts, from their owners."""
+        g = len(self._ghosts.ids)
+        self._ghosts.forward(self._table[: self.n], self._table[self.n :])
+        self.lib.contact_unpack(g, self._pointer(self._ghost_rows, "int64_t[]"),
+                                self._pointer(self._table[self.n :]), *self._surface[:3])  # fmt: skip
+
+    def _local(self, ghosts: np.ndarray) -> None:
+        """The local nodes: the owned surface nodes, then ``ghosts`` (global numbers,
+        sorted); new arrays for their values."""
+        self._ghost_bytes += self._ghosts.sent
+        self._ghosts = Ghosts(self.owners, ghosts, self.ids)
+        n = self.n + len(ghosts)
+        table = np.zeros((n, 7))
+        table[: self.n] = self._table[: self.n]
+        self._table = table
+        self._packed = self._pointer(self._table)
+        self._ghost_rows = np.arange(self.n, n, dtype=np.int64)
+        self.x, self.v, self.mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
+        self.force, self.stiffness = np.zeros((n, 3)), np.zeros(n)
+        self._surface = [self._pointer(a) for a in (self.x, self.v, self.mass, self.force,
+                                                    self.stiffness, self._owned_force)]  # fmt: skip
+        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
+        self._local_half = np.zeros(n)
+        if self.half_thickness is not None:
+            self._local_half[: self.n] = self.half_thickness
+            self._params.half_thickness = self._pointer(self._local_half)
+        if self.mirrored is not None:
+            share, planes = self.mirrored
+            self._local_share, self._local_planes = np.ones(n), np.zeros(n, dtype=np.int8)
+            self._local_share[: self.n], self._local_planes[: self.n] = share, planes
+            self._ghosts.forward(share.reshape(-1, 1), self._local_share[self.n :].reshape(-1, 1))
+            self._params.share = self._pointer(self._local_share)
+            self._params.planes = self._pointer(self._local_planes, "int8_t[]")
+
+    def _to_local(self, ids: np.ndarray) -> np.ndarray:
+        """Local indices of global numbers ``ids`` (owned surface nodes or ghosts; -1
+        stays -1)."""
+        owned = self.owners.mine(ids)
+        ghosts = self._ghosts.ids
+        at = np.where(owned, np.searchsorted(self.ids, ids),
+                      self.n + np.searchsorted(ghosts, ids))  # fmt: skip
+        return np.where(ids >= 0, at, -1).astype(np.int64)
+
+    def _boxes(self) -> tuple[np.ndarray, np.ndarray]:
+        """The boxes (m, low and high corners per rank) of every rank's secondary nodes now
+        (collective)."""
+        rows = np.concatenate([np.searchsorted(self.ids, sh.secondary) for sh in self.shares])
+        x = self.x[rows]
+        box = np.concatenate([x.min(axis=0, initial=np.inf), x.max(axis=0, initial=-np.inf)])
+        boxes = np.zeros((self.comm.size, 6))
+        self.comm.Allgather(box, boxes)
+        self.sent += box.nbytes * (self.comm.size - 1)
+        return boxes[:, :3], boxes[:, 3:]
 
     def _sort(self) -> None:
+        """Share the segments near each rank's secondary nodes, list the ghosts, and sort
+        the candidates of the rank's secondary nodes (collective)."""
+        # The positions of the nodes of the segments this rank owns.
+        box = self._box_ghosts
+        known = np.zeros((len(box.ids), 7))
+        box.forward(self._table[: self.n], known)
+        ids = np.concatenate([self.ids, box.ids])
+        order = np.argsort(ids)
+        x = np.concatenate([self.x[: self.n], known[:, :3]])
+        low, high = self._boxes()
+        widen = self.reach + self.margin
+        rows = []
+        for k, sh in enumerate(self.shares):
+            corners = np.where(sh.segments >= 0, sh.segments, sh.segments[:, :1])
+            corners = x[order[np.searchsorted(ids, corners, sorter=order)]]  # (m, 4, 3)
+            a, b = corners.min(axis=1) - widen, corners.max(axis=1) + widen
+            near = np.all((a[:, None, :] <= high[None]) & (b[:, None, :] >= low[None]), axis=2)
+            seg, rank = np.nonzero(near)
+            ints = np.column_stack([np.full(len(seg), k), sh.places[seg], sh.segments[seg]])
+            rows.append((np.column_stack([np.ascontiguousarray(ints, dtype=np.int64)
+                                          .view(np.float64), sh.stiffness[seg],
+                                          sh.depth[seg]]), rank))  # fmt: skip
+        records = np.concatenate([r for r, _ in rows]) if rows else np.zeros((0, 8))
+        ranks = np.concatenate([r for _, r in rows]).astype(np.int64) if rows else np.zeros(0, int)
+        received = send_rows(self.comm, records.reshape(-1, 8), ranks)
+        self.sent += 8 * 8 * int(np.count_nonzero(ranks != self.comm.rank))
+        ints = np.ascontiguousarray(received[:, :6]).view(np.int64)
+        # Every node of the segments near this rank's secondary nodes: those of other ranks
+        # are its ghosts.
+        nodes = ints[:, 2:].ravel()
+        nodes = np.unique(nodes[nodes >= 0])
+        self._local(nodes[~self.owners.mine(nodes)])
+        self._read_ghosts()
+        passes = []
+        for k, sh in enumerate(self.shares):
+            here = np.flatnonzero(ints[:, 0] == k)
+            here = here[np.argsort(ints[here, 1])]  # in their order in the whole pass
+            ps = Pass(np.searchsorted(self.ids, sh.secondary).astype(np.int64),
+                      self._to_local(ints[here, 2:]), received[here, 6].copy(),
+                      received[here, 7].copy(), sh.exclude)  # fmt: skip
+            ps.tangential, ps.gaps = sh.tangential, sh.gaps
+            passes.append(ps)
+        self.passes = passes
         lib, p = self.lib, self._pointer
-        for ps in self.passes:
-            reach = np.full(len(ps.segments), self.reach + self.margin)
+        for ps in passes:
+            reach = np.full(len(ps.segments), widen)
             while True:
                 work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
                 count = lib.contact_sort(
@@ -223,10 +402,19 @@ class ContactInterface:
                 if count <= len(ps.candidates):
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
-        self._passes = [self._pass_pointers(ps) for ps in self.passes]
-        self._sorted_at = self.x.copy()
+        self._passes = [self._pass_pointers(ps) for ps in passes]
+        self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
+
+    def _moved(self) -> bool:
+        """Whether some surface node moved more than half the margin since the latest sort
+        (collective)."""
+        moved = self.lib.contact_moved(self.n, self._surface[0], self._sorted_pointer)
+        if self.comm.size > 1:
+            moved = self.comm.allreduce(moved if moved == moved else math.inf, op=MPI.MAX)
+            self.sent += 8
+        return not moved <= (0.5 * self.margin) ** 2
 
     def _pending_books(self, dt_v: float, v: np.ndarray) -> tuple[np.ndarray, float]:
         """The impulse (N s, on the secondary side) and the work on this rank's nodes (J)
@@ -234,7 +422,7 @@ class ContactInterface:
         if not self._pending:
             return np.zeros(3), 0.0
         v = self._pointer(v)
-        second = self.lib.contact_power(len(self.mine), self._rows[0], self._surface[7], v)
+        second = self.lib.contact_power(self.n, self._rows[0], self._surface[5], v)
         return dt_v * self.latest, 0.5 * dt_v * (self._first + second)
 
     def _book_pending(self, dt_v: float, v: np.ndarray) -> None:
@@ -249,13 +437,11 @@ class ContactInterface:
             previous = self._previous_dt
             dt_v = s.dt_previous if previous == 0.0 else 0.5 * (previous + s.dt_previous)
             self._book_pending(dt_v, s.v)
-        self._gather(s)
-        if self._sorted_at is None:
+        self._read(s)
+        if self._sorted_at is None or self._moved():
             self._sort()
         else:
-            moved = self.lib.contact_moved(self.size, self._surface[0], self._sorted_pointer)
-            if not moved <= (0.5 * self.margin) ** 2:
-                self._sort()
+            self._read_ghosts()
         self.force[:] = 0.0
         self._params.dt = s.dt_previous
         lib = self.lib
@@ -270,12 +456,19 @@ class ContactInterface:
             tangential += out[8]
             dissipated += out[9]
             normal += out[10]
+        n = self.n
+        if self.comm.size > 1:
+            # The forces and stiffness on the ghosts, to their owners.
+            back = self._ghosts.reverse(np.column_stack([self.force[n:], self.stiffness[n:]]))
+            np.add.at(self.force, self._ghosts.rows, back[:, :3])
+            np.add.at(self.stiffness, self._ghosts.rows, back[:, 3])
+            self.stiffness[n:] = 0.0
         x, v, mass, force, stiffness = self._surface[:5]
-        self.dt_limit = lib.contact_step(self.size, mass, stiffness)
+        self.dt_limit = lib.contact_step(n, mass, stiffness)
         _, _, state_v, state_mass, a = self._state
-        mine, where, _ = self._rows
-        self._first = lib.contact_apply(len(self.mine), mine, where, force, state_mass, state_v,
-                                        a, self._surface[7])  # fmt: skip
+        mine, where = self._rows
+        self._first = lib.contact_apply(n, mine, where, force, state_mass, state_v, a,
+                                        self._surface[5])  # fmt: skip
         self.energy = energy + tangential
         self.dissipated += dissipated
         self.latest, self.normal_force, self.contacts = latest, normal, contacts
@@ -286,33 +479,44 @@ class ContactInterface:
         """What the latest pass added to the accelerations: the state rows of this rank's
         owned surface nodes, the force on each (N, rows of 3), and the segments of every
         pass (rows of 4 global node numbers, -1 as the 4th of a triangle; the same on every
-        rank), for the outputs (:mod:`rwall_fem.output.contact_loads`)."""
-        segments = [np.where(ps.segments >= 0, self.nodes[np.maximum(ps.segments, 0)], -1)
-                    for ps in self.passes]  # fmt: skip
-        return self.mine, self._owned_force, np.concatenate(segments).reshape(-1, 4)
+        rank: each rank's own, gathered), for the outputs
+        (:mod:`rwall_fem.output.contact_loads`; collective)."""
+        mine = np.concatenate([sh.segments for sh in self.shares]).reshape(-1, 4)
+        segments = np.concatenate(self.comm.allgather(mine)).reshape(-1, 4)
+        return self.mine, self._owned_force, segments
 
     def energies(self) -> dict[str, float]:
         """This rank's share of the books (J) after the update of step n: -W - D on its
-        nodes (W up to the first half of step n, as the kinetic energy K^n has it), D on
-        rank 0 (every rank computes it all)."""
+        nodes (W up to the first half of step n, as the kinetic energy K^n has it), D of
+        its secondary nodes."""
         # As K^n = 1/2 m v^{n-1/2} . v^{n+1/2} books it: of step n, the first half only.
         work = 0.5 * self.state.dt_velocity * self._first if self._pending else 0.0
-        dissipated = self.dissipated if self.comm.rank == 0 else 0.0
         return {
-            "contact_energy": -(self.work + work) - dissipated,
-            "contact_friction": dissipated,
+            "contact_energy": -(self.work + work) - self.dissipated,
+            "contact_friction": self.dissipated,
         }
+
+    def _totals(self) -> dict:
+        """The books summed over the ranks (collective): the latest force on the secondary
+        side, the normal force, the contacts, the stored energy, the dissipation and the
+        impulse so far (with the latest step's)."""
+        impulse = self.impulse + self._pending_books(self.state.dt_velocity, self.state.v)[0]
+        local = np.array([*self.latest, self.normal_force, self.contacts, self.energy,
+                          self.dissipated, *impulse])  # fmt: skip
+        total = self.comm.allreduce(local) if self.comm.size > 1 else local
+        return {"latest": total[:3], "normal": float(total[3]), "contacts": int(total[4]),
+                "energy": float(total[5]), "dissipated": float(total[6]),
+                "impulse": total[7:]}  # fmt: skip
 
     def row(self, t: float, index: int, energy: float) -> tuple:
         """The row of ``contacts.csv`` at time t (s) after the update of the latest step,
-        whose booked contact energy (J, summed over the ranks) is ``energy``."""
-        impulse, _ = self._pending_books(self.state.dt_velocity, self.state.v)
-        return (t, index, *self.latest.tolist(), *(self.impulse + impulse).tolist(),
-                self.normal_force, self.contacts, energy, self.dissipated, self.energy)  # fmt: skip
+        whose booked contact energy (J, summed over the ranks) is ``energy`` (collective)."""
+        b = self._totals()
+        return (t, index, *b["latest"].tolist(), *b["impulse"].tolist(), b["normal"],
+                b["contacts"], energy, b["dissipated"], b["energy"])  # fmt: skip
 
     def describe(self) -> str:
         """One line for ``run.log``: the surface, the gap, the stiffness and the friction."""
-        k0 = np.concatenate([ps.stiffness for ps in self.passes])
         inside, behind, deepest = self.starting_inside
         start = (
             f"; {inside} node(s) start inside the gap (the deepest {deepest:.3g} m in, "
@@ -321,42 +525,53 @@ class ContactInterface:
             if inside else ""
         )  # fmt: skip
         return (
-            f"{self.name}: {len(self.passes)} pass(es), {self.size} surface nodes, "
-            f"{sum(len(ps.segments) for ps in self.passes)} segments; gap {self.gap:.4g} m, "
-            f"k0 {k0.min(initial=np.inf):.4g} to {k0.max(initial=0.0):.4g} N/m, damping "
+            f"{self.name}: {len(self.shares)} pass(es), {self.size} surface nodes, "
+            f"{self.segments_total} segments; gap {self.gap:.4g} m, "
+            f"k0 {self.k0_range[0]:.4g} to {self.k0_range[1]:.4g} N/m, damping "
             f"{self.damping:g}, friction {self.friction:g}{start}"
         )
 
     def summary(self) -> dict:
-        """What ``summary.json`` says of the interface (the same on every rank)."""
-        impulse = self.impulse + self._pending_books(self.state.dt_velocity, self.state.v)[0]
+        """What ``summary.json`` says of the interface (the same on every rank; collective):
+        ``exchanged_bytes`` is what the ranks sent each other for it over the run."""
+        b = self._totals()
+        sent = self.sent + self._ghost_bytes + self._ghosts.sent + self._box_ghosts.sent
         return {
             "name": self.name,
             "surface_nodes": self.size,
-            "segments": sum(len(ps.segments) for ps in self.passes),
-            "passes": len(self.passes),
+            "segments": self.segments_total,
+            "passes": len(self.shares),
             "gap": self.gap,
             "friction": self.friction,
             "sorts": self.sorts,
-            "impulse": impulse.tolist(),
-            "penalty_energy": self.energy,
-            "contact_friction": self.dissipated,
+            "impulse": b["impulse"].tolist(),
+            "penalty_energy": b["energy"],
+            "contact_friction": b["dissipated"],
+            "exchanged_bytes": int(self.comm.allreduce(sent)) if self.comm.size > 1 else 0,
         }
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The friction forces of each pass, the books, and the impulse of the latest step
-        (booked now: its velocity step is known after the update)."""
+        """The friction force and own gap of each pass's secondary nodes, per owned surface
+        node (0 and inf off the secondary set: their number does not change when erosion
+        changes the passes), the books, and the impulse of the latest step (booked now: its
+        velocity step is known after the update)."""
         self._book_pending(self.state.dt_velocity, self.state.v)
-        arrays = {f"tangential{k}": ps.tangential for k, ps in enumerate(self.passes)}
-        arrays |= {f"gaps{k}": ps.gaps for k, ps in enumerate(self.passes)}
+        arrays = {}
+        for k, sh in enumerate(self.shares):
+            rows = np.searchsorted(self.ids, sh.secondary)
+            arrays[f"tangential{k}"] = np.zeros((self.n, 3))
+            arrays[f"tangential{k}"][rows] = sh.tangential
+            arrays[f"gaps{k}"] = np.full(self.n, np.inf)
+            arrays[f"gaps{k}"][rows] = sh.gaps
         books = [self.dissipated, *self.impulse, *self.latest, self.normal_force,
                  self.contacts, self.energy, self.work]  # fmt: skip
         return arrays | {"books": np.array(books)}
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
-        for k, ps in enumerate(self.passes):
-            ps.tangential[:] = arrays[f"tangential{k}"]
-            ps.gaps[:] = arrays[f"gaps{k}"]
+        for k, sh in enumerate(self.shares):
+            rows = np.searchsorted(self.ids, sh.secondary)
+            sh.tangential[:] = arrays[f"tangential{k}"][rows]
+            sh.gaps[:] = arrays[f"gaps{k}"][rows]
         books = arrays["books"].tolist()
         self.dissipated = books[0]
         self.impulse[:] = books[1:4]

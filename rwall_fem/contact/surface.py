@@ -26,8 +26,8 @@ holds it), so nothing can come at it from outside, and a node of another body cu
 same plane, sliding in that plane, would be taken as a whole gap inside it.
 
 Every rank gets every segment of the interface, in global node numbers, sorted by their
-nodes: every rank of a run computes the contact alike (:mod:`rwall_fem.contact.interface`;
-the global numbers, hence the order, depend on the partition).
+nodes (the same on every rank); the interface keeps each rank's share of them
+(:mod:`rwall_fem.contact.interface`).
 """
 
 from __future__ import annotations

@@ -4,7 +4,9 @@ The C sources beside this file (one per element family, with the formulas in
 their header comments; ``update.c``, ``wall.c`` and ``contact.c`` for the per-node passes
 of a step, the update, the rigid walls and the contact interfaces, which share the
 friction law of ``friction.h``) are compiled into one extension module the first time a
-process needs them, the way FFCx compiles forms, and cached per user under
+process needs them, the way FFCx compiles forms (the shells' kernels into a second one,
+an :class:`Extension` of :mod:`rwall_fem.shells.elements`, by the same :func:`load`), and
+cached per user under
 ``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
 ``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
 compiler flags, the Python and cffi versions and the processor's instruction
@@ -36,6 +38,7 @@ import re
 import shutil
 import sys
 import tempfile
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
@@ -45,6 +48,9 @@ __all__ = [
     "MODELS",
     "POINT_SLOTS",
     "STEP_SLOTS",
+    "ELEMENTS",
+    "ELEMENT_PARAMS",
+    "Extension",
     "KernelBuildError",
     "compiler_error",
     "load",
@@ -67,9 +73,8 @@ STEP_SLOTS = 12  # what a kernel notes of the element steps, inverted and eroded
 FAILURE = {"plastic_strain": 1, "johnson_cook": 2}  # the failure criteria (failure.h)
 HOURGLASS = ("none", "physical", "stiffness", "viscous")
 
-_CDEF = (
-    """
-typedef struct {
+# The constants and arrays every element kernel reads (the shells' too).
+ELEMENT_PARAMS = """typedef struct {
   double lmbda, mu, density, wave_speed, hourglass_coefficient, dt;
   int hardening;
   double yield_stress, hardening_modulus, hardening_coefficient, hardening_exponent;
@@ -99,8 +104,10 @@ typedef struct {
   double *cell_work;
   int64_t cell_stride;
   const double *velocity;
-} element_params;
-double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
+} element_params;"""
+_CDEF = (
+    f"\n{ELEMENT_PARAMS}\n"
+    + """double plastic_point(const element_params *p, double sigma[6], double *eps_p, double *T,
                      const double dL[9]);
 void tet4_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
                   const double *v, const element_params *p, double *state, int64_t stride,
@@ -193,6 +200,23 @@ double contact_power(int64_t n, const int64_t *rows, const double *kept, const d
 )
 
 
+@dataclass(frozen=True)
+class Extension:
+    """C sources of this folder compiled together into one cffi extension module: its
+    ``name`` (before the cache key), its ``sources`` (the headers it includes, then the
+    ``.c`` files: all of them make the cache key), the declarations ``cdef`` that Python
+    calls, and ``what`` it is, in words (for the line of a failed compile)."""
+
+    name: str
+    sources: tuple[str, ...]
+    cdef: str
+    what: str
+
+
+ELEMENTS = Extension("_rwall_kernels", SOURCES, _CDEF, "the element kernels")
+_UNWRITABLE: set[Path] = set()  # cache folders found unwritable (warned of once)
+
+
 class KernelBuildError(RuntimeError):
     """The C compiler could not build compiled code (the element kernels, DOLFINx's forms);
     the message is one line."""
@@ -215,14 +239,14 @@ def _cpu() -> str:
     return f"{platform.machine()} {flags}"
 
 
-def _key(flags: list[str]) -> str:
+def _key(extension: Extension, flags: list[str]) -> str:
     import cffi
 
     digest = hashlib.sha256()
     here = Path(__file__).parent
-    for name in SOURCES:
+    for name in extension.sources:
         digest.update((here / name).read_bytes())
-    for part in (_CDEF, " ".join(flags), sys.version, cffi.__version__, _cpu()):
+    for part in (extension.cdef, " ".join(flags), sys.version, cffi.__version__, _cpu()):
         digest.update(part.encode())
     return digest.hexdigest()[:16]
 
@@ -264,25 +288,28 @@ def _writable(folder: Path) -> Path:
     return Path(tempfile.mkdtemp(prefix=".build-", dir=folder))
 
 
-def _build(name: str, flags: list[str], folder: Path) -> tuple[Path, Path | None]:
-    """Compile the kernels as extension module ``name`` and publish the library in
-    ``folder`` under its digest (one atomic rename: a concurrent process sees all of it
-    or nothing). Returns its path, and the private temporary folder to remove once it is
-    loaded when ``folder`` cannot be written."""
+def _build(extension: Extension, name: str, flags: list[str], folder: Path
+           ) -> tuple[Path, Path | None]:  # fmt: skip
+    """Compile ``extension`` as module ``name`` and publish the library in ``folder`` under
+    its digest (one atomic rename: a concurrent process sees all of it or nothing). Returns
+    its path, and the private temporary folder to remove once it is loaded when ``folder``
+    cannot be written."""
     private = None
     try:
         work = _writable(folder)
     except OSError as err:
-        log.warning(
-            "the kernel cache %s cannot be written (%s): the kernels are compiled for this "
-            "process only (set RWALL_FEM_CACHE to a folder it can write)",
-            folder,
-            err.strerror,
-        )
+        if folder not in _UNWRITABLE:  # one warning a process, for all its extensions
+            _UNWRITABLE.add(folder)
+            log.warning(
+                "the kernel cache %s cannot be written (%s): the kernels are compiled for "
+                "this process only (set RWALL_FEM_CACHE to a folder it can write)",
+                folder,
+                err.strerror,
+            )
         private = folder = Path(tempfile.mkdtemp(prefix="rwall_fem_kernels_"))
         work = _writable(folder)
     try:
-        built = _compile(name, flags, work)
+        built = _compile(extension, name, flags, work)
         final = folder / f"{name}.{_digest(built)}.so"
         os.replace(built, final)
     except BaseException:
@@ -294,14 +321,14 @@ def _build(name: str, flags: list[str], folder: Path) -> tuple[Path, Path | None
     return final, private
 
 
-def _compile(name: str, flags: list[str], work: Path) -> Path:
-    """Compile the kernels as extension module ``name`` in the folder ``work``."""
+def _compile(extension: Extension, name: str, flags: list[str], work: Path) -> Path:
+    """Compile ``extension`` as module ``name`` in the folder ``work``."""
     import cffi
 
     ffi = cffi.FFI()
-    ffi.cdef(_CDEF)
+    ffi.cdef(extension.cdef)
     here = Path(__file__).parent
-    source = "".join(f'#include "{n}"\n' for n in SOURCES if n.endswith(".c"))
+    source = "".join(f'#include "{n}"\n' for n in extension.sources if n.endswith(".c"))
     ffi.set_source(name, source, include_dirs=[str(here)], extra_compile_args=flags)
     # setuptools reports each compiler command on stdout: keep it out of the run's output.
     with contextlib.redirect_stdout(io.StringIO()):
@@ -318,17 +345,18 @@ def compiler_error(what: str, detail: str) -> KernelBuildError:
 
 
 @cache
-def load():
-    """The compiled kernels ``(ffi, lib)``: the cached library if it passes its check, else
-    built (a few seconds) and cached; without a cache that can be written, built for this
-    process alone. :class:`KernelBuildError` (one line) when no flag set compiles."""
+def load(extension: Extension = ELEMENTS):
+    """The compiled ``extension`` (the solids' element kernels and the per-node passes by
+    default) as ``(ffi, lib)``: the cached library if it passes its check, else built (a
+    few seconds) and cached; without a cache that can be written, built for this process
+    alone. :class:`KernelBuildError` (one line) when no flag set compiles."""
     failures = []
     for flags in FLAG_SETS:
-        name = f"_rwall_kernels_{_key(flags)}"
+        name = f"{extension.name}_{_key(extension, flags)}"
         path, private = _cached(name, _cache_dir()), None
         try:
             if path is None:
-                path, private = _build(name, flags, _cache_dir())
+                path, private = _build(extension, name, flags, _cache_dir())
         except Exception as err:  # the compiler's failure, whatever setuptools wraps it in
             lines = str(err).strip().splitlines() or [type(err).__name__]
             failures.append(f"{' '.join(flags[:2])}: {lines[-1]}")
@@ -339,4 +367,4 @@ def load():
             if private is not None:  # the loaded library stays mapped
                 shutil.rmtree(private, ignore_errors=True)
         return module.ffi, module.lib
-    raise compiler_error("the element kernels", "; ".join(failures))
+    raise compiler_error(extension.what, "; ".join(failures))

@@ -1,6 +1,7 @@
 /* Node-to-surface penalty contact (Radioss /INTER/TYPE7; rwall_fem/contact/, docs/theory.md,
- * "Contact between parts").  All arrays index the interface's surface nodes (the nodes of
- * its segments and its secondary nodes, gathered from every rank), rows of 3 for vectors.
+ * "Contact between parts").  All arrays index a rank's local nodes of the interface (its
+ * owned surface nodes, then the other ranks' nodes of the segments near its secondary
+ * nodes), rows of 3 for vectors.
  * A segment is 4 node indices: a quadrilateral, or a triangle whose 4th is -1.
  *
  * contact_moved: the largest squared distance a node moved since the last sort.

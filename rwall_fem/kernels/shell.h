@@ -52,6 +52,8 @@ typedef struct
   int drill_slot;          /* the state's first row of the 4 nodal drilling moments */
   double *new_thickness;   /* Radioss's Ithick = 1: the thicknesses to update (the array
                               `thickness` points to); NULL: constant */
+  int qeph_step;           /* quadrilaterals, 1: QEPH's characteristic length (Ishell 24) */
+  double qeph_dn;          /* its numerical damping dn: the length times sqrt(1 + dn^2) - dn */
 } shell_params;
 
 /* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one

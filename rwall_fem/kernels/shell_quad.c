@@ -67,7 +67,8 @@
  * energy[0] += stored elastic energy (J), energy[1] += hourglass dissipation of the step,
  * energy[2] += plastic dissipation of the step, energy[3] as failure.h.  The cell's stable
  * step is L_c / c with Radioss's L_c = max(A / longest diagonal, shortest side or diagonal)
- * in the current configuration (times p->calibration), noted in `step` (step.h).
+ * in the current configuration (times p->calibration), noted in `step` (step.h); with
+ * s->qeph_step, QEPH's L_c instead (quad_length_qeph).
  */
 #include "shell.h"
 
@@ -368,9 +369,36 @@ INLINE void quad_drill_forces(const quad_frame_t *g, const vec mz[4], vec *restr
   }
 }
 
-/* Radioss's characteristic length (m) of the cells of frame g. */
-INLINE vec quad_length(const quad_frame_t *g)
+/* QEPH's characteristic length (m) of the cells of frame g (OpenRadioss's czcorc.F,
+ * CZCORC1, for Ishell 24), times sqrt(1 + dn^2) - dn of its numerical damping dn (cndt3.F):
+ * L_c = A / (F (5/4 + h) max(|x13|^2, |x24|^2))^(1/2), with x13, x24 the half diagonals,
+ * F = 2 (1 + min(1/2, (max(C1, C2) / min(C1, C2) - 1) / 4)) (0.78 + 0.22 f^3),
+ * f = 3.413 max(0, 4 A / (C1 C2) - 0.7071), C1, C2 the lengths of x1 + x2 - x0 - x3 and
+ * x2 + x3 - x0 - x1 (twice the mid-side vectors), h = max(|x1 x x3|, |x0 x x2|) / A about the
+ * centroid (0 on a parallelogram): 0.894 of a square's side. */
+INLINE vec quad_length_qeph(const quad_frame_t *g, double dn)
 {
+  const vec *X = g->x, *Y = g->y, A = g->area;
+  const vec x13 = 0.5 * (X[0] - X[2]), y13 = 0.5 * (Y[0] - Y[2]);
+  const vec x24 = 0.5 * (X[1] - X[3]), y24 = 0.5 * (Y[1] - Y[3]);
+  const vec diagonal = vmax(x13 * x13 + y13 * y13, x24 * x24 + y24 * y24);
+  const vec h = vmax(vabs(X[1] * Y[3] - Y[1] * X[3]), vabs(X[0] * Y[2] - Y[0] * X[2])) / A;
+  const vec rx = X[1] + X[2] - X[0] - X[3], ry = Y[1] + Y[2] - Y[0] - Y[3];
+  const vec sx = X[2] + X[3] - X[0] - X[1], sy = Y[2] + Y[3] - Y[0] - Y[1];
+  const vec c1 = vsqrt(rx * rx + ry * ry), c2 = vsqrt(sx * sx + sy * sy);
+  const vec aspect = 1.0 + vmin(VZERO + 0.5, 0.25 * (vmax(c1, c2) / vmin(c1, c2) - 1.0));
+  const vec f = 3.413 * vmax(VZERO, 4.0 * A / (c1 * c2) - 0.7071);
+  const vec shape = 2.0 * aspect * (0.78 + 0.22 * f * f * f);
+  const double damping = sqrt(1.0 + dn * dn) - dn;
+  return (damping * A) / vmax(vsqrt(shape * (1.25 + h) * diagonal), VZERO + 1e-300);
+}
+
+/* Radioss's characteristic length (m) of the cells of frame g: CDLEN3's for its
+ * Belytschko-Tsay shells, or QEPH's with s->qeph_step. */
+INLINE vec quad_length(const shell_params *s, const quad_frame_t *g)
+{
+  if (s->qeph_step)
+    return quad_length_qeph(g, s->qeph_dn);
   vec l2[6];
   static const int PAIRS[6][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {0, 2}, {1, 3}};
   for (int e = 0; e < 6; ++e)
@@ -452,7 +480,7 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     const ivec inverted = ~(g.area > 0.0);
     vec dte = VZERO + INFINITY;
     if (p->estimate)
-      dte = (p->calibration / s->bar_speed) * quad_length(&g);
+      dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
     const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
                                       &hourglass, du, fe, 8, energy, step);
     stored_total += lane_sum(vselect(failed, VZERO, elastic), b.nb);
@@ -488,9 +516,10 @@ void shell_quad_plastic(int64_t n, const int32_t *cells, const double *X, const 
   shell_quad(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
-/* The projected area (m^2) and characteristic length (m) of each quadrilateral at x. */
-void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
-                      double *length)
+/* The projected area (m^2) and characteristic length (m) of each quadrilateral at x (the
+ * length as s's rule). */
+void shell_quad_sizes(const shell_params *s, int64_t n, const int32_t *cells, const double *x,
+                      double *area, double *length)
 {
   vec xe[12];
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
@@ -499,7 +528,7 @@ void shell_quad_sizes(int64_t n, const int32_t *cells, const double *x, double *
     shell_gather(cells, 4, &b, x, xe);
     quad_frame_t g;
     quad_frame(xe, &g);
-    const vec l = quad_length(&g);
+    const vec l = quad_length(s, &g);
     for (int k = 0; k < b.nb; ++k)
     {
       area[k0 + k] = g.area[k];

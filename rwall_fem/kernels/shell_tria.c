@@ -246,9 +246,10 @@ void shell_tria_plastic(int64_t n, const int32_t *cells, const double *X, const 
   shell_tria(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
-/* The area (m^2) and characteristic length (m) of each triangle at x. */
-void shell_tria_sizes(int64_t n, const int32_t *cells, const double *x, double *area,
-                      double *length)
+/* The area (m^2) and characteristic length (m) of each triangle at x (s: unused, as for
+ * the quadrilaterals' rules). */
+void shell_tria_sizes(const shell_params *s, int64_t n, const int32_t *cells, const double *x,
+                      double *area, double *length)
 {
   vec xe[9] = {VZERO};
   for (int64_t k0 = 0; k0 < n; k0 += LANES)

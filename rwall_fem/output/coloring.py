@@ -124,8 +124,9 @@ def coloring(
         stored = sorted(k.removeprefix("cell_") for k in frames[0] if k.startswith("cell_"))
         if color not in stored:
             fields = f"its cell fields: {', '.join(stored)}" if stored else "no cell fields"
+            nodal = [c for c in COLORS if c != "contact_pressure" or c in frames[0]]
             raise ValueError(
-                f"color {color!r}: not a field of this body; choose one of {', '.join(COLORS)} "
+                f"color {color!r}: not a field of this body; choose one of {', '.join(nodal)} "
                 f"({fields})"
             )
         values = [f[f"cell_{color}"] for f in frames]

@@ -854,9 +854,9 @@ _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 SURFACE_CELLS = ("quadrilateral", "triangle")
 SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor",
               "failed_share", "thickness_change", "hourglass_stiffness",
-              "drilling_stiffness")  # fmt: skip
+              "drilling_stiffness", "step_length")  # fmt: skip
 # The shells' [element] keys of the quadrilateral's kernel only (shell_quad.c).
-QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness")
+QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length")
 SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
@@ -953,6 +953,16 @@ class Element:
         "slow or static problems on twisted meshes; at most 0.1, so that they never set "
         "the step)",
         default_doc="0 (no drilling stiffness; Radioss's Idrill = 1 reads as 0.01)",
+    )
+    step_length: str | None = key(
+        Choice(("bt", "qeph")),
+        None,
+        doc="quadrilateral shells: the characteristic length of the stable step L_c / c. bt: "
+        "Radioss's for its Belytschko-Tsay shells, max(A / longest diagonal, shortest side "
+        "or diagonal); qeph: QEPH's (Ishell 24), from the half diagonals and the cell's "
+        "shape (0.894 of a square's side), times sqrt(1 + dn^2) - dn of its numerical "
+        "damping dn = 0.015",
+        default_doc="bt (Radioss's Ishell 24 and 12 read as qeph)",
     )
 
 
@@ -1642,7 +1652,7 @@ def _element_fits_shells_or_solids(v, raw, fail):
     """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor, ...)
     for surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
     volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles;
-    hourglass_stiffness and drilling_stiffness on quadrilaterals only. (For a
+    hourglass_stiffness, drilling_stiffness and step_length on quadrilaterals only. (For a
     mesh file the cells are known when the body is built.)"""
     mesh = v["mesh"]
     if mesh is None or mesh.shape is None:

@@ -29,10 +29,11 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.elements import GhostedField
-from rwall_fem.erosion import ErodedParts, ErodingBody
+from rwall_fem.body import PartedBody, held_nodes
+from rwall_fem.erosion import ErodedParts
 from rwall_fem.kernels import STEP_SLOTS, load
 
-__all__ = ["FORMULATIONS", "ShellBody", "ShellPart", "ShellSection"]
+__all__ = ["FORMULATIONS", "ShellBody", "ShellSection"]
 
 
 # The scene's names of the shell formulations.
@@ -69,30 +70,19 @@ class ShellSection:
                  if t.hourglass_stiffness > 0.0 else "")  # fmt: skip
         extra += (f", drilling springs {t.drilling_stiffness:g} G t A"
                   if t.drilling_stiffness > 0.0 else "")  # fmt: skip
+        extra += ", QEPH's step length" if t.step_length == "qeph" else ""
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
                 f"{self.thickness:g} m{change}{share}{extra}")  # fmt: skip
 
 
-@dataclass
-class ShellPart:
-    """A part of a shell body: its ``name``, the local indices of its owned ``cells``, its
-    ``material``, its :class:`ShellSection` ``technology`` and initial ``velocity``
-    (m/s)."""
-
-    name: str
-    cells: np.ndarray
-    material: object
-    technology: ShellSection
-    velocity: tuple[float, float, float]
-
-
-class ShellBody(ErodingBody):
-    """The internal force and moments of the shell ``parts`` (:class:`ShellPart`) on the
-    vector space ``V``, with the displacement and velocity fields ``u`` and ``v`` (m, m/s)
-    of the state; ``inertia`` (owned nodes, 2) holds the nodes' masses (kg) and
-    rotational inertias (kg m^2). ``force_class`` is the shell element force (one per part;
-    ``ShellForce(V, material, technology, u, v, w, thickness=, cells=, f=, m=)``, filling
-    nodal forces ``f`` (N) and moments ``m`` (N m)). ``explicit``: the scene gave its parts.
+class ShellBody(PartedBody):
+    """The internal force and moments of the shell ``parts`` (:class:`~rwall_fem.body.Part`,
+    each with its :class:`ShellSection`) on the vector space ``V``, with the displacement
+    and velocity fields ``u`` and ``v`` (m, m/s) of the state; ``inertia`` (owned nodes, 2)
+    holds the nodes' masses (kg) and rotational inertias (kg m^2). ``force_class`` is the
+    shell element force (one per part; ``ShellForce(V, material, technology, u, v, w,
+    thickness=, cells=, f=, m=)``, filling nodal forces ``f`` (N) and moments ``m``
+    (N m)). ``explicit``: the scene gave its parts.
     """
 
     conservative = False  # the kernels' stresses follow a path (rate form)
@@ -126,7 +116,7 @@ class ShellBody(ErodingBody):
         owned = V.mesh.topology.index_map(V.mesh.topology.dim).size_local
         self._alone = len(parts) == 1 and len(parts[0].cells) == owned
         self.step = self.elements[0].step if self._alone else np.zeros(STEP_SLOTS)
-        self.held = _held(V, parts)
+        self.held = held_nodes(V, self.elements)
         self.part_masses = None  # (owned nodes, parts), kg: set by the builder
         self.rotational_kinetic = 0.0  # the rotations' K^n of the latest update, J
         self.rotational_sums = (0.0, 0.0)  # sum M . w^{n-1/2}, sum M . w^{n+1/2}, W
@@ -218,24 +208,6 @@ class ShellBody(ErodingBody):
         self._free[np.ix_(nodes, columns)] = 0.0
         self.w.owned[np.ix_(nodes, columns)] = 0.0
 
-    def _combine_steps(self) -> None:
-        """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index
-        among the owned cells) and place, the inverted cells."""
-        best = min(range(len(self.elements)), key=lambda k: self.elements[k].step[0])
-        self.controlling_part = best
-        step, mine = self.step, self.elements[best].step
-        step[:5] = mine[:5]
-        if mine[1] >= 0:
-            step[1] = self.parts[best].cells[int(mine[1])]
-        step[5], step[6], step[10], step[11] = 0.0, -1.0, 0.0, 0.0
-        for part, force in zip(self.parts, self.elements, strict=True):
-            if force.step[5] and not step[5]:
-                step[6] = part.cells[int(force.step[6])]
-                step[7:10] = force.step[7:10]
-            step[5] += force.step[5]
-            step[10] += force.step[10]
-            step[11] += force.step[11]
-
     def book(self, state, first: float, second: float) -> None:
         """After the update of step n: book the work of the forces and moments at mid-step
         velocities, dt^n/2 (first + second), from sum f . v^{n-1/2} + M . w^{n-1/2}
@@ -279,9 +251,7 @@ class ShellBody(ErodingBody):
 
     def part_values(self, state) -> np.ndarray:
         """This rank's values (J) of :meth:`part_columns` at step n."""
-        v_old = state.v - state.dt_velocity * state.a
-        per_node = 0.5 * state.mass * np.einsum("ij,ij->i", v_old, state.v)
-        kinetic = per_node @ (self.part_masses / state.mass[:, None])
+        kinetic = self.part_kinetic(state)
         return np.array(
             [
                 value
@@ -291,46 +261,8 @@ class ShellBody(ErodingBody):
             ]
         )
 
-    def part_momenta(self, state) -> np.ndarray:
-        """(parts, 3): this rank's share of each part's momentum (kg m/s) at v^{n+1/2}, by
-        the parts' shares of the nodes' masses."""
-        return (self.part_masses / state.mass[:, None]).T @ (state.mass[:, None] * state.v)
-
-    def plastic_strains(self) -> np.ndarray:
-        """The equivalent plastic strain of every point of the elasto-plastic parts."""
-        return np.concatenate(
-            [f.kernel.plastic_strains().ravel() for f in self.elements if f.plastic]
-            or [np.zeros(0)]
-        )
-
-    @property
-    def plastic_work(self) -> float:
-        """Plastic dissipation (J) of this rank's cells so far."""
-        return sum(force.plastic_work for force in self.elements)
-
     def step_change_work(self) -> float:
         return 0.0
-
-    def cell_fields(self, state) -> dict[str, np.ndarray]:
-        """Values per owned cell for the outputs: the parts' cell fields (the plane stresses
-        of a surface as ``<name>_xx``, ``_yy``, ``_xy``) and, for a body of parts,
-        ``"part"``, the part's index."""
-        owned = self.V.mesh.topology.index_map(self.V.mesh.topology.dim).size_local
-        fields: dict[str, np.ndarray] = {}
-        for part, force in zip(self.parts, self.elements, strict=True):
-            for name, values in force.cell_fields(state).items():
-                if values.ndim == 2:  # the plane stresses of a surface, local frame: Pa
-                    for component, row in zip(("xx", "yy", "xy"), values, strict=True):
-                        fields.setdefault(f"{name}_{component}", np.zeros(owned))[
-                            part.cells] = row  # fmt: skip
-                else:
-                    fields.setdefault(name, np.zeros(owned))[part.cells] = values
-        if self.explicit:
-            index = np.zeros(owned)
-            for k, part in enumerate(self.parts):
-                index[part.cells] = k
-            fields["part"] = index
-        return fields
 
     # --- the stable step ---------------------------------------------------------------
 
@@ -346,10 +278,6 @@ class ShellBody(ErodingBody):
 
     calibration = 1.0
 
-    def steps_at_rest(self) -> np.ndarray:
-        """Every owned cell's stable step estimate at rest (s), part after part."""
-        return np.concatenate([force.steps_at_rest() for force in self.elements])
-
     def cell_position(self, cell: int) -> np.ndarray:
         """The centroid (m) of the owned ``cell`` (its local index) at X + u."""
         nodes = self._nodes[cell]
@@ -359,13 +287,6 @@ class ShellBody(ErodingBody):
         """The owned ``cell``'s part in words."""
         part, _ = self._locate(cell)
         return f"of part {self.parts[part].name}" if self.explicit else "a shell"
-
-    def _locate(self, cell: int) -> tuple[int, int]:
-        for k, part in enumerate(self.parts):
-            where = np.flatnonzero(part.cells == cell)
-            if len(where):
-                return k, int(where[0])
-        raise KeyError(cell)
 
     # --- checkpoints -------------------------------------------------------------------
 
@@ -378,9 +299,7 @@ class ShellBody(ErodingBody):
             "inertia": self.inertia,
             "books": np.array([self._done, self._latest, self.rotational_kinetic]),
         }
-        for k, force in enumerate(self.elements):
-            arrays |= {f"part{k}_{name}": a for name, a in force.checkpoint_state().items()}
-        return arrays
+        return arrays | self._element_states()
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
         self.w.owned[:] = arrays["w"]
@@ -388,10 +307,7 @@ class ShellBody(ErodingBody):
             self.inertia[...] = arrays["inertia"]
             self.inv_inertia[:] = 1.0 / self.inertia[:, 1]
         self._done, self._latest, self.rotational_kinetic = arrays["books"].tolist()
-        for k, force in enumerate(self.elements):
-            prefix = f"part{k}_"
-            mine = {n.removeprefix(prefix): a for n, a in arrays.items() if n.startswith(prefix)}
-            force.restore_state(mine)
+        self._restore_elements(arrays)
 
 
 def _cap(material) -> float:
@@ -399,18 +315,3 @@ def _cap(material) -> float:
     cap = getattr(material, "max_flow_stress", None)
     return math.inf if cap is None else cap
 
-
-def _held(V, parts) -> np.ndarray:
-    """(owned + ghost nodes, parts): how many cells of each part hold each node, on any
-    rank (collective)."""
-    from dolfinx import la
-
-    count = len(parts)
-    held = la.vector(V.dofmap.index_map, count)
-    rows = held.array.reshape(-1, count)
-    nodes = np.asarray(_compat.cell_nodes(V))
-    for k, part in enumerate(parts):
-        np.add.at(rows[:, k], nodes[part.cells].ravel(), 1.0)
-    _compat.scatter_reverse_add(held)
-    held.scatter_forward()
-    return rows.copy()

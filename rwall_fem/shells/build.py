@@ -18,7 +18,7 @@ from rwall_fem.body import PartError, parts_of
 from rwall_fem.elements import GhostedField
 from rwall_fem.scene import SceneError
 from rwall_fem.scene.schema import SHELL_KEYS, element_fits_the_surface
-from rwall_fem.shells.body import ShellBody, ShellPart, ShellSection
+from rwall_fem.shells.body import ShellBody, ShellSection
 from rwall_fem.shells.inertia import lumped_inertia
 
 __all__ = ["shell_solid", "solid_keys_on_shells"]
@@ -76,6 +76,7 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             shear_factor=element.shear_factor or SHEAR_FACTOR,
             hourglass_stiffness=element.hourglass_stiffness or 0.0,
             drilling_stiffness=element.drilling_stiffness or 0.0,
+            step_length=element.step_length or "bt",
         )
     except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
         said = str(err)
@@ -110,10 +111,9 @@ def shell_solid(scene, comm: MPI.Comm, body):
     specs = scene.body_parts
     sections = [_section(scene, i, spec, cell) for i, spec in enumerate(specs)]
     try:
-        found = parts_of(specs, body, sections, comm)
+        parts = parts_of(specs, body, sections, comm)
     except PartError as err:
         raise SceneError(f"{scene.source}: {err}") from None
-    parts = [ShellPart(p.name, p.cells, p.material, p.technology, p.velocity) for p in found]
     V = _compat.vector_space(body.msh)
     nodes = np.asarray(_compat.cell_nodes(V))
     if scene.mesh is not None and scene.mesh.noise is not None:

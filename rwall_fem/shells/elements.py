@@ -6,9 +6,9 @@ with the Belytschko-Wong-Chiang warping correction by rigid-body projection unle
 formulation is plain ``"bt"``), ``shell_tria.c`` (the C0 triangle of Belytschko, Stolarski
 and Carpenter, its transverse shear tied along its sides) and ``shell.h`` (the
 plane-stress J2 return and the rule through the thickness); their formulas are in their
-header comments. They are compiled through cffi into a module of their own, cached like
-:mod:`rwall_fem.kernels` (they include its ``batch.h``, ``plasticity.h``, ``step.h`` and
-``failure.h``).
+header comments. They are compiled through cffi into a module of their own by
+:func:`rwall_fem.kernels.load` (they include its ``batch.h``, ``plasticity.h``, ``step.h``
+and ``failure.h``).
 
 :class:`ShellKernel` is the compiled kernel of one material and technology on NumPy arrays
 (what the element tests drive); :class:`ShellForce` is the internal force of the cells of a
@@ -22,35 +22,34 @@ unless :attr:`ShellTechnology.drilling_stiffness` gives the quadrilaterals drill
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import io
 import math
-import re
 from dataclasses import dataclass
-from functools import cache
-from pathlib import Path
 
 import numpy as np
 
 from rwall_fem import kernels
-from rwall_fem.kernels import FAILURE, STEP_SLOTS
+from rwall_fem.internal_force import InternalForce, set_failure, set_flow_stress
+from rwall_fem.kernels import STEP_SLOTS
 
 __all__ = ["ShellForce", "ShellKernel", "ShellTechnology", "load", "thickness_rule"]
 
-HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "shell.h",
            "shell_quad.c", "shell_tria.c")  # fmt: skip
 POINT_SLOTS = 5  # per point through the thickness: sxx, syy, sxy, eps_p, temperature
 MAX_POINTS = 10
 FORMULATIONS = {"quadrilateral": ("bwc", "bt"), "triangle": ("bsc",)}
 FAMILY = {"quadrilateral": "quad", "triangle": "tria"}
+# The quadrilaterals' characteristic lengths of the step: "bt", Radioss's for its
+# Belytschko-Tsay shells (CDLEN3); "qeph", QEPH's (CZCORC1) with its default numerical
+# damping dn = QEPH_DN (the length times sqrt(1 + dn^2) - dn, cndt3.F).
+STEP_LENGTHS = ("bt", "qeph")
+QEPH_DN = 0.015
 # DOLFINx's quadrilateral vertices (0,0), (1,0), (0,1), (1,1): counter-clockwise order.
 _CCW = [0, 1, 3, 2]
 
-_STRUCT = re.search(r"typedef struct \{.*?\} element_params;", kernels._CDEF, re.S).group(0)
 _CDEF = (
-    _STRUCT
+    kernels.ELEMENT_PARAMS
     + """
 typedef struct {
   const double *thickness;
@@ -65,6 +64,8 @@ typedef struct {
   double kd;
   int drill_slot;
   double *new_thickness;
+  int qeph_step;
+  double qeph_dn;
 } shell_params;
 """
     + "".join(
@@ -76,8 +77,8 @@ typedef struct {
         for law in ("elastic", "plastic")
     )
     + "".join(
-        f"void shell_{family}_sizes(int64_t n, const int32_t *cells, const double *x,"
-        " double *area, double *length);\n"
+        f"void shell_{family}_sizes(const shell_params *s, int64_t n, const int32_t *cells,"
+        " const double *x, double *area, double *length);\n"
         for family in ("quad", "tria")
     )
     + """
@@ -85,83 +86,13 @@ double shell_point(const element_params *p, const shell_params *s, double sigma[
                    double *eps_p, double *T, const double de[3]);
 """
 )
+SHELLS = kernels.Extension("_rwall_shells", SOURCES, _CDEF, "the shell kernels")
 
 
-def _key(flags: list[str]) -> str:
-    import hashlib
-    import sys
-
-    import cffi
-
-    digest = hashlib.sha256()
-    here = Path(kernels.__file__).parent
-    for name in SOURCES:
-        digest.update((here / name).read_bytes())
-    for part in (_CDEF, " ".join(flags), sys.version, cffi.__version__, kernels._cpu()):
-        digest.update(part.encode())
-    return digest.hexdigest()[:16]
-
-
-def _compile(name: str, flags: list[str], work: Path) -> Path:
-    import cffi
-
-    ffi = cffi.FFI()
-    ffi.cdef(_CDEF)
-    here = Path(kernels.__file__).parent
-    source = "".join(f'#include "{n}"\n' for n in SOURCES if n.endswith(".c"))
-    ffi.set_source(name, source, include_dirs=[str(here)], extra_compile_args=flags)
-    with contextlib.redirect_stdout(io.StringIO()):
-        return Path(ffi.compile(tmpdir=str(work), verbose=False))
-
-
-def _build(name: str, flags: list[str], folder: Path):
-    import os
-    import shutil
-    import tempfile
-
-    private = None
-    try:
-        work = kernels._writable(folder)
-    except OSError:
-        private = folder = Path(tempfile.mkdtemp(prefix="rwall_fem_shells_"))
-        work = kernels._writable(folder)
-    try:
-        built = _compile(name, flags, work)
-        final = folder / f"{name}.{kernels._digest(built)}.so"
-        os.replace(built, final)
-    except BaseException:
-        if private is not None:
-            shutil.rmtree(private, ignore_errors=True)
-        raise
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return final, private
-
-
-@cache
 def load():
-    """The compiled shell kernels ``(ffi, lib)``, cached as :func:`rwall_fem.kernels.load`
-    caches the solids' (same folder, same checks)."""
-    import shutil
-
-    failures = []
-    for flags in kernels.FLAG_SETS:
-        name = f"_rwall_shells_{_key(flags)}"
-        path, private = kernels._cached(name, kernels._cache_dir()), None
-        try:
-            if path is None:
-                path, private = _build(name, flags, kernels._cache_dir())
-        except Exception as err:
-            lines = str(err).strip().splitlines() or [type(err).__name__]
-            failures.append(f"{' '.join(flags[:2])}: {lines[-1]}")
-            continue
-        try:
-            module = kernels._import(name, path)
-        finally:
-            if private is not None:
-                shutil.rmtree(private, ignore_errors=True)
-        return module.ffi, module.lib
-    raise kernels.compiler_error("the shell kernels", "; ".join(failures))
+    """The compiled shell kernels ``(ffi, lib)``, through :func:`rwall_fem.kernels.load`
+    (the same cache, checks and flags as the solids')."""
+    return kernels.load(SHELLS)
 
 
 def thickness_rule(points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -196,12 +127,14 @@ class ShellTechnology:
     hourglass_stiffness: float = 0.0
     # drilling stiffness over G t A (quadrilaterals; 0: none, shell_quad.c)
     drilling_stiffness: float = 0.0
+    # the characteristic length of the step (quadrilaterals, STEP_LENGTHS; shell_quad.c)
+    step_length: str = "bt"
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
                hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
                hourglass_stiffness: float = 0.0,
-               drilling_stiffness: float = 0.0) -> ShellTechnology:
+               drilling_stiffness: float = 0.0, step_length: str = "bt") -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -228,10 +161,13 @@ class ShellTechnology:
             raise ValueError(
                 f"element.drilling_stiffness: must be >= 0, got {drilling_stiffness}"
             )
+        if step_length not in STEP_LENGTHS:
+            raise ValueError(f"element.step_length: {step_length!r}; allowed: {STEP_LENGTHS}")
         quad = cell == "quadrilateral"
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
                    float(hourglass_stiffness) if quad else 0.0,
-                   float(drilling_stiffness) if quad else 0.0)  # fmt: skip
+                   float(drilling_stiffness) if quad else 0.0,
+                   step_length if quad else "bt")  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -240,7 +176,8 @@ class ShellTechnology:
         name = "Belytschko-Lin-Tsay quadrilaterals"
         warp = " with the BWC warping correction" if self.formulation == "bwc" else ""
         hm, hf, hr = self.hourglass
-        return f"{name}{warp}, viscous hourglass hm {hm:g} hf {hf:g} hr {hr:g}"
+        step = ", QEPH's step length" if self.step_length == "qeph" else ""
+        return f"{name}{warp}, viscous hourglass hm {hm:g} hf {hf:g} hr {hr:g}{step}"
 
 
 class ShellKernel:
@@ -312,6 +249,7 @@ class ShellKernel:
             s.points = 0
             self.history = np.zeros((8, n))
         s.hk = technology.hourglass_stiffness
+        s.qeph_step, s.qeph_dn = int(technology.step_length == "qeph"), QEPH_DN
         self.thickness_change = bool(thickness_change)
         if self.thickness_change:
             s.new_thickness = ffi.cast("double *", self.thickness.ctypes.data)
@@ -331,42 +269,14 @@ class ShellKernel:
         return int(self.shell.points)
 
     def _set_plasticity(self, material) -> None:
-        p = self.params
-        law = material.hardening if material.model == "elastic_plastic" else "johnson_cook"
-        p.hardening = HARDENING[law]
-        p.yield_stress = material.yield_stress or 0.0
-        p.hardening_modulus = getattr(material, "hardening_modulus", None) or 0.0
-        p.hardening_coefficient = getattr(material, "hardening_coefficient", None) or 0.0
-        p.hardening_exponent = getattr(material, "hardening_exponent", None) or 0.0
-        p.rate_coefficient = getattr(material, "strain_rate_coefficient", 0.0)
-        p.reference_rate = getattr(material, "reference_strain_rate", 1.0)
-        curve = getattr(material, "hardening_curve", None)
-        if curve is not None:
-            p.table_size = len(curve)
-            for i, (strain, stress) in enumerate(curve):
-                p.table_strain[i], p.table_stress[i] = strain, stress
-        heating = getattr(material, "heating", None)
-        room = 0.0
-        if heating is not None:
-            p.thermal = 1
-            p.thermal_exponent = heating.softening_exponent
-            p.melting_temperature = heating.melting_temperature
-            p.room_temperature = room = heating.room_temperature
-            p.specific_heat = heating.specific_heat
-            p.taylor_quinney = heating.taylor_quinney
+        """The flow-stress law's constants, and the state: two rows of transverse shear
+        forces, then per point through the thickness its plane stress (Pa), plastic strain
+        and temperature (K), then with a failure criterion the damage of each point."""
+        room = set_flow_stress(self.params, material)
         points = self.points
         slots = 2 + POINT_SLOTS * points
-        failure = self.failure
-        if failure is not None:
-            p.failure = FAILURE[failure.criterion]
-            p.damage_slot = slots
-            if failure.criterion == "plastic_strain":
-                p.failure_strain = failure.plastic_strain
-            else:
-                constants = (failure.d1, failure.d2, failure.d3, failure.d4, failure.d5)
-                for i, value in enumerate(constants):
-                    p.damage_constants[i] = value
-                p.damage_reference_rate = failure.reference_strain_rate
+        if self.failure is not None:
+            set_failure(self.params, self.failure, slots)
             slots += points
         self.history = np.zeros((slots, self.num_cells))
         self.history[2 + POINT_SLOTS - 1 : 2 + POINT_SLOTS * points : POINT_SLOTS] = room
@@ -407,7 +317,7 @@ class ShellKernel:
         x = np.ascontiguousarray(x, dtype=np.float64)
         ffi = self.ffi
         getattr(self.lib, f"shell_{self.family}_sizes")(
-            self.num_cells, ffi.cast("int32_t *", self.cells.ctypes.data),
+            self.shell, self.num_cells, ffi.cast("int32_t *", self.cells.ctypes.data),
             ffi.cast("double *", x.ctypes.data), ffi.cast("double *", area.ctypes.data),
             ffi.cast("double *", length.ctypes.data),
         )  # fmt: skip
@@ -458,7 +368,7 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     return np.sqrt(sxx**2 + syy**2 - sxx * syy + 3 * sxy**2)
 
 
-class ShellForce:
+class ShellForce(InternalForce):
     """Internal force (N) and moment (N m) of shell cells of a DOLFINx surface mesh (a part
     of the body: all owned cells unless ``cells``, their local indices), shaped like
     :class:`~rwall_fem.elements.ElementForce`.
@@ -473,6 +383,7 @@ class ShellForce:
     """
 
     conservative = False
+    estimate_every_step = True  # the frame and the lengths follow the shell every cycle
 
     def __init__(self, V, material, technology: ShellTechnology, u, v, w, *, thickness,
                  cells=None, f=None, m=None, max_flow_stress: float = math.inf,
@@ -504,6 +415,7 @@ class ShellForce:
         self.params, self.ffi = k.params, k.ffi
         self.cells, self.num_cells = k.cells, k.num_cells
         self.history = k.history
+        self.points = k.points
         self.area0, self.length0 = k.sizes(self.X)
         self.volume0 = self.area0 * k.thickness  # m^3, at rest
         self.step = np.zeros(STEP_SLOTS)
@@ -511,7 +423,7 @@ class ShellForce:
         self.erosion = None
         if self.failure is not None:
             self._erode()
-        self._kernel = self._bind()
+        self._rebind()
 
     @property
     def energy_names(self) -> tuple[str, ...]:
@@ -521,103 +433,20 @@ class ShellForce:
             names += ("hourglass",)
         return names + (("eroded_internal",) if self.erosion is not None else ())
 
-    @property
-    def energy_parts(self) -> tuple[str, ...]:
-        parts = ("elastic", "plastic_work") if self.plastic else ()
-        return parts + (("eroded_kinetic",) if self.erosion is not None else ())
-
-    def _bind(self):
+    def _rebind(self) -> None:
         computed = self.num_cells if self.erosion is None else self.erosion.computed
-        return self.kernel.bind(computed, self.X, self.u.array, self.v.array, self.w.array,
-                                self.f.array, self.m.array, self._energy, self.step)  # fmt: skip
-
-    def _erode(self) -> None:
-        from rwall_fem.erosion import ErodedCells
-
-        self.erosion = e = ErodedCells(self.V, self.cells)
-        p, ffi = self.params, self.ffi
-        p.erode = 1
-        p.eroded = ffi.cast("int32_t *", e.listed.ctypes.data)
-        p.cell_work = ffi.cast("double *", e.work.ctypes.data)
-        p.cell_stride = self.num_cells
-        # the kernels read p->velocity nowhere for shells (du comes with the batch)
-
-    def erode_below(self, floor: float) -> None:
-        """From now on, erode the cells whose step estimate falls below ``floor`` (s)."""
-        self.params.erode_step = floor
-        if self.erosion is None:
-            self._erode()
-            self._kernel = self._bind()
-
-    def list_cells_below(self, floor: float, factor: np.ndarray) -> None:
-        """From now on, scale each cell's step estimate by ``factor`` (per cell, sqrt of its
-        mass over its mass at rest) and list the cells whose scaled step is below ``floor``
-        (s) in :attr:`below` and :attr:`below_step` (their steps before scaling), the first
-        ``int(step[10])`` entries: mass scaling (:mod:`rwall_fem.mass_scaling`)."""
-        self.below = np.zeros(self.num_cells, dtype=np.int32)
-        self.below_step = np.zeros(self.num_cells)
-        self._factor = factor
-        p, ffi = self.params, self.ffi
-        p.step_factor = ffi.cast("double *", factor.ctypes.data)
-        p.step_floor = floor
-        p.below = ffi.cast("int32_t *", self.below.ctypes.data)
-        p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
-
-    @property
-    def damage(self) -> np.ndarray:
-        """The damage of every point (points, cells): with a failure criterion."""
-        start = self.params.damage_slot
-        return self.history[start : start + self.kernel.points]
+        self._kernel = self.kernel.bind(computed, self.X, self.u.array, self.v.array,
+                                        self.w.array, self.f.array, self.m.array, self._energy,
+                                        self.step)  # fmt: skip
 
     def steps_at_rest(self) -> np.ndarray:
         """Each owned cell's stable step estimate at rest (s): calibration x L_c / c_bar."""
         return self.params.calibration * self.length0 / self.kernel.shell.bar_speed
 
-    def compute(self, state) -> None:
-        """Add f_int and m_int of step n into :attr:`f` and :attr:`m` (u, v, w scattered
-        forward); estimate the cells' steps on the way (:attr:`step`, ``step.h``)."""
-        self.params.dt = state.dt_previous
-        self._energy[0] = 0.0
-        self.params.estimate = 1
-        self.step[:] = (np.inf, -1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        self._kernel()
-        if self.step[11]:
-            e = self.erosion
-            e.remove(int(self.step[11]))
-            self.params.live = self.ffi.cast("int32_t *", e.live.ctypes.data)
-            self._kernel = self._bind()
-
-    def detach_nodes(self) -> None:
-        self.erosion.detach()
-
     def plastic_strains(self) -> np.ndarray:
         """The equivalent plastic strain of every point through the thickness (rows, bottom
         to top) of its cells (columns); elasto-plastic forces only."""
         return self.kernel.plastic_strains()
-
-    @property
-    def stored_energy(self) -> float:
-        return float(self._energy[0])
-
-    @property
-    def hourglass_energy(self) -> float:
-        return float(self._energy[1])
-
-    @property
-    def plastic_work(self) -> float:
-        return float(self._energy[2])
-
-    @property
-    def eroded_energy(self) -> float:
-        return float(self._energy[3])
-
-    @property
-    def smallest_step(self) -> float:
-        return float(self.step[0])
-
-    @property
-    def inverted_cells(self) -> int:
-        return int(self.step[5])
 
     def cell_fields(self, state) -> dict[str, np.ndarray]:
         """Per owned cell: ``stress_bottom``, ``stress_middle``, ``stress_top`` ((3, cells):
@@ -644,25 +473,12 @@ class ShellForce:
         return fields
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        arrays = {"energy": self._energy, "step": self.step, "history": self.history}
+        arrays = super().checkpoint_state()
         if self.kernel.thickness_change:
             arrays["thickness"] = self.kernel.thickness
-        if self.erosion is not None:
-            arrays |= {f"erosion_{k}": v for k, v in self.erosion.checkpoint_state().items()}
         return arrays
 
     def restore_state(self, arrays: dict[str, np.ndarray]) -> None:
-        self._energy[:] = arrays["energy"]
-        self.step[:] = arrays["step"]
-        self.history[...] = arrays["history"]
         if self.kernel.thickness_change:
             self.kernel.thickness[:] = arrays["thickness"]
-        if self.erosion is not None:
-            e, prefix = self.erosion, "erosion_"
-            e.restore_state(
-                {k.removeprefix(prefix): v for k, v in arrays.items() if k.startswith(prefix)}
-            )
-            self.params.live = (
-                self.ffi.NULL if e.live is None else self.ffi.cast("int32_t *", e.live.ctypes.data)
-            )
-            self._kernel = self._bind()
+        super().restore_state(arrays)

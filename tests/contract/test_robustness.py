@@ -232,13 +232,13 @@ def test_a_cache_that_cannot_be_written_gives_way_to_a_private_one(tmp_path, mon
     blocked = tmp_path / "file"
     blocked.write_text("not a folder")
 
-    def compile_(name, flags, work):
+    def compile_(extension, name, flags, work):
         library = work / f"{name}.so"
         library.write_bytes(b"built")
         return library
 
     monkeypatch.setattr(kernels, "_compile", compile_)
-    final, private = kernels._build("_rwall_kernels_x", [], blocked / "kernels")
+    final, private = kernels._build(kernels.ELEMENTS, "_rwall_kernels_x", [], blocked / "kernels")
     assert private is not None and final.parent == private and final.read_bytes() == b"built"
     shutil.rmtree(private)
 
@@ -253,6 +253,30 @@ def test_a_cache_that_cannot_be_written_gives_way_to_a_private_one(tmp_path, mon
     finally:
         _compat._form_cache.cache_clear()
 
+
+
+@pytest.mark.serial
+def test_processes_starting_together_share_one_kernel_cache(tmp_path):
+    """Two processes (ranks starting together) load an extension into an empty cache at
+    once, through the one loader of :mod:`rwall_fem.kernels` (the solids' and the shells'
+    kernels take it; a small extension here, quick to compile): both load, the cache then
+    holds whole libraries of one key only (no build folder left), and a later process
+    loads what is there without publishing anything new."""
+    code = ("from rwall_fem import kernels; kernels.load(kernels.Extension('_rwall_probe', "
+            "('batch.h',), '', 'a probe'))")  # fmt: skip
+    env = _env(RWALL_FEM_CACHE=str(tmp_path))
+    both = [subprocess.Popen([sys.executable, "-c", code], env=env, stderr=subprocess.PIPE,
+                             text=True) for _ in range(2)]  # fmt: skip
+    for process in both:
+        _, err = process.communicate(timeout=600)
+        assert process.returncode == 0, err
+    libraries = {path: path.stat().st_mtime_ns for path in tmp_path.iterdir()}
+    assert libraries and all(p.suffix == ".so" for p in libraries), sorted(libraries)
+    assert len({p.name.split(".")[0] for p in libraries}) == 1  # one key: one source set
+    later = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                           text=True, timeout=600)  # fmt: skip
+    assert later.returncode == 0, later.stderr
+    assert {path: path.stat().st_mtime_ns for path in tmp_path.iterdir()} == libraries
 
 def _jit():
     import dolfinx.jit

@@ -9,6 +9,7 @@ Bad shell cards are refused in one line naming the file and line.
 """
 
 import copy
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -244,6 +245,37 @@ def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, 
     sim = build_simulation(scene, comm, shared_dir)
     compiled = sim.internal.elements[0].kernel.shell
     assert (compiled.kd, compiled.hk) == (drilling or 0.0, scene.element.hourglass_stiffness)
+
+
+@pytest.mark.parametrize("ishell", [1, 24])
+def test_ishell_24_takes_qeph_step_length(ishell, shared_dir):
+    """Ishell 24 (QEPH): QEPH's characteristic length of the step, with dn = 0.015 (the
+    compiled kernel's); Ishell 1: Radioss's Belytschko-Tsay length. The body's first
+    step is 0.9 of its smallest cell's L_c / sqrt(E / rho) by the rule."""
+
+    def edit(lines):
+        _replace(lines, "/PROP/SHELL/1", 2, i10(ishell) + i10(0) * 4)
+
+    scene = load_deck(written(plate_deck(), shared_dir, edit))
+    qeph = ishell == 24
+    assert scene.element.step_length == ("qeph" if qeph else None)
+    sim = build_simulation(scene, comm, shared_dir)
+    elements = sim.internal.elements[0]
+    compiled = elements.kernel.shell
+    assert (compiled.qeph_step, compiled.qeph_dn) == (int(qeph), 0.015)
+    side = comm.allreduce(elements.length0.min() if len(elements.length0) else np.inf, op=MPI.MIN)
+    square = 1 / math.sqrt(2 * (0.78 + 0.22 * (3.413 * 0.2929) ** 3) * 1.25 / 2)
+    factor = square * (math.sqrt(1 + 0.015**2) - 0.015) if qeph else 1.0
+    assert side == pytest.approx(factor * 5e-3, rel=1e-9)  # the deck's 5 mm squares
+
+    def other_dn(lines):
+        edit(lines)
+        _replace(lines, "/PROP/SHELL/1", 3, f20(0.0) * 4 + f20(0.02))
+
+    said = []
+    load_deck(written(plate_deck(), shared_dir, other_dn), report=said)
+    warned = [w for w in said[0].warnings if "dn = 0.02" in w]
+    assert len(warned) == int(qeph) and all("takes dn = 0.015" in w for w in warned)
 
 
 def test_idrill_other_than_1_and_2_is_refused(shared_dir):

@@ -206,3 +206,52 @@ def test_characteristic_length():
     area, length = kernel.sizes(X)
     assert area[0] == pytest.approx(2.0, rel=1e-14)
     assert length[0] == pytest.approx(max(2.0 / math.sqrt(5.0), 1.0), rel=1e-14)
+
+
+def qeph_length(x, y, dn=0.015):
+    """QEPH's L_c (OpenRadioss's CZCORC1 and CNDT3) of a flat cell with corners (x, y)."""
+    x, y = np.asarray(x) - np.mean(x), np.asarray(y) - np.mean(y)
+    area = 0.5 * ((x[2] - x[0]) * (y[3] - y[1]) - (x[3] - x[1]) * (y[2] - y[0]))
+    half13, half24 = np.hypot(x[0] - x[2], y[0] - y[2]) / 2, np.hypot(x[1] - x[3], y[1] - y[3]) / 2
+    h = max(abs(x[1] * y[3] - y[1] * x[3]), abs(x[0] * y[2] - y[0] * x[2])) / area
+    c1 = math.hypot(x[1] + x[2] - x[0] - x[3], y[1] + y[2] - y[0] - y[3])
+    c2 = math.hypot(x[2] + x[3] - x[0] - x[1], y[2] + y[3] - y[0] - y[1])
+    f = 3.413 * max(0.0, 4 * area / (c1 * c2) - 0.7071)
+    shape = 2 * (1 + min(0.5, (max(c1, c2) / min(c1, c2) - 1) / 4)) * (0.78 + 0.22 * f**3)
+    length = area / math.sqrt(shape * (1.25 + h) * max(half13, half24) ** 2)
+    return length * (math.sqrt(1 + dn**2) - dn)
+
+
+@pytest.mark.parametrize("corners, closed", [
+    # a square of side 1: L_c = 1 / (2 (0.78 + 0.22 f^3) 5/4 / 2)^(1/2), f = 3.413 (1 - 0.7071)
+    ([(0, 0), (1, 0), (1, 1), (0, 1)],
+     1 / math.sqrt(2 * (0.78 + 0.22 * (3.413 * 0.2929) ** 3) * 1.25 / 2)),
+    # a 2 x 1 rectangle: aspect factor 1 + (2 - 1) / 4, half diagonal sqrt(5) / 2
+    ([(0, 0), (2, 0), (2, 1), (0, 1)],
+     2 / math.sqrt(2 * 1.25 * (0.78 + 0.22 * (3.413 * 0.2929) ** 3) * 1.25 * 1.25)),
+    ([(0, 0), (2, 0), (1.5, 1), (0.5, 1)], None),  # a trapezoid: h > 0
+    ([(0, 0), (1, 0.1), (1.3, 0.8), (-0.2, 1.1)], None),
+])  # fmt: skip
+def test_qeph_characteristic_length(corners, closed):
+    """QEPH's L_c (Ishell 24), rotated and moved in space: the closed form of a square
+    (0.894 of its side, times sqrt(1 + dn^2) - dn = 0.9851) and a rectangle, and
+    OpenRadioss's formula on cells that are not parallelograms."""
+    x, y = np.array(corners, dtype=float).T
+    expected = qeph_length(x, y)
+    if closed is not None:
+        assert expected == pytest.approx(closed * (math.sqrt(1 + 0.015**2) - 0.015), rel=1e-12)
+    X = np.column_stack([x, y, np.zeros(4)]) @ rotation([1.0, 2.0, 3.0], 0.7).T + [3.0, -1.0, 2.0]
+    cells = np.array([[0, 1, 2, 3]], np.int32)
+    qeph = ShellKernel(ELASTIC, ShellTechnology.choose("quadrilateral", step_length="qeph"),
+                       cells, T)  # fmt: skip
+    area, length = qeph.sizes(X)
+    assert length[0] == pytest.approx(expected, rel=1e-12)
+    if closed is not None:  # on rectangles QEPH's step is the shorter (not on every cell)
+        bt = ShellKernel(ELASTIC, ShellTechnology.choose("quadrilateral"), cells, T)
+        assert bt.sizes(X)[1][0] > length[0]
+
+
+def test_qeph_step_length_is_for_quadrilaterals():
+    assert ShellTechnology.choose("triangle", step_length="qeph").step_length == "bt"
+    with pytest.raises(ValueError, match="element.step_length"):
+        ShellTechnology.choose("quadrilateral", step_length="diagonal")

@@ -76,12 +76,15 @@ class Clearance:
 
     def __init__(self, sim):
         interface = sim.contacts[0]
-        ps = interface.passes[0]
-        self.interface, self.segments = interface, ps.segments
-        n, m = interface.size, len(ps.segments)
+        self.comm = sim.comm
+        # The whole surface: each rank's segments (global node numbers), from every rank.
+        segments = np.concatenate(self.comm.allgather(interface.shares[0].segments))
+        self.ids = np.unique(segments)
+        self.interface, self.segments = interface, np.searchsorted(self.ids, segments)
+        n, m = len(self.ids), len(segments)
         holds = np.zeros((n, m), dtype=bool)  # node i is a corner of segment j
         for k in range(4):
-            holds[ps.segments[:, k], np.arange(m)] = True
+            holds[self.segments[:, k], np.arange(m)] = True
         near = (holds.astype(np.int32) @ holds.T.astype(np.int32)) > 0  # share a segment
         self.excluded = (near.astype(np.int32) @ holds.astype(np.int32)) > 0
         self.smallest = []
@@ -91,7 +94,10 @@ class Clearance:
         return s.step % 5 == 0
 
     def record(self, sim, s):
-        x = self.interface.x
+        it = self.interface
+        ids = np.concatenate(self.comm.allgather(it.ids))
+        x = np.concatenate(self.comm.allgather(it.x[: it.n]))
+        x = x[np.argsort(ids)][np.searchsorted(np.sort(ids), self.ids)]
         corners = x[self.segments]  # (m, 4, 3)
         centre = corners.mean(axis=1)
         reach = 0.75 * 4e-3 + 2 * GAP

@@ -314,6 +314,15 @@ def test_contact_does_not_depend_on_the_ranks(shared_dir, tmp_path):
     compare_runs(parallel.history.energy, parallel.history.contact(0), serial.history.energy,
                  serial.history.contact(0),
                  serial.history.summary["energy"]["initial"])  # fmt: skip
+    # Each rank holds its share: its owned surface nodes (each node on one rank), its own
+    # secondary nodes, and of the other ranks' nodes only those near them.
+    comm, mine, whole = MPI.COMM_WORLD, parallel.contacts[0], serial.contacts[0]
+    assert comm.allreduce(mine.n) == mine.size == whole.size
+    for k, ps in enumerate(whole.passes):
+        assert comm.allreduce(len(mine.shares[k].secondary)) == len(ps.secondary)
+    assert len(mine.x) < mine.size
+    assert comm.allreduce(len(mine.x) - mine.n) > 0  # the contact crosses the partition
+    assert parallel.history.summary["contacts"][0]["exchanged_bytes"] > 0
 
 
 def compare_runs(e_par, c_par, e_ser, c_ser, energy):

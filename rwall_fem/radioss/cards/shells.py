@@ -7,7 +7,7 @@ viscous hourglass control hm, hf, hr) with an elastic ``hourglass_stiffness``: 1
 (Radioss's Belytschko-Tsay, whose hourglass forces are elastic, CHVIS3) and 24 and 12
 (QEPH, Belytschko-Leviathan's physical stabilisation, read the same way) hk = 3
 :data:`HELAS` hm (1 - nu^2), the same stiffness on a square cell's membrane hourglass
-mode; 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
+mode, 24 with QEPH's step (``step_length = "qeph"``); 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
 :data:`HOURGLASS_STIFFNESS`; a warning says what each is read as; a
 blank Ishell is 1, as in OpenRadioss's starter. Ish3n 1 and 2 (the C0 triangle) to
 ``"bsc"``. Iplas 0 (blank) or 2, Radioss's radial return for LAW2, is read as the exact
@@ -42,7 +42,7 @@ HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
 # square cell is hk E t / (12 (1 - nu^2)) on the same mode, so hk = 3 HELAS hm (1 - nu^2).
 HELAS = 0.5
 # The [element] keys of the quadrilaterals only, left out for triangles.
-_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness")
+_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length")
 
 
 def _elements(deck: Deck, card: Card) -> None:
@@ -76,7 +76,7 @@ def _property(deck: Deck, card: Card) -> None:
     ishell, ismstr, ish3n, idrill, _, thickfail = read_fields(
         card, first, "i:Ishell i:Ismstr i:Ish3n i:Idrill i:Ipinch -:blank f:P_thickfail"
     )
-    hm, hf, hr, _, _ = card.read(2, "f:hm f:hf f:hr f:dm f:dn", "hm hf hr dm dn")
+    hm, hf, hr, _, dn = card.read(2, "f:hm f:hf f:hr f:dm f:dn", "hm hf hr dm dn")
     third = card.line(3, "N Istrain Thick Ashear Ithick Iplas")
     n, _, thick, ashear, ithick, iplas = read_fields(
         card, third, "i:N i:Istrain f:Thick f:Ashear -:blank i:Ithick i:Iplas"
@@ -87,7 +87,7 @@ def _property(deck: Deck, card: Card) -> None:
         "given": {"ishell": ishell, "ismstr": ismstr, "ish3n": ish3n, "idrill": idrill,
                   "ithick": ithick, "iplas": iplas},
         "n": n, "thick": thick * units.length, "ashear": ashear, "hourglass": (hm, hf, hr),
-        "thickfail": thickfail,
+        "thickfail": thickfail, "dn": dn,
     }  # fmt: skip
 
 
@@ -157,10 +157,15 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     if ishell != 3:
         what = ("QEPH's physical stabilisation" if ishell in (12, 24) else
                 "Radioss's elastic hourglass forces (HELAS hm, with a quadratic viscosity)")
+        step = (", with QEPH's characteristic length of the step (its dn = 0.015)"
+                if ishell == 24 else "")  # fmt: skip
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   f"warping correction, {what} as the elastic hourglass stiffness "
-                  "3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr",
+                  f"3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr{step}",
                   first)  # fmt: skip
+        if ishell == 24 and raw["dn"] and raw["dn"] != 0.015:
+            deck.warn(card, f"dn = {raw['dn']:g}: QEPH's numerical damping is not applied; "
+                      "its step takes dn = 0.015", first)  # fmt: skip
     return {"kind": "shell", "ishell": ishell, "ish3n": ish3n, "where": card.header.where,
             "line": first.where, "element": element}  # fmt: skip
 
@@ -174,6 +179,8 @@ def shell_element(deck: Deck, pid: int, cell: str, poisson: float) -> tuple[dict
     if p["ishell"] != 3:  # Radioss's elastic hourglass forces (CHVIS3), QEPH read alike
         hm = element["hourglass_coefficients"][0]
         element["hourglass_stiffness"] = 3.0 * HELAS * hm * (1.0 - poisson**2)
+    if p["ishell"] == 24:  # QEPH's own characteristic length (CZCORC1, CNDT3)
+        element["step_length"] = "qeph"
     if cell == "triangle":
         for name in _QUADRILATERAL_KEYS:
             element.pop(name, None)
