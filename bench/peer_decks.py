@@ -112,7 +112,7 @@ def shell_figures(starter: Path, out: Path) -> dict:
 
 def show(name, ours, theirs):
     for key, value in ours.items():
-        ref = theirs.get(key if key in theirs or "_" not in key else key.split("_")[0])
+        ref = theirs.get(key)
         diff = f"{100 * (value / ref - 1):+.2f} %" if ref else ""
         print(f"{name:14s} {key:10s} {value:.5g}  OpenRadioss {ref if ref else '-'}  {diff}")
 
