@@ -25,6 +25,8 @@ The faces of solid parts on a symmetry plane (a plane x_c = const whose nodes a
 from __future__ import annotations
 
 import logging
+import math
+from dataclasses import dataclass
 
 import numpy as np
 from mpi4py import MPI
@@ -120,10 +122,11 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                                          + [s.nodes for s in here]))  # fmt: skip
         edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
-        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]])
+        share = GapShare.of(spec)
+        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge)
 
-        def passes(sides=sides, nodes=nodes, scale=spec.stiffness_scale) -> list[Pass]:
+        def passes(sides=sides, nodes=nodes, spec=spec, share=share) -> list[Pass]:
             """The passes of the interface from its sides' surfaces as they are."""
             out = []
             for sec_parts, seg_parts, exclude in sides:
@@ -131,7 +134,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 out.append(Pass(
                     np.searchsorted(nodes, sec.nodes).astype(np.int64),
                     np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
-                    scale * seg.stiffness, _sized_depth(seg), exclude,
+                    _bounded_stiffness(spec, seg.stiffness), _sized_depth(seg, share),
+                    exclude,
                 ))  # fmt: skip
             return out
 
@@ -227,25 +231,57 @@ def _gap_floor(sides, edge: float) -> float:
 
 # A shell's share of a variable gap is at most this fraction of its shortest side (Radioss
 # TYPE7 Igap 3's default %mesh_size, i7sti3.F; LS-DYNA's automatic contacts alike): a
-# node then stays clear of its own flat sheet beyond its neighbouring segments.
+# node then stays clear of its own flat sheet beyond its neighbouring segments. A scene's
+# ``gap_size_share`` (a deck's %mesh_size) changes it.
 SIZE_SHARE = 0.4
 
 
-def _sized_depth(s: Surface) -> np.ndarray:
+@dataclass(frozen=True)
+class GapShare:
+    """How a shell's half thickness t/2 becomes its share of a variable gap (Radioss
+    TYPE7 Igap 2 and 3, ``i7sti3.F``, ``i7cor3.F``): min(scale t/2, size x its shortest
+    side, cap) (m); ``cap`` is half the scene's ``gap_max`` (inf: none), so that a pair of
+    shares, the pair's gap, is at most ``gap_max``."""
+
+    scale: float = 1.0
+    size: float = SIZE_SHARE
+    cap: float = math.inf
+
+    @classmethod
+    def of(cls, spec) -> GapShare:
+        """The share of the ``[[contact]]`` table ``spec``."""
+        cap = math.inf if spec.gap_max is None else 0.5 * spec.gap_max
+        return cls(spec.gap_scale, spec.gap_size_share, cap)
+
+
+def _bounded_stiffness(spec, stiffness: np.ndarray) -> np.ndarray:
+    """The penalty stiffness k0 (N/m) of segments whose elements give ``stiffness``:
+    scaled by ``stiffness_scale`` (Radioss Stfac), then within [stiffness_min,
+    stiffness_max] (Radioss Stmin, Stmax: ``i7cor3.F``, STIF = max(KMIN, min(STIF, KMAX)))."""
+    high = np.inf if spec.stiffness_max is None else spec.stiffness_max
+    return np.clip(spec.stiffness_scale * stiffness, spec.stiffness_min, high)
+
+
+def _sized_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
     """The depths of the segments of ``s`` (m) with each shell's share of a variable gap
-    (-depth, half its thickness) at most :data:`SIZE_SHARE` x its shortest side."""
-    return np.where(s.depth < 0.0, np.maximum(s.depth, -SIZE_SHARE * s.edge), s.depth)
+    (-depth, half its thickness) as ``share`` makes it: at most ``share.size`` x its
+    shortest side."""
+    shell = s.depth < 0.0
+    half = np.minimum(np.minimum(share.scale * -s.depth, share.size * s.edge), share.cap)
+    return np.where(shell, -half, s.depth)
 
 
-def _node_gaps(nodes: np.ndarray, surfaces: list[Surface]) -> np.ndarray:
+def _node_gaps(nodes: np.ndarray, surfaces: list[Surface],
+               share: GapShare = GapShare()) -> np.ndarray:  # fmt: skip
     """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
-    solid's), at most :data:`SIZE_SHARE` x the shortest side of the shells at it."""
+    solid's), as ``share`` makes it: at most ``share.size`` x the shortest side of the
+    shells at it."""
     out, size = np.zeros(len(nodes)), np.full(len(nodes), np.inf)
     for s in surfaces:
         half = np.repeat(np.maximum(-s.depth, 0.0), 4)
-        side = np.repeat(np.where(s.depth < 0.0, SIZE_SHARE * s.edge, np.inf), 4)
+        side = np.repeat(np.where(s.depth < 0.0, share.size * s.edge, np.inf), 4)
         ids = s.segments.ravel()
         rows = np.searchsorted(nodes, ids[ids >= 0])
         np.maximum.at(out, rows, half[ids >= 0])
         np.minimum.at(size, rows, side[ids >= 0])
-    return np.minimum(out, size)
+    return np.minimum(np.minimum(share.scale * out, size), share.cap)

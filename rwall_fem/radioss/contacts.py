@@ -11,8 +11,11 @@ The gap: Igap 0 (1000) is constant, GAPmin or Radioss's default for it, the mean
 thickness of the main shells capped at half the shortest side of the main segments (0.1
 x that side without shells); Igap 1 (2, 3) leaves ``gap`` out: the scene's variable gap,
 half the sum of the thicknesses, each shell's share at most 0.4 x its shortest side
-(Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`). Stfac is
-``stiffness_scale``, Fric ``friction`` (Ifiltr, Xfreq its filter), VIS_S ``damping``.
+(Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`), with Igap 2 and 3
+Fscalegap ``gap_scale`` and Gap_max ``gap_max``, with Igap 3 %mesh_size
+``gap_size_share``. Stfac is ``stiffness_scale``, with Istf 2 to 5 Stmin and Stmax
+``stiffness_min`` and ``stiffness_max``, Fric ``friction`` (Ifiltr, Xfreq its filter),
+VIS_S ``damping``.
 """
 
 from __future__ import annotations
@@ -79,11 +82,22 @@ def _common(deck: Deck, inter, main: list[DeckPart], where: str) -> dict:
         table["friction"] = inter.friction
         if inter.filter_flag:
             table["friction_filter"] = {_FILTER[inter.filter_flag]: inter.filter_factor}
+    if inter.stiffness_min:
+        table["stiffness_min"] = inter.stiffness_min
+    if inter.stiffness_max:
+        table["stiffness_max"] = inter.stiffness_max
     if inter.igap == 0:
         table["gap"] = inter.gap_min or _default_gap(deck, main)
-    elif inter.gap_min:
+        return table
+    if inter.gap_min:
         deck.warnings.append(f"{where}: GAPmin = {inter.gap_min:g} m: not honoured with a "
                              "variable gap (Igap 1): its floor is Radioss's default")  # fmt: skip
+    if inter.gap_scale != 1.0:
+        table["gap_scale"] = inter.gap_scale
+    if inter.gap_max:
+        table["gap_max"] = inter.gap_max
+    if inter.size_share != 0.4:
+        table["gap_size_share"] = inter.size_share
     return table
 
 
@@ -145,5 +159,7 @@ def _names(parts: list[DeckPart]) -> str:
 
 def _describe(table: dict) -> str:
     gap = f"gap {table['gap']:g} m" if "gap" in table else "variable gap"
+    if "gap_max" in table:
+        gap += f" at most {table['gap_max']:g} m"
     return (f": {gap}, stiffness scale {table['stiffness_scale']:g}, damping "
             f"{table['damping']:g}, friction {table.get('friction', 0.0):g}")

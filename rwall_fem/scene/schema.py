@@ -1277,11 +1277,46 @@ class ContactSpec:
         default_doc="0.1 x the shortest edge of the segments; on shells a variable gap, half "
         "the sum of the thicknesses (Radioss Igap 1)",
     )
+    gap_scale: float = key(
+        Real(low=0.0),
+        1.0,
+        doc="Radioss Fscalegap: scales each shell's half thickness in the variable gap "
+        "(before gap_size_share and gap_max)",
+    )
+    gap_max: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="m",
+        doc="Radioss Gap_max: the variable gap of a pair at most this (each side's share at "
+        "most half of it), never below the floor gap",
+        default_doc="no bound",
+    )
+    gap_size_share: float = key(
+        Real(low=0.0, high=1.0),
+        0.4,
+        doc="Radioss %mesh_size (Igap 3): each shell's share of the variable gap at most "
+        "this fraction of its shortest side (of the shells at a node)",
+    )
     stiffness_scale: float = key(
         Real(low=0.0),
         1.0,
         doc="Radioss Stfac: scales the penalty stiffness k0 = B A^2 / V of the cell under "
         "each segment (E t of a shell segment)",
+    )
+    stiffness_min: float = key(
+        Real(low=0.0, low_open=False),
+        0.0,
+        unit="N/m",
+        doc="Radioss Stmin: the penalty stiffness k0 of each segment (after stiffness_scale) "
+        "at least this",
+    )
+    stiffness_max: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="N/m",
+        doc="Radioss Stmax: the penalty stiffness k0 of each segment (after stiffness_scale) "
+        "at most this",
+        default_doc="no bound",
     )
     damping: float = key(
         Real(low=0.0, low_open=False, high=1.0),
@@ -1321,6 +1356,33 @@ def _sides_are_named(v, raw, fail):
     for side in ("main", "secondary"):
         if not v[side]:
             fail(side, "names no part; give at least one part name (or self = true)")
+
+
+# The keys that shape the variable gap only.
+_VARIABLE_GAP_KEYS = ("gap_scale", "gap_max", "gap_size_share")
+
+
+@rule(
+    ContactSpec,
+    json=[
+        {
+            "if": {"required": ["gap"]},
+            "then": {"not": {"anyOf": [{"required": [k]} for k in _VARIABLE_GAP_KEYS]}},
+        }
+    ],
+)
+def _gap_keys_agree(v, raw, fail):
+    """gap_scale, gap_max and gap_size_share shape the variable gap: not with a given
+    (constant) gap; stiffness_min is not above stiffness_max."""
+    if v["gap"] is not None:
+        for name in _VARIABLE_GAP_KEYS:
+            if name in raw:
+                fail(name, "shapes the variable gap: leave it out with a given gap (constant), "
+                     "or leave gap out")  # fmt: skip
+    high = v["stiffness_max"]
+    if high is not None and v["stiffness_min"] > high:
+        fail("stiffness_min", f"{v['stiffness_min']:g} N/m is above stiffness_max {high:g} "
+             "N/m: the bounds of the penalty stiffness")  # fmt: skip
 
 
 # --- [[part]] -------------------------------------------------------------------------

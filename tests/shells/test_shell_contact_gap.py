@@ -105,7 +105,8 @@ def test_a_gently_bending_fine_sheet_does_not_touch_itself(shared_dir):
 
 
 def test_without_the_cap_the_fine_sheet_touches_itself(shared_dir, monkeypatch):
-    monkeypatch.setattr(contact_module, "SIZE_SHARE", np.inf)  # the old rule
+    uncapped = classmethod(lambda cls, spec: cls(size=np.inf))  # the old rule
+    monkeypatch.setattr(contact_module.GapShare, "of", uncapped)
     sim = build_simulation(parse_scene(sheet(True, False), source="test"), comm, shared_dir)
     nodes = comm.allreduce(len(sim.state.X))
     inside = starting_inside(sim)

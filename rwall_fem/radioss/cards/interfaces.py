@@ -5,8 +5,11 @@ older surface-to-surface and node-to-surface contacts) too, saying that TYPE7 do
 they do.
 
 Fields read: grnd_IDs, surf_IDm, Istf, Igap, Idel, Gapmin, Stfac, Fric, Inacti, VISs,
-Ifric, Ifiltr, Xfreq. Each other field that is not at its default gives one warning line
-saying it is not honoured (``docs/radioss.md``, "Contact interfaces").
+Ifric, Ifiltr, Xfreq; Fscalegap and Gap_max with Igap 2 and 3, %mesh_size with Igap 3,
+Stmin and Stmax with Istf 2 to 5 (where Radioss reads them: ``hm_read_inter_type07.F``;
+elsewhere Radioss leaves them out, and a warning line says so). Each other field that is
+not at its default gives one warning line saying it is not honoured (``docs/radioss.md``,
+"Contact interfaces").
 """
 
 from __future__ import annotations
@@ -24,7 +27,9 @@ __all__ = ["Interface", "STARTER"]
 class Interface:
     """An /INTER/TYPE7 in SI: its secondary node group and main surface, the stiffness
     flag and scale, the gap flag and minimum gap (m, 0: Radioss's default), Coulomb's
-    coefficient with its filter (``ifq``, ``xfreq``: as /RWALL's), the normal damping."""
+    coefficient with its filter (``ifq``, ``xfreq``: as /RWALL's), the normal damping;
+    the variable gap's scale, bound (m, 0: none) and size share (Fscalegap, Gap_max,
+    %mesh_size), the bounds of the penalty stiffness (N/m, Stmin, Stmax; 0: none)."""
 
     id: int
     title: str
@@ -39,6 +44,11 @@ class Interface:
     filter_factor: float
     damping: float
     where: str
+    gap_scale: float = 1.0
+    gap_max: float = 0.0
+    size_share: float = 0.4
+    stiffness_min: float = 0.0
+    stiffness_max: float = 0.0
 
 
 def _ignored(deck: Deck, card: Card, line, values: dict) -> None:
@@ -70,13 +80,9 @@ def _type7(deck: Deck, card: Card) -> None:
                   card.lines[1])  # fmt: skip
     if istf in (2, 3, 4, 5):
         deck.warn(card, f"Istf = {istf}: not honoured: the stiffness is the main side's "
-                  "(Istf 1000)", card.lines[1])  # fmt: skip
+                  "(Istf 1000), within Stmin and Stmax", card.lines[1])  # fmt: skip
     if igap not in (0, 1, 2, 3, 1000):
         card.fail(f"Igap = {igap}: 0 or 1000 (a constant gap), 1, 2 or 3 (variable)",
-                  card.lines[1])  # fmt: skip
-    if igap == 2:
-        deck.warn(card, "Igap = 2: read as Igap 3 without Fscalegap and Gap_max (the "
-                  "variable gap, each shell's share at most 0.4 x its shortest side)",
                   card.lines[1])  # fmt: skip
     if idel not in (0, 1000):
         deck.warn(card, f"Idel = {idel}: not honoured: contact bodies do not erode here, "
@@ -85,14 +91,19 @@ def _type7(deck: Deck, card: Card) -> None:
                                          "Iadm": iadm})  # fmt: skip
     fscale, gapmax, fpenmax, itied, ists = card.read(
         2, "f:Fscalegap f:Gap_max f:Fpenmax -:blank:20 i:Itied i:Ists")
-    _ignored(deck, card, card.lines[2], {"Fscalegap": fscale, "Gap_max": gapmax,
-                                         "Fpenmax": fpenmax, "Itied": itied,
+    gap = _variable_gap(deck, card, igap, fscale, gapmax, units.length)
+    _ignored(deck, card, card.lines[2], {"Fpenmax": fpenmax, "Itied": itied,
                                          "Ists": ists})  # fmt: skip
     stmin, stmax, mesh, dtmin, irem_gap, irem_i2 = card.read(
         3, "f:Stmin f:Stmax f:Percent_mesh_size f:dtmin i:Irem_gap i:Irem_i2")
-    _ignored(deck, card, card.lines[3], {"Stmin": stmin, "Stmax": stmax,
-                                         "%mesh_size": mesh, "dtmin": dtmin,
-                                         "Irem_gap": irem_gap, "Irem_i2": irem_i2})  # fmt: skip
+    gap["size_share"] = _size_share(deck, card, igap, mesh)
+    stiffness = units.factor("force") / units.length
+    bounds = _stiffness_bounds(deck, card, istf, stmin, stmax, stiffness)
+    _ignored(deck, card, card.lines[3], {"dtmin": dtmin, "Irem_i2": irem_i2})
+    if irem_gap == 2:
+        deck.warn(card, "Irem_gap = 2: not honoured: a node is kept off its own segments "
+                  "and their neighbours only (self-contact), not off every segment within "
+                  "the gap through the mesh", card.lines[3])  # fmt: skip
     at = 5 if icurv in (1, 2) else 4  # the curvature's node line
     stfac, fric, gapmin, tstart, tstop = card.read(at, "f:Stfac f:Fric f:GAPmin f:Tstart f:Tstop")
     if stfac < 0:
@@ -127,8 +138,60 @@ def _type7(deck: Deck, card: Card) -> None:
         iid, card.title(), nodes, surf, istf, 1 if igap in (1, 2, 3) else 0,
         gapmin * units.length, stfac or 1.0, fric, ifiltr,
         xfreq * (units.factor("rate") if ifiltr == 3 else 1.0), viss or 0.05,
-        card.header.where,
+        card.header.where, **gap, **bounds,
     ))  # fmt: skip
+
+
+def _variable_gap(deck: Deck, card: Card, igap: int, scale: float, bound: float,
+                  length: float) -> dict:  # fmt: skip
+    """Fscalegap and Gap_max (the deck's length, ``length`` m): read with Igap 2 and 3 (0:
+    1 and no bound), left out
+    with a warning line with Igap 0 and 1 (as Radioss does); a negative one refused."""
+    if scale < 0:
+        card.fail(f"Fscalegap = {scale:g}: the gap scale is > 0 (0: 1)", card.lines[2])
+    if bound < 0:
+        card.fail(f"Gap_max = {bound:g}: the largest gap is > 0 (0: no bound)", card.lines[2])
+    if igap in (2, 3):
+        return {"gap_scale": scale or 1.0, "gap_max": bound * length}
+    for name, value in (("Fscalegap", scale), ("Gap_max", bound)):
+        if value:
+            deck.warn(card, f"{name} = {value:g}: left out: Radioss reads it with Igap 2 and "
+                      f"3 only (Igap = {igap})", card.lines[2])  # fmt: skip
+    return {}
+
+
+def _size_share(deck: Deck, card: Card, igap: int, share: float) -> float:
+    """%mesh_size: each shell's share of the variable gap at most this fraction of its
+    shortest side, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
+    line with Igap 0 to 2 (as Radioss does; 0.4 kept, the cap of every variable gap)."""
+    if not 0.0 <= share <= 1.0:
+        card.fail(f"%mesh_size = {share:g}: the share of the shortest side is in (0, 1] (0: "
+                  "0.4)", card.lines[3])  # fmt: skip
+    if share and igap != 3:
+        deck.warn(card, f"%mesh_size = {share:g}: left out: Radioss reads it with Igap 3 only "
+                  f"(Igap = {igap}); 0.4 kept", card.lines[3])  # fmt: skip
+        return 0.4
+    return share or 0.4
+
+
+def _stiffness_bounds(deck: Deck, card: Card, istf: int, low: float, high: float,
+                      unit: float) -> dict:  # fmt: skip
+    """Stmin and Stmax (the deck's stiffness, ``unit`` N/m): read with Istf 2 to 5 (Stmax
+    0: no bound), left out with a
+    warning line with Istf 0 and 1000 (as Radioss does); negative or crossed, refused."""
+    if low < 0 or high < 0:
+        card.fail(f"Stmin = {low:g}, Stmax = {high:g}: the bounds of the stiffness are >= 0 "
+                  "(Stmax 0: no bound)", card.lines[3])  # fmt: skip
+    if high and low > high:
+        card.fail(f"Stmin = {low:g} is above Stmax = {high:g}: the bounds of the stiffness",
+                  card.lines[3])  # fmt: skip
+    if istf in (2, 3, 4, 5):
+        return {"stiffness_min": low * unit, "stiffness_max": high * unit}
+    for name, value in (("Stmin", low), ("Stmax", high)):
+        if value:
+            deck.warn(card, f"{name} = {value:g}: left out: Radioss reads it with Istf 2 to 5 "
+                      f"only (Istf = {istf})", card.lines[3])  # fmt: skip
+    return {}
 
 
 def _older(deck: Deck, card: Card) -> None:
