@@ -124,7 +124,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
         share = GapShare.of(spec)
         node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
-        gap = spec.gap if spec.gap is not None else _gap_floor(start, edge)
+        gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
 
         def passes(sides=sides, nodes=nodes, spec=spec, share=share) -> list[Pass]:
             """The passes of the interface from its sides' surfaces as they are."""
@@ -220,13 +220,14 @@ def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | N
             np.concatenate([p[2] for p in pieces]).reshape(-1, 3)[order])  # fmt: skip
 
 
-def _gap_floor(sides, edge: float) -> float:
+def _gap_floor(sides, edge: float, scale: float = 1.0) -> float:
     """The default (constant, or the floor of a variable) gap (m): Radioss's Gapmin,
-    min(thinnest shell, half the shortest side) with shells, 0.1 x the shortest edge of
-    solids' faces."""
+    min(thinnest shell x ``scale``, half the shortest side) with shells (``i7sti3.F``:
+    the thickness scaled by Fscalegap, the floor not bounded by Gap_max), 0.1 x the
+    shortest edge of solids' faces."""
     thickness = [2.0 * -s.depth[s.depth < 0.0] for pair in sides for s in pair[:2]]
     thickness = np.concatenate(thickness)
-    return min(float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
+    return min(scale * float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
 
 
 # A shell's share of a variable gap is at most this fraction of its shortest side (Radioss
