@@ -1,0 +1,128 @@
+"""The TYPE7 fields that shape the variable gap and bound the penalty stiffness, read
+where Radioss reads them (``hm_read_inter_type07.F``): Fscalegap and Gap_max with Igap 2
+and 3, %mesh_size with Igap 3, Stmin and Stmax with Istf 2 to 5. A deck with them gives
+the [[contact]] a scene would write for the same interface (gap_scale, gap_max,
+gap_size_share, stiffness_min, stiffness_max); where Radioss leaves a field out, one
+warning line says so; a bad value is one line naming the field.
+
+The deck is ``test_deck_contacts``'s plate in self-contact, in kg-mm-ms: a length of 1 is
+1 mm, a stiffness of 1 is 1 kN/mm = 1e6 N/m.
+"""
+
+import logging
+
+import pytest
+from mpi4py import MPI
+
+from rwall_fem.radioss import DeckError, load_deck
+from rwall_fem.scene.schema import ContactSpec
+
+from .test_deck_contacts import field, tube
+
+comm = MPI.COMM_WORLD
+
+
+def _set(*fields):
+    """An edit writing ``(row, column, text)`` into the /INTER/TYPE7 card."""
+
+    def edit(lines, k):
+        for row, start, text in fields:  # integers 10 wide, reals 20
+            field(lines, k, row, start, text.rjust(10 if row == 1 or start >= 80 else 20))
+
+    return edit
+
+
+IGAP = lambda v: (1, 40, str(v))  # noqa: E731
+ISTF = lambda v: (1, 20, str(v))  # noqa: E731
+FSCALE = lambda v: (2, 0, str(v))  # noqa: E731
+GAPMAX = lambda v: (2, 20, str(v))  # noqa: E731
+STMIN = lambda v: (3, 0, str(v))  # noqa: E731
+STMAX = lambda v: (3, 20, str(v))  # noqa: E731
+MESH = lambda v: (3, 40, str(v))  # noqa: E731
+IREM = lambda v: (3, 80, str(v))  # noqa: E731
+
+
+def load(shared_dir, caplog, *fields):
+    """The deck's one contact and the warning lines of its interface."""
+    log = logging.getLogger("rwall_fem")  # as test_deck_contacts: the command line, run
+    log.addHandler(caplog.handler)  # in-process by other tests, stops it propagating
+    try:
+        with caplog.at_level("WARNING", logger="rwall_fem"):
+            (contact,) = load_deck(tube(shared_dir, _set(*fields))).contacts
+    finally:
+        log.removeHandler(caplog.handler)
+    # once each: the handler added and the root's (when the logger propagates) both see it
+    said = dict.fromkeys(r.getMessage() for r in caplog.records)
+    return contact, [s for s in said if "/INTER/TYPE7/1" in s]
+
+
+SELF = dict(single_surface=True)
+
+
+@pytest.mark.parametrize(
+    "fields, scene",
+    [
+        ([IGAP(3), FSCALE(0.5), GAPMAX(0.4), MESH(0.3)],
+         ContactSpec(**SELF, gap_scale=0.5, gap_max=4e-4, gap_size_share=0.3)),
+        ([IGAP(2), FSCALE(0.5), GAPMAX(0.4)],
+         ContactSpec(**SELF, gap_scale=0.5, gap_max=4e-4)),
+        ([IGAP(3)], ContactSpec(**SELF)),  # blank: 1, no bound, 0.4
+        ([ISTF(2), STMIN(10), STMAX(300)],
+         ContactSpec(**SELF, gap=1e-3, stiffness_min=1e7, stiffness_max=3e8)),
+        ([ISTF(4), STMIN(10)], ContactSpec(**SELF, gap=1e-3, stiffness_min=1e7)),
+    ],
+    ids=["igap3", "igap2", "igap3-blank", "istf2-bounds", "istf4-min"],
+)
+def test_the_deck_gives_the_scene_contact(fields, scene, shared_dir, caplog):
+    contact, said = load(shared_dir, caplog, *fields)
+    _same(contact, scene)
+    assert not any("left out" in s or "Igap = 2" in s for s in said), said
+
+
+def _same(a: ContactSpec, b: ContactSpec) -> None:
+    """Equal, the lengths and stiffnesses to round-off of the unit conversion."""
+    for name in ContactSpec.__dataclass_fields__:
+        x, y = getattr(a, name), getattr(b, name)
+        if isinstance(x, float) and isinstance(y, float):
+            assert x == pytest.approx(y, rel=1e-12), name
+        else:
+            assert x == y, name
+
+
+@pytest.mark.parametrize(
+    "fields, line, check",
+    [
+        ([IGAP(1), FSCALE(0.5)], "Fscalegap = 0.5: left out: Radioss reads it with Igap 2 "
+         "and 3 only (Igap = 1)", lambda c: c.gap_scale == 1.0),
+        ([GAPMAX(0.4)], "Gap_max = 0.4: left out", lambda c: c.gap_max is None),
+        ([IGAP(2), MESH(0.3)], "%mesh_size = 0.3: left out: Radioss reads it with Igap 3 only",
+         lambda c: c.gap_size_share == 0.4),
+        ([STMAX(300)], "Stmax = 300: left out: Radioss reads it with Istf 2 to 5 only",
+         lambda c: c.stiffness_max is None),
+        ([IREM(2)], "Irem_gap = 2: not honoured", lambda c: True),
+    ],
+    ids=["fscale-igap1", "gapmax-igap0", "mesh-igap2", "stmax-istf0", "irem-gap"],
+)
+def test_fields_radioss_leaves_out_give_one_line(fields, line, check, shared_dir, caplog):
+    contact, said = load(shared_dir, caplog, *fields)
+    assert check(contact)
+    assert sum(line in s for s in said) == 1, said
+    assert all("\n" not in s for s in said)
+
+
+@pytest.mark.parametrize(
+    "fields, message",
+    [
+        ([IGAP(3), GAPMAX(-1)], "Gap_max = -1: the largest gap is > 0"),
+        ([IGAP(3), FSCALE(-0.5)], "Fscalegap = -0.5: the gap scale is > 0"),
+        ([IGAP(3), MESH(1.5)], "%mesh_size = 1.5: the share of the shortest side is in (0, 1]"),
+        ([ISTF(2), STMIN(-1)], "Stmin = -1, Stmax = 0: the bounds of the stiffness are >= 0"),
+        ([ISTF(2), STMIN(10), STMAX(5)], "Stmin = 10 is above Stmax = 5"),
+    ],
+    ids=["gapmax", "fscale", "mesh", "stmin", "crossed"],
+)
+def test_bad_values_are_one_line(fields, message, shared_dir):
+    with pytest.raises(DeckError) as caught:
+        load_deck(tube(shared_dir, _set(*fields)))
+    said = str(caught.value)
+    assert message in said and "\n" not in said and "model_0000.rad:" in said
