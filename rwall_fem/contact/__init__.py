@@ -14,8 +14,11 @@ On a body of shells the segments are the shells, both sides active
 (:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
 variable, as Radioss's Igap 1: a node against a segment gets half the thickness of the
 thickest shell at the node plus half the segment's (half the sum of the thicknesses),
-floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side). A given
-``gap`` is constant (Radioss Igap 0).
+floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side); each
+shell's share is at most ``gap_size_share`` x its shortest side, scaled by ``gap_scale``
+and at most ``gap_max`` / 2 (Radioss Igap 2 and 3: :class:`GapShare`). A given ``gap`` is
+constant (Radioss Igap 0). The penalty stiffness of each segment is bounded by
+``stiffness_min`` and ``stiffness_max`` (Radioss Stmin, Stmax).
 
 The faces of solid parts on a symmetry plane (a plane x_c = const whose nodes a
 ``[[boundary]]`` holds at zero velocity in c) are left out of the surfaces
