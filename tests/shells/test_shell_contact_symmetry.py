@@ -187,3 +187,28 @@ def test_a_half_and_a_quarter_meet_as_the_whole(tmp_path_factory, name, triangle
     for cuts, found in worst.items():
         for key, error in found.items():
             assert error <= 1e-11, (cuts, key)
+
+
+def test_the_nodes_on_the_planes_and_only_they_act_as_shares(shared_dir):
+    """The quarter's nodes on x = 0 or y = 0 (the plate's 21, the cap's 13) hold their
+    share of the whole node, 1/2, and the two on both planes 1/4; a sheet lying in a plane
+    whose edge is held in that plane's normal with its rotations (a sliding clamp: the
+    plate's rim held in z, its rotations about x and y held) is not cut there: nothing
+    acts as a share."""
+    from rwall_fem import build_simulation, parse_scene
+
+    def shares(raw):
+        sim = build_simulation(parse_scene(raw, source="test"), comm, shared_dir)
+        mirrored = sim.contacts[0].mirrored
+        if mirrored is None:
+            return {}
+        share, planes = mirrored
+        counted = {(s, p): comm.allreduce(int(np.sum((share == s) & (planes == p))))
+                   for s, p in ((0.5, 1), (0.5, 2), (0.25, 3))}  # fmt: skip
+        return counted | {"others": comm.allreduce(int(np.sum((share < 1.0) & (planes == 0))))}
+
+    quarter = scene(shared_dir, "xy", CONTACTS["two_parts"])
+    assert shares(quarter) == {(0.5, 1): 10 + 6, (0.5, 2): 10 + 6, (0.25, 3): 2, "others": 0}
+    sliding = scene(shared_dir, "", CONTACTS["two_parts"])
+    sliding["boundary"] = [{"group": "rim", "components": "z", "rotations": "xy"}]
+    assert shares(sliding) == {}
