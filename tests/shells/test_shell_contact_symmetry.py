@@ -99,7 +99,7 @@ def write_msh(path, cut_x: bool, cut_y: bool, triangles=False) -> None:
     out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names))]
     out += [f'{d} {t} "{name}"' for d, t, name in names]
     out += ["$EndPhysicalNames", "$Nodes", str(len(nodes))]
-    out += [f"{k + 1} {x!r} {y!r} {z!r}" for k, (x, y, z) in enumerate(nodes)]
+    out += [f"{k + 1} {x:.17g} {y:.17g} {z:.17g}" for k, (x, y, z) in enumerate(nodes)]
     out += ["$EndNodes", "$Elements", str(len(lines) + len(cells))]
     k = 0
     for group, p, q in lines:
