@@ -196,7 +196,8 @@ def held_plane_sides(body, k: int, comm, held) -> tuple[Surface, np.ndarray]:
     sides[:, 0] = ids[:, :corners].ravel()
     sides[:, 1] = np.roll(ids[:, :corners], -1, axis=1).ravel()
     edges = np.repeat(edge, corners)
-    axis = held_plane_faces(Surface(sides, 0.0 * edges, 0.0 * edges, edges), *held)
+    zero = np.zeros_like(edges)
+    axis = held_plane_faces(Surface(sides, zero, zero, edges), *held)
     leaves = np.repeat(spread, corners, axis=0)[np.arange(len(sides)), np.maximum(axis, 0)]
     on = (axis >= 0) & (leaves > 1e-9 * edges)
     gathered = comm.allgather((sides[on], axis[on], edges[on]))
@@ -204,7 +205,8 @@ def held_plane_sides(body, k: int, comm, held) -> tuple[Surface, np.ndarray]:
     axis = np.concatenate([g[1] for g in gathered]).astype(np.int64)
     edges = np.concatenate([g[2] for g in gathered])
     _, first = np.unique(np.sort(sides[:, :2], axis=1), axis=0, return_index=True)
-    return Surface(sides[first], 0.0 * edges[first], 0.0 * edges[first], edges[first]), axis[first]
+    zero = np.zeros(len(first))
+    return Surface(sides[first], zero, zero, edges[first]), axis[first]
 
 
 def once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:

@@ -202,6 +202,9 @@ def _shell_scene(directory) -> dict:
     }  # fmt: skip
 
 
+TET_FACES = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
+
+
 def _tet_faces(points, cells) -> np.ndarray:
     """The faces of the tetrahedra (rows of 3 point indices) in the planes z = 0 (the
     plate's top, from the cells below) and z = gap (the block's bottom, from above)."""
@@ -209,7 +212,7 @@ def _tet_faces(points, cells) -> np.ndarray:
     centre = points[cells].mean(axis=1)[:, 2]
     for z, above in ((0.0, False), (0.1 * H * (1 + 1e-6), True)):
         mine = cells[(centre > z) == above]
-        every = np.concatenate([mine[:, list(f)] for f in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))])
+        every = np.concatenate([mine[:, list(f)] for f in TET_FACES])
         faces.append(every[np.all(np.abs(points[every, 2] - z) <= 1e-9, axis=1)])
     return np.concatenate(faces)
 
@@ -251,7 +254,8 @@ def test_the_contact_pressure_on_triangles_is_the_force_over_a_third_of_the_area
             normal = mine.sum(axis=0) / np.linalg.norm(mine.sum(axis=0))
             tributary = np.linalg.norm(mine, axis=1).sum() / 3.0
             expected = abs(force[node] @ normal) / tributary
-            assert pressure[node] == pytest.approx(expected, rel=1e-9, abs=1e-12 * largest), (k, node)
+            close = pytest.approx(expected, rel=1e-9, abs=1e-12 * largest)
+            assert pressure[node] == close, (k, node)
             assert tributary == pytest.approx(count[node] * H**2 / 6.0, rel=1e-3)
             checked += 1
             kinds.add(int(count[node]))
