@@ -23,6 +23,9 @@ constant (Radioss Igap 0). The penalty stiffness of each segment is bounded by
 The faces of solid parts on a symmetry plane (a plane x_c = const whose nodes a
 ``[[boundary]]`` holds at zero velocity in c) are left out of the surfaces
 (:func:`~rwall_fem.contact.surface.held_plane_faces`); their nodes stay secondary nodes.
+Shells are cut along their sides (:func:`~rwall_fem.contact.surface.held_plane_sides`: the
+nodes held in c have their rotations about the two other axes held too) and stay segments.
+The nodes on the planes act with their share of the whole node (:func:`_mirror`).
 """
 
 from __future__ import annotations
@@ -41,7 +44,13 @@ from rwall_fem.contact.erosion import (
     may_erode,
 )
 from rwall_fem.contact.interface import ContactInterface, Pass
-from rwall_fem.contact.surface import Surface, held_plane_faces, part_surface, shell_surface
+from rwall_fem.contact.surface import (
+    Surface,
+    held_plane_faces,
+    held_plane_sides,
+    part_surface,
+    shell_surface,
+)
 
 __all__ = ["build_contacts"]
 
@@ -64,9 +73,11 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     surfaces: dict[str, Surface] = {}
     eroding: dict[str, ErodingSurface] = {}  # the parts whose cells may erode
     interfaces = []
-    held = None if solid.shells else _held_at_rest(scene, solid)
-    cut: dict[str, Surface] = {}  # the faces of each part left out, on symmetry planes
-    axes: dict[str, np.ndarray] = {}  # and the axes of their planes
+    held = _held_at_rest(scene, solid)
+    # The faces of each solid part left out, on symmetry planes (shells: the sides on
+    # them), and the axes of their planes
+    cut: dict[str, Surface] = {}
+    axes: dict[str, np.ndarray] = {}
 
     def _total(parts: tuple[str, ...]) -> Surface:
         """The faces of ``parts`` now, part after part."""
@@ -96,14 +107,16 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                         eroding[name] = ErodingShells(body, k, comm, force)
                     else:
                         eroding[name] = ErodingSurface(body, k, comm, force, held)
-                    if held is not None:
+                    if held is not None and not solid.shells:
                         cut[name], axes[name] = eroding[name].cut, eroding[name].axes
                 else:
                     surfaces[name] = faces(body, k, comm)
-                    if held is not None:
+                    if held is not None and not solid.shells:
                         axis = held_plane_faces(surfaces[name], *held)
                         cut[name], axes[name] = surfaces[name].select(axis >= 0), axis[axis >= 0]
                         surfaces[name] = surfaces[name].select(axis < 0)
+                if held is not None and solid.shells:
+                    cut[name], axes[name] = held_plane_sides(body, k, comm, held)
             total = _total(parts)
             if not len(total.segments):
                 raise SceneError(f"{where}.{key}: the parts {', '.join(parts)} have no "
@@ -158,7 +171,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         if left_out:
             _mirror(interface, nodes, [(cut[name], axes[name]) for name in left_out])
             logging.getLogger("rwall_fem").info(
-                "%s: faces on symmetry planes left out of the surface: %s", interface.name,
+                "%s: %s on symmetry planes: %s", interface.name,
+                "shell sides" if solid.shells else "faces left out of the surface",
                 ", ".join(f"{n} {name}" for name, n in left_out.items()))  # fmt: skip
         gap = interface.gap_max  # the largest of a variable gap
         for key, parts in (("main", spec.main or tuple(names)), ("secondary", spec.secondary)):
@@ -181,9 +195,9 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
 
 def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray]]) -> None:
     """Let ``interface`` (over the surface nodes ``nodes``) act as in the whole model of a
-    model cut by symmetry planes: each node of the faces left out (``planes``: the faces
-    and the axes of their planes) is on those planes, and holds 1/2 of the whole node per
-    plane (``kernels/contact.c``, mirror)."""
+    model cut by symmetry planes: each node of the faces left out or shell sides on the
+    planes (``planes``: those and the axes of their planes) is on those planes, and holds
+    1/2 of the whole node per plane (``kernels/contact.c``, mirror)."""
     on = np.zeros(len(nodes), dtype=np.int8)
     for faces, axis in planes:
         ids = faces.segments
@@ -199,12 +213,14 @@ def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray
 
 
 def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """The nodes that ``[[boundary]]`` tables hold at zero velocity in some component, the
-    same on every rank: their global numbers (sorted), positions (m) and held components
-    (rows of 3 booleans); None without such a table."""
+    """The nodes that ``[[boundary]]`` tables hold at zero velocity in some component c
+    (on shells, with their rotations about the two other axes held: a symmetry plane's
+    condition), the same on every rank: their global numbers (sorted), positions (m) and
+    held components (rows of 3 booleans); None without such a table."""
     from rwall_fem.meshing import group_nodes
 
     held = np.zeros((solid.owned, 3), dtype=bool)
+    turns = np.zeros((solid.owned, 3), dtype=bool)  # the rotations held (shells)
     for spec in scene.boundaries:
         v = np.asarray(spec.velocity, dtype=float)
         rest = np.all(v[:, 1:] == 0.0, axis=0) if v.ndim == 2 else v == 0.0
@@ -212,6 +228,10 @@ def _held_at_rest(scene, solid) -> tuple[np.ndarray, np.ndarray, np.ndarray] | N
         nodes = nodes[nodes < solid.owned]
         for c in spec.components:
             held[nodes, "xyz".index(c)] |= bool(rest["xyz".index(c)])
+        for c in spec.rotations or "":
+            turns[nodes, "xyz".index(c)] = True
+    if solid.shells:
+        held &= np.roll(turns, -1, axis=1) & np.roll(turns, -2, axis=1)
     if not solid.comm.allreduce(bool(held.any()), op=MPI.LOR):
         return None
     mine = np.flatnonzero(held.any(axis=1))

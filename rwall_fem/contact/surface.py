@@ -25,6 +25,12 @@ holds at zero velocity in c: the body goes on beyond it (its mirror image, or wh
 holds it), so nothing can come at it from outside, and a node of another body cut by the
 same plane, sliding in that plane, would be taken as a whole gap inside it.
 
+A shell is cut by a symmetry plane along its sides, not its faces, and stays a segment:
+:func:`held_plane_sides` finds the sides on such planes (a side of a shell that leaves the
+plane, lying in a plane x_c = const whose nodes a boundary condition holds at zero
+velocity in c with their rotations about the two other axes held), whose nodes act with
+their share of the whole node (:mod:`rwall_fem.contact`).
+
 Every rank gets every segment of the interface, in global node numbers, sorted by their
 nodes (the same on every rank); the interface keeps each rank's share of them
 (:mod:`rwall_fem.contact.interface`).
@@ -36,8 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Surface", "boundary_faces", "cell_faces", "held_plane_faces", "part_surface",
-           "once", "shell_segments", "shell_surface"]
+__all__ = ["Surface", "boundary_faces", "cell_faces", "held_plane_faces", "held_plane_sides",
+           "part_surface", "once", "shell_segments", "shell_surface"]
 
 # The faces of DOLFINx's reference cells as cycles of their vertices.
 _FACES = {
@@ -168,6 +174,39 @@ def held_plane_faces(surface: Surface, nodes: np.ndarray, x: np.ndarray,
     flat = spread <= 1e-9 * surface.edge[:, None]
     on = flat & fixed.all(axis=1) & ~fixed.all(axis=(1, 2))[:, None]
     return np.where(on.any(axis=1), np.argmax(on, axis=1), -1)
+
+
+def held_plane_sides(body, k: int, comm, held) -> tuple[Surface, np.ndarray]:
+    """The sides of the shells of part ``k`` of ``body`` (a
+    :class:`~rwall_fem.shells.body.ShellBody`) on symmetry planes, the same on every rank
+    of ``comm`` (collective): each as a segment of 2 nodes (its 3rd and 4th -1, its
+    stiffness and depth 0, its shell's shortest side), and the axis c of its plane. A side
+    is on a plane x_c = const as a solid's face is (:func:`held_plane_faces`, ``held``: the
+    nodes held in c, for shells those whose rotations about the two other axes are held
+    too), and its shell leaves the plane (a corner off it by more than 1e-9 of its
+    shortest side): a sheet lying in the plane, held so, is clamped there, not cut."""
+    ids, values = shell_segments(body, k)
+    X = body.elements[k].X
+    local = body.elements[k].cells
+    corners = local.shape[1]
+    edge = values[:, 2]
+    x = X[local]  # (cells, corners, 3)
+    spread = x.max(axis=1) - x.min(axis=1)  # (cells, 3)
+    sides = np.full((len(ids) * corners, 4), -1, dtype=np.int64)
+    sides[:, 0] = ids[:, :corners].ravel()
+    sides[:, 1] = np.roll(ids[:, :corners], -1, axis=1).ravel()
+    edges = np.repeat(edge, corners)
+    zero = np.zeros_like(edges)
+    axis = held_plane_faces(Surface(sides, zero, zero, edges), *held)
+    leaves = np.repeat(spread, corners, axis=0)[np.arange(len(sides)), np.maximum(axis, 0)]
+    on = (axis >= 0) & (leaves > 1e-9 * edges)
+    gathered = comm.allgather((sides[on], axis[on], edges[on]))
+    sides = np.concatenate([g[0] for g in gathered]).reshape(-1, 4)
+    axis = np.concatenate([g[1] for g in gathered]).astype(np.int64)
+    edges = np.concatenate([g[2] for g in gathered])
+    _, first = np.unique(np.sort(sides[:, :2], axis=1), axis=0, return_index=True)
+    zero = np.zeros(len(first))
+    return Surface(sides[first], zero, zero, edges[first]), axis[first]
 
 
 def once(ids: np.ndarray, values: np.ndarray, comm) -> Surface:
