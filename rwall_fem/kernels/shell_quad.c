@@ -394,7 +394,10 @@ INLINE vec quad_length_qeph(const quad_frame_t *g, double dn)
 }
 
 /* Radioss's characteristic length (m) of the cells of frame g: CDLEN3's for its
- * Belytschko-Tsay shells, or QEPH's with s->qeph_step. */
+ * Belytschko-Tsay shells, max(A / longest diagonal, shortest side or diagonal) on the
+ * cell's projection onto its mid-plane (CDLEN3 takes the in-plane coordinates X2..Y4 of
+ * cderi3.F: a warped cell's sides count as their projections), or QEPH's with
+ * s->qeph_step. */
 INLINE vec quad_length(const shell_params *s, const quad_frame_t *g)
 {
   if (s->qeph_step)
@@ -405,8 +408,7 @@ INLINE vec quad_length(const shell_params *s, const quad_frame_t *g)
   {
     const vec dx = g->x[PAIRS[e][1]] - g->x[PAIRS[e][0]];
     const vec dy = g->y[PAIRS[e][1]] - g->y[PAIRS[e][0]];
-    const vec dz = g->z[PAIRS[e][1]] - g->z[PAIRS[e][0]];
-    l2[e] = dx * dx + dy * dy + dz * dz;
+    l2[e] = dx * dx + dy * dy;
   }
   vec shortest = l2[0];
   for (int e = 1; e < 6; ++e)

@@ -208,6 +208,22 @@ def test_characteristic_length():
     assert length[0] == pytest.approx(max(2.0 / math.sqrt(5.0), 1.0), rel=1e-14)
 
 
+@pytest.mark.parametrize("sides, warp", [((1.0, 1.0), 0.3), ((2.0, 1.0), 0.45), ((1.0, 1.0), 0.0)])
+def test_characteristic_length_of_a_warped_cell(sides, warp):
+    """CDLEN3 works on the cell's projection onto its mid-plane (cderi3.F's X2..Y4): a
+    rectangle a x b whose corners are lifted +w, -w, +w, -w off it has the rectangle's
+    L_c = max(a b / (a^2 + b^2)^(1/2), min(a, b)), not the longer one of its sides in
+    space ((min(a, b)^2 + 4 w^2)^(1/2)), wherever it is in space."""
+    a, b = sides
+    X = np.array([[0.0, 0.0, warp], [a, 0.0, -warp], [a, b, warp], [0.0, b, -warp]])
+    X = X @ rotation([1.0, -2.0, 0.5], 1.1).T + [0.5, 2.0, -1.0]
+    kernel = ShellKernel(ELASTIC, ShellTechnology.choose("quadrilateral"),
+                         np.array([[0, 1, 2, 3]], np.int32), T)  # fmt: skip
+    area, length = kernel.sizes(X)
+    assert area[0] == pytest.approx(a * b, rel=1e-13)
+    assert length[0] == pytest.approx(max(a * b / math.hypot(a, b), min(a, b)), rel=1e-13)
+
+
 def qeph_length(x, y, dn=0.015):
     """QEPH's L_c (OpenRadioss's CZCORC1 and CNDT3) of a flat cell with corners (x, y)."""
     x, y = np.asarray(x) - np.mean(x), np.asarray(y) - np.mean(y)
