@@ -148,10 +148,6 @@ INLINE vec capped_flow_stress(const element_params *p, vec e, vec factor,
   return flow_stress(p, e, VZERO, VZERO, slope); /* capped; factor 1 */
 }
 
-/* The residual sigma_y / q - 1 a plane-stress return leaves (plane_stress_returns): the
- * flow stress and the returned von Mises stress agree to this share. */
-#define RETURN_TOLERANCE 1e-8
-
 /* Terms of the binomial series of (1 + x)^n used by near_flow_stress. */
 #define BINOMIAL_TERMS 13
 
@@ -228,16 +224,11 @@ INLINE vec von_mises_squared(const vec sig[3])
  * c = (k1 P1 + 2 G P2) / q_tr^2 (P1 = p^2 / 4, P2 = 3 d^2 / 4 + 3 sxy^2), h the slope of the
  * law at eps_p (the secant over the perfectly plastic increment at eps_p = 0, where a power
  * law's is infinite); kept in the bracket [0, (q_tr / y0 - 1) / k1], whose midpoint is
- * geometric while it spans decades.  A lane stops once the residual the step just taken
- * leaves is within RETURN_TOLERANCE by Newton's quadratic convergence, |R_k| (dg_k /
- * dg_(k-1))^2 with dg_(-1) the start's step from g = 0 (in steady flow R is 1e-4 to 1e-6 at
- * the start and the one step leaves 1e-8 to 1e-12), or once |R| at the previous iterate is
- * below 1e-7, or g moves by round-off; from eps_p = 0, where the power law's infinite
- * slope makes the residual no guide to the next one's, only once |R| is itself below
- * 1e-13.  Each lane keeps its g from its own stop, so that its result does not depend on
- * the lanes it is batched with.  The power laws' flow stress in the iterations is
- * near_flow_stress's series about eps_p while the increment is below eps_p / 20, else exp
- * and log. */
+ * geometric while it spans decades.  It stops once |R| at the previous iterate is below 1e-7
+ * (the step just taken leaves one of order 1e-14; 1e-13 from eps_p = 0, where the power
+ * law's infinite slope makes the residual no guide to the next one's) or g moves by
+ * round-off.  The power laws' flow stress in the iterations is near_flow_stress's series
+ * about eps_p while the increment is below eps_p / 20, else exp and log. */
 INLINE void plane_stress_returns(const element_params *p, const shell_params *s, int n,
                                  vec sig[][3], const vec eps_p[], const vec rate[],
                                  const vec T[], const vec q_old2[], vec d[], vec flow[])
@@ -309,7 +300,6 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
   vec pp[SHELL_MAX_POINTS], dd[SHELL_MAX_POINTS], P1[SHELL_MAX_POINTS], P2[SHELL_MAX_POINTS];
   vec g[SHELL_MAX_POINTS], lo[SHELL_MAX_POINTS], hi[SHELL_MAX_POINTS];
   vec tolerance[SHELL_MAX_POINTS];
-  ivec virgin_lane[SHELL_MAX_POINTS];
   for (int a = 0; a < m; ++a)
   {
     const int j = which[a];
@@ -323,7 +313,6 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     /* from eps_p = 0 a power law's slope is infinite and the residual no guide to the next
      * step's: iterate until it is itself at round-off */
     tolerance[a] = vselect(virgin, VZERO + 1e-13, VZERO + 1e-7);
-    virgin_lane[a] = virgin;
     near[a] = power_law && !shell_any(virgin);
     const vec safe_q = vselect(flowing, q_trial[a], VZERO + 1.0);
     lo[a] = VZERO;
@@ -343,13 +332,6 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
   }
   double binomial[BINOMIAL_TERMS];
   binomial_coefficients(p->hardening_exponent, binomial);
-  ivec active[SHELL_MAX_POINTS];
-  vec last_step[SHELL_MAX_POINTS], g_final[SHELL_MAX_POINTS];
-  for (int a = 0; a < m; ++a)
-  {
-    active[a] = plastic[a];
-    last_step[a] = g_final[a] = g[a]; /* the start's step from g = 0 */
-  }
   for (int iteration = 0; iteration < 50; ++iteration)
   {
     vec q[SHELL_MAX_POINTS], dq[SHELL_MAX_POINTS], rq[SHELL_MAX_POINTS];
@@ -399,25 +381,12 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       }
       const vec change = vabs(next - g[a]);
       g[a] = vselect(plastic[a], next, VZERO);
-      /* the lane's return ends with the step just taken when |R| was within its tolerance,
-       * g moved by round-off, or (not virgin) the residual the step leaves, about
-       * |R| (change / last_step)^2 by Newton's quadratic convergence, is within
-       * RETURN_TOLERANCE; its g is kept from then on while the other lanes iterate, so that
-       * a cell's result does not depend on the cells it is batched with */
-      const ivec predicted = ~virgin_lane[a] & (vabs(R) * change * change
-                                                <= RETURN_TOLERANCE * last_step[a] * last_step[a]);
-      const ivec stop = active[a] & (~((vabs(R) > tolerance[a])
-                                       & (change > 1e-15 * g[a] + 1e-300)) | predicted);
-      g_final[a] = vselect(stop, g[a], g_final[a]);
-      active[a] &= ~stop;
-      last_step[a] = change;
-      more |= shell_any(active[a]);
+      more |= shell_any(plastic[a] & (vabs(R) > tolerance[a])
+                        & (change > 1e-15 * g[a] + 1e-300));
     }
     if (!more)
       break;
   }
-  for (int a = 0; a < m; ++a) /* lanes still active after 50 iterations keep their last g */
-    g[a] = vselect(active[a], g[a], g_final[a]);
   for (int a = 0; a < m; ++a)
   {
     const int j = which[a];
