@@ -60,8 +60,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     acting on ``state``, whose cells erode as those of ``internal`` (the
     :class:`~rwall_fem.body.Body` of the step; default: the solid's);
     :class:`~rwall_fem.scene.SceneError` (one line, on every rank)
-    for a part the body does not have, a side without faces, or a gap not smaller than a
-    part."""
+    for a part the body does not have, a side without faces, a key of the variable gap on
+    a body of solids, or a gap not smaller than a part."""
     from rwall_fem.scene import SceneError
     from rwall_fem.scene.keys import did_you_mean
     from rwall_fem.walls.constraint import filter_alpha
@@ -89,6 +89,11 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
 
     for i, spec in enumerate(scene.contacts):
         where = f"{scene.source}: contact[{i}]"
+        share = GapShare.of(spec)
+        if share.keys() and not solid.shells:
+            raise SceneError(f"{where}.{share.keys()[0]}: shapes the variable gap of shells; "
+                             "a body of solids has a constant gap (gap, default 0.1 x the "
+                             "shortest edge): leave it out")  # fmt: skip
 
         def side(key: str, parts: tuple[str, ...]) -> Surface:
             for name in parts:
@@ -138,7 +143,6 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                                          + [s.nodes for s in here]))  # fmt: skip
         edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
-        share = GapShare.of(spec)
         node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
 
@@ -276,6 +280,14 @@ class GapShare:
         """The share of the ``[[contact]]`` table ``spec``."""
         cap = math.inf if spec.gap_max is None else 0.5 * spec.gap_max
         return cls(spec.gap_scale, spec.gap_size_share, cap)
+
+    def keys(self) -> list[str]:
+        """The ``[[contact]]`` keys that make this share differ from the default one."""
+        default = GapShare()
+        return [key for key, given, usual in (("gap_scale", self.scale, default.scale),
+                                              ("gap_max", self.cap, default.cap),
+                                              ("gap_size_share", self.size, default.size))
+                if given != usual]  # fmt: skip
 
 
 def _bounded_stiffness(spec, stiffness: np.ndarray) -> np.ndarray:

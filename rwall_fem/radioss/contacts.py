@@ -92,13 +92,17 @@ def _common(deck: Deck, inter, main: list[DeckPart], where: str) -> dict:
     if inter.gap_min:
         deck.warnings.append(f"{where}: GAPmin = {inter.gap_min:g} m: not honoured with a "
                              "variable gap (Igap 1): its floor is Radioss's default")  # fmt: skip
-    if inter.gap_scale != 1.0:
-        table["gap_scale"] = inter.gap_scale
-    if inter.gap_max:
-        table["gap_max"] = inter.gap_max
-    if inter.size_share != 0.4:
-        table["gap_size_share"] = inter.size_share
-    return table
+    shaping = {"gap_scale": ("Fscalegap", inter.gap_scale, 1.0),
+               "gap_max": ("Gap_max", inter.gap_max, 0.0),
+               "gap_size_share": ("%mesh_size", inter.size_share, 0.4)}  # fmt: skip
+    given = {key: value for key, (_, value, default) in shaping.items() if value != default}
+    if given and not any(_is_shell(deck, p) for p in main):
+        # A solid's face adds no thickness: its variable gap is the floor alone
+        deck.warnings.append(f"{where}: {', '.join(shaping[k][0] for k in given)}: left out: "
+                             "they shape the gap of shells, and the segments are solids' "
+                             "faces")  # fmt: skip
+        return table
+    return table | given
 
 
 def _default_gap(deck: Deck, main: list[DeckPart]) -> float:

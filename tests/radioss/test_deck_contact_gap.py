@@ -140,3 +140,36 @@ def test_the_deck_builds_the_bounded_interface(shared_dir):
     assert interface.gap_max == pytest.approx(5e-4, rel=1e-12)
     assert interface.k0_range == pytest.approx((1e8, 1e8), rel=1e-12)
     assert interface.shell_half == pytest.approx(2e-4, rel=1e-12)  # each share
+
+
+def test_a_solid_deck_leaves_the_shells_gap_fields_out(shared_dir, caplog):
+    """A self-contact of solids (the bar of ``test_bad_decks``) with Igap 3, Fscalegap,
+    Gap_max and %mesh_size: a solid's face adds no thickness to the gap (Radioss's variable
+    gap of solids is its floor), so the fields are left out with one warning line and the
+    contact keeps the solids' gap; a scene giving them on solids is refused
+    (``bad_scenes/354``)."""
+    from .test_bad_decks import good, written
+    from .test_deck_contacts import TYPE7
+
+    d = good()
+    d.cards += ["/SURF/PART/EXT/1" if c == "/SURF/PART/1" else c for c in TYPE7]
+
+    def edit(lines):
+        _set(IGAP(3), FSCALE(0.5), GAPMAX(0.4), MESH(0.3))(lines, lines.index("/INTER/TYPE7/1"))
+
+    directory = shared_dir / "solid_gap"
+    if comm.rank == 0:
+        directory.mkdir(exist_ok=True)
+    comm.Barrier()
+    log = logging.getLogger("rwall_fem")
+    log.addHandler(caplog.handler)
+    try:
+        with caplog.at_level("WARNING", logger="rwall_fem"):
+            (contact,) = load_deck(written(d, directory, edit)).contacts
+    finally:
+        log.removeHandler(caplog.handler)
+    said = [s for s in dict.fromkeys(r.getMessage() for r in caplog.records)
+            if "Fscalegap, Gap_max, %mesh_size: left out" in s]  # fmt: skip
+    assert len(said) == 1 and "\n" not in said[0], said
+    assert (contact.gap, contact.gap_scale, contact.gap_max, contact.gap_size_share) == (
+        None, 1.0, None, 0.4)
