@@ -183,8 +183,9 @@ def held_plane_sides(body, k: int, comm, held) -> tuple[Surface, np.ndarray]:
     stiffness and depth 0, its shell's shortest side), and the axis c of its plane. A side
     is on a plane x_c = const as a solid's face is (:func:`held_plane_faces`, ``held``: the
     nodes held in c, for shells those whose rotations about the two other axes are held
-    too), and its shell leaves the plane (a corner off it by more than 1e-9 of its
-    shortest side): a sheet lying in the plane, held so, is clamped there, not cut."""
+    too), its shell leaves the plane (a corner off it by more than 1e-9 of its shortest
+    side: a sheet lying in the plane, held so, is clamped there, not cut) and no other
+    shell of the part holds it (a line of a whole model held so is not a cut)."""
     ids, values = shell_segments(body, k)
     X = body.elements[k].X
     local = body.elements[k].cells
@@ -200,11 +201,18 @@ def held_plane_sides(body, k: int, comm, held) -> tuple[Surface, np.ndarray]:
     axis = held_plane_faces(Surface(sides, zero, zero, edges), *held)
     leaves = np.repeat(spread, corners, axis=0)[np.arange(len(sides)), np.maximum(axis, 0)]
     on = (axis >= 0) & (leaves > 1e-9 * edges)
-    gathered = comm.allgather((sides[on], axis[on], edges[on]))
+    shell = np.repeat(np.sort(ids, axis=1), corners, axis=0)  # each side's shell, its nodes
+    gathered = comm.allgather((sides[on], axis[on], edges[on], shell[on]))
     sides = np.concatenate([g[0] for g in gathered]).reshape(-1, 4)
     axis = np.concatenate([g[1] for g in gathered]).astype(np.int64)
     edges = np.concatenate([g[2] for g in gathered])
-    _, first = np.unique(np.sort(sides[:, :2], axis=1), axis=0, return_index=True)
+    shell = np.concatenate([g[3] for g in gathered]).reshape(-1, 4)
+    pair = np.sort(sides[:, :2], axis=1)
+    # Each side of each shell once (a shell may be on several ranks), then the sides of one
+    # shell only: a side between two shells is inside the model, not on its cut
+    _, first = np.unique(np.column_stack([pair, shell]), axis=0, return_index=True)
+    _, inverse, counts = np.unique(pair[first], axis=0, return_inverse=True, return_counts=True)
+    first = first[counts[inverse.ravel()] == 1]
     zero = np.zeros(len(first))
     return Surface(sides[first], zero, zero, edges[first]), axis[first]
 

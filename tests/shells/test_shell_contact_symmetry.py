@@ -66,7 +66,7 @@ def sheet(n: int, cut_x: bool, cut_y: bool, triangles: bool):
 def write_msh(path, cut_x: bool, cut_y: bool, triangles=False) -> None:
     """The plate and the cap as a gmsh 2.2 file: the physical surfaces "plate" and "cap",
     the curves "rim" (the plate's outer edges), "cut_x" and "cut_y" (the edges on x = 0
-    and y = 0 of a cut model)."""
+    and y = 0: of a cut model, its cuts; of the whole, its centre lines)."""
     nodes, cells, lines = [], [], []
     for part, (n, tag) in enumerate(((PLATE, 1), (CAP, 2))):
         grid, conn = sheet(n, cut_x, cut_y, triangles)
@@ -91,10 +91,8 @@ def write_msh(path, cut_x: bool, cut_y: bool, triangles=False) -> None:
                 edge([(-n, j) for j in range(j0, n + 1)], 3)
             if not cut_y:
                 edge([(i, -n) for i in range(i0, n + 1)], 3)
-        if cut_x:
-            edge([(0, j) for j in range(j0, n + 1)], 4)
-        if cut_y:
-            edge([(i, 0) for i in range(i0, n + 1)], 5)
+        edge([(0, j) for j in range(j0, n + 1)], 4)  # a cut, or the whole's centre line
+        edge([(i, 0) for i in range(i0, n + 1)], 5)
     names = [(2, 1, "plate"), (2, 2, "cap"), (1, 3, "rim"), (1, 4, "cut_x"), (1, 5, "cut_y")]
     out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names))]
     out += [f'{d} {t} "{name}"' for d, t, name in names]
@@ -202,7 +200,8 @@ def test_the_nodes_on_the_planes_and_only_they_act_as_shares(shared_dir, erode):
     share of the whole node, 1/2, and the two on both planes 1/4, also when the shells may
     erode (the surfaces then follow the erosion); a sheet lying in a plane whose edge is
     held in that plane's normal with its rotations (a sliding clamp: the plate's rim held
-    in z, its rotations about x and y held) is not cut there: nothing acts as a share."""
+    in z, its rotations about x and y held) is not cut there, nor is the whole model along
+    its centre lines held so (shells on both sides of them): nothing acts as a share."""
     from rwall_fem import build_simulation, parse_scene
 
     def shares(raw):
@@ -224,3 +223,7 @@ def test_the_nodes_on_the_planes_and_only_they_act_as_shares(shared_dir, erode):
     sliding = scene(shared_dir, "", CONTACTS["two_parts"])
     sliding["boundary"] = [{"group": "rim", "components": "z", "rotations": "xy"}]
     assert shares(sliding) == {}
+    whole = scene(shared_dir, "", CONTACTS["two_parts"])
+    whole["boundary"] += [{"group": f"cut_{c}", "components": c,
+                           "rotations": "".join(a for a in "xyz" if a != c)} for c in "xy"]
+    assert shares(whole) == {}
