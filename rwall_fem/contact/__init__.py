@@ -90,8 +90,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     for i, spec in enumerate(scene.contacts):
         where = f"{scene.source}: contact[{i}]"
         share = GapShare.of(spec)
-        if share.keys() and not solid.shells:
-            raise SceneError(f"{where}.{share.keys()[0]}: shapes the variable gap of shells; "
+        if share.scene_keys() and not solid.shells:
+            raise SceneError(f"{where}.{share.scene_keys()[0]}: shapes the variable gap of shells; "
                              "a body of solids has a constant gap (gap, default 0.1 x the "
                              "shortest edge): leave it out")  # fmt: skip
 
@@ -281,7 +281,7 @@ class GapShare:
         cap = math.inf if spec.gap_max is None else 0.5 * spec.gap_max
         return cls(spec.gap_scale, spec.gap_size_share, cap)
 
-    def keys(self) -> list[str]:
+    def scene_keys(self) -> list[str]:
         """The ``[[contact]]`` keys that make this share differ from the default one."""
         default = GapShare()
         return [key for key, given, usual in (("gap_scale", self.scale, default.scale),

@@ -145,8 +145,8 @@ def _type7(deck: Deck, card: Card) -> None:
 def _variable_gap(deck: Deck, card: Card, igap: int, scale: float, bound: float,
                   length: float) -> dict:  # fmt: skip
     """Fscalegap and Gap_max (the deck's length, ``length`` m): read with Igap 2 and 3 (0:
-    1 and no bound), left out
-    with a warning line with Igap 0 and 1 (as Radioss does); a negative one refused."""
+    1 and no bound), left out with a warning line with Igap 0 and 1 (as Radioss does); a
+    negative one refused."""
     if scale < 0:
         card.fail(f"Fscalegap = {scale:g}: the gap scale is > 0 (0: 1)", card.lines[2])
     if bound < 0:
@@ -177,8 +177,8 @@ def _size_share(deck: Deck, card: Card, igap: int, share: float) -> float:
 def _stiffness_bounds(deck: Deck, card: Card, istf: int, low: float, high: float,
                       unit: float) -> dict:  # fmt: skip
     """Stmin and Stmax (the deck's stiffness, ``unit`` N/m): read with Istf 2 to 5 (Stmax
-    0: no bound), left out with a
-    warning line with Istf 0 and 1000 (as Radioss does); negative or crossed, refused."""
+    0: no bound), left out with a warning line with Istf 0 and 1000 (as Radioss does);
+    negative or crossed, refused."""
     if low < 0 or high < 0:
         card.fail(f"Stmin = {low:g}, Stmax = {high:g}: the bounds of the stiffness are >= 0 "
                   "(Stmax 0: no bound)", card.lines[3])  # fmt: skip
