@@ -91,9 +91,9 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         where = f"{scene.source}: contact[{i}]"
         share = GapShare.of(spec)
         if share.scene_keys() and not solid.shells:
-            raise SceneError(f"{where}.{share.scene_keys()[0]}: shapes the variable gap of shells; "
-                             "a body of solids has a constant gap (gap, default 0.1 x the "
-                             "shortest edge): leave it out")  # fmt: skip
+            raise SceneError(f"{where}.{share.scene_keys()[0]}: shapes the variable gap of "
+                             "shells; a body of solids has a constant gap (gap, default 0.1 x "
+                             "the shortest edge): leave it out")  # fmt: skip
 
         def side(key: str, parts: tuple[str, ...]) -> Surface:
             for name in parts:
