@@ -169,6 +169,7 @@ BEYOND = {
     "299_shell_stiffness_damping",
     "332_shell_drilling_stiffness_on_triangles",
     "333_shell_drilling_stiffness_on_hexahedra",
+    "354_contact_gap_max_on_solids",  # a key of shells' gap on a body of solids
     # The flow-stress cap lies above the initial yield stress: two values compared.
     "320_flow_stress_cap_below_yield",
     "322_johnson_cook_cap_below_yield",
