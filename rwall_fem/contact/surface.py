@@ -26,8 +26,8 @@ holds it), so nothing can come at it from outside, and a node of another body cu
 same plane, sliding in that plane, would be taken as a whole gap inside it.
 
 A shell is cut by a symmetry plane along its sides, not its faces, and stays a segment:
-:func:`held_plane_sides` finds the sides on such planes (a side of a shell that leaves the
-plane, lying in a plane x_c = const whose nodes a boundary condition holds at zero
+:func:`held_plane_sides` finds the sides on such planes (a side of one shell only, which
+leaves the plane, lying in a plane x_c = const whose nodes a boundary condition holds at zero
 velocity in c with their rotations about the two other axes held), whose nodes act with
 their share of the whole node (:mod:`rwall_fem.contact`).
 
