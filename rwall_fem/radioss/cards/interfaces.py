@@ -163,13 +163,15 @@ def _variable_gap(deck: Deck, card: Card, igap: int, scale: float, bound: float,
 def _size_share(deck: Deck, card: Card, igap: int, share: float) -> float:
     """%mesh_size: each shell's share of the variable gap at most this fraction of its
     shortest side, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
-    line with Igap 0 to 2 (as Radioss does; 0.4 kept, the cap of every variable gap)."""
+    line with Igap 0 to 2 (as Radioss does; with Igap 1 and 2 0.4 kept, the cap of every
+    variable gap)."""
     if not 0.0 <= share <= 1.0:
         card.fail(f"%mesh_size = {share:g}: the share of the shortest side is in (0, 1] (0: "
                   "0.4)", card.lines[3])  # fmt: skip
     if share and igap != 3:
+        kept = "; 0.4 kept" if igap in (1, 2) else ""  # a constant gap has no share
         deck.warn(card, f"%mesh_size = {share:g}: left out: Radioss reads it with Igap 3 only "
-                  f"(Igap = {igap}); 0.4 kept", card.lines[3])  # fmt: skip
+                  f"(Igap = {igap}){kept}", card.lines[3])  # fmt: skip
         return 0.4
     return share or 0.4
 
