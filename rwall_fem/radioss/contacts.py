@@ -13,7 +13,8 @@ x that side without shells); Igap 1 (2, 3) leaves ``gap`` out: the scene's varia
 half the sum of the thicknesses, each shell's share at most 0.4 x its shortest side
 (Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`), with Igap 2 and 3
 Fscalegap ``gap_scale`` and Gap_max ``gap_max``, with Igap 3 %mesh_size
-``gap_size_share``. Stfac is ``stiffness_scale``, with Istf 2 to 5 Stmin and Stmax
+``gap_size_share`` (on shells: a solid's face adds no thickness, and a warning line says
+they are left out). Stfac is ``stiffness_scale``, with Istf 2 to 5 Stmin and Stmax
 ``stiffness_min`` and ``stiffness_max``, Fric ``friction`` (Ifiltr, Xfreq its filter),
 VIS_S ``damping``.
 """
