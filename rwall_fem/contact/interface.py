@@ -91,6 +91,8 @@ class Pass:
         self.node_offsets = np.cumsum(self.node_offsets)
         self.offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
+        self.used = np.zeros(0, dtype=np.int64)  # the segments that are candidates (a sort's)
+        self.boxes = np.zeros((len(self.segments), 6))  # their boxes, m (kernels/contact.c)
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
         self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
         # inside the gap, growing back (kernels/contact.c); inf for the others
@@ -229,8 +231,9 @@ class ContactInterface:
             p = self._pointer
             self.lib.contact_initial_gaps(
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-                p(ps.depth), self._surface[0], self._params, p(ps.gaps), p(out),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
+                p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
+                self._surface[0], self._params, p(ps.gaps), p(out),
             )  # fmt: skip
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
@@ -277,8 +280,9 @@ class ContactInterface:
         x, v, mass, force, stiffness = self._surface[:5]
         return (
             p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-            p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-            p(ps.depth), x, v, mass, self._params, p(ps.tangential), p(ps.gaps), force,
+            p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
+            p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth), x, v, mass,
+            self._params, p(ps.tangential), p(ps.gaps), force,
             stiffness, p(ps.out),
         )  # fmt: skip
 
@@ -402,6 +406,7 @@ class ContactInterface:
                 if count <= len(ps.candidates):
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
+            ps.used = np.unique(ps.candidates[:count])
         self._passes = [self._pass_pointers(ps) for ps in passes]
         self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)

@@ -11,6 +11,8 @@
  *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
  *   segment, whatever the grid.
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
+ * Both passes over the candidates take the list of the segments that are candidates of some
+ * node (`used`) and room for their boxes (`boxes`, 6 a segment), found once a call.
  * contact_forces: one pass of the secondary nodes against their candidates: the closest
  *   point on the surface (closest_on_surface: the segments within a band of the closest
  *   distance blended, a quadrilateral as 4 triangles about its centre, the side from the
@@ -445,22 +447,43 @@ typedef struct
   double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
 } surface_point;
 
-/* The squared distance (m^2) of p to the box of segment `seg`'s corners: a lower bound of
- * its distance to the segment (which lies in the box), found with a few comparisons. */
-INLINE double box_distance2(const double p[3], const int64_t *seg, const double *x)
+/* The boxes of the segments `used` (nused of them, indices into segs) at positions x: 6
+ * values a segment in `boxes` (its corners' lowest x, y, z, then highest), the others'
+ * left as they are.  Once a pass, so that each candidate's test reads one row. */
+static void segment_boxes(int64_t nused, const int64_t *restrict used,
+                          const int64_t *restrict segs, const double *restrict x,
+                          double *restrict boxes)
 {
-  const int corners = seg[3] >= 0 ? 4 : 3;
+  for (int64_t u = 0; u < nused; ++u)
+  {
+    const int64_t j = used[u], *seg = segs + 4 * j;
+    const int corners = seg[3] >= 0 ? 4 : 3;
+    double *box = boxes + 6 * j;
+    for (int c = 0; c < 3; ++c)
+    {
+      double a = x[3 * seg[0] + c], b = a;
+      for (int k = 1; k < corners; ++k)
+      {
+        const double y = x[3 * seg[k] + c];
+        a = y < a ? y : a;
+        b = y > b ? y : b;
+      }
+      box[c] = a;
+      box[3 + c] = b;
+    }
+  }
+}
+
+/* The squared distance (m^2) of p to a segment's box (segment_boxes): a lower bound of its
+ * distance to the segment (which lies in the box).  At most one of the two terms of an
+ * axis is positive (low <= high), so each is the distance along it, without a branch. */
+INLINE double box_distance2(const double p[3], const double *restrict box)
+{
   double d2 = 0.0;
   for (int c = 0; c < 3; ++c)
   {
-    double a = x[3 * seg[0] + c], b = a;
-    for (int k = 1; k < corners; ++k)
-    {
-      const double y = x[3 * seg[k] + c];
-      a = y < a ? y : a;
-      b = y > b ? y : b;
-    }
-    const double out = p[c] < a ? a - p[c] : (p[c] > b ? p[c] - b : 0.0);
+    const double below = box[c] - p[c], above = p[c] - box[3 + c];
+    const double out = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
     d2 += out * out;
   }
   return d2;
@@ -473,7 +496,8 @@ INLINE double box_distance2(const double p[3], const int64_t *seg, const double 
 #define FAR (1.0 + 1e-6)
 
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
- * 0 if none is within reach.  `distance` holds to - from values (scratch).
+ * 0 if none is within reach.  `boxes` are the candidates' boxes (segment_boxes); `distance`
+ * holds to - from values (scratch).
  *
  * The segments whose distance is within BAND of the closest one's share the point, in
  * shares falling linearly from 1 to 0 over that band, as the triangles of a quadrilateral
@@ -489,22 +513,22 @@ INLINE double box_distance2(const double p[3], const int64_t *seg, const double 
 static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               const int64_t *restrict candidates, const int64_t *restrict segs,
                               const double *restrict stiffness0, const double *restrict depth,
-                              const double *restrict x, double reach, double *restrict distance,
-                              surface_point *pt)
+                              const double *restrict x, const double *restrict boxes,
+                              double reach, double *restrict distance, surface_point *pt)
 {
   double best = INFINITY;
   const double far2 = FAR * reach * FAR * reach;
   for (int64_t k = from; k < to; ++k)
   {
-    const int64_t *seg = segs + 4 * candidates[k];
-    if (box_distance2(xs, seg, x) > far2)
+    const int64_t j = candidates[k];
+    if (box_distance2(xs, boxes + 6 * j) > far2)
     {
       distance[k - from] = INFINITY; /* out of reach and out of any band: as the exact
                                         distance would be (see FAR) */
       continue;
     }
     double q[3], w[4], n[3];
-    const double dk = closest_on_segment(xs, seg, x, q, w, n);
+    const double dk = closest_on_segment(xs, segs + 4 * j, x, q, w, n);
     distance[k - from] = dk;
     best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
   }
@@ -629,7 +653,9 @@ INLINE double grown_gap(double *node_gap, double d, double gap)
  * largest initial penetration gap - d0 (m). */
 void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
                           const int64_t *restrict offsets, const int64_t *restrict candidates,
-                          const int64_t *restrict segs, const double *restrict stiffness0,
+                          const int64_t *restrict segs, int64_t nused,
+                          const int64_t *restrict used, double *restrict boxes,
+                          const double *restrict stiffness0,
                           const double *restrict depth, const double *restrict x,
                           const contact_params *prm, double *restrict node_gap, double out[3])
 {
@@ -638,12 +664,13 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
   double *distance = (double *)malloc(most * sizeof(double));
+  segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
     node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, x, prm->reach, distance, &pt))
+                            segs, stiffness0, depth, x, boxes, prm->reach, distance, &pt))
       continue;
     const double g = pair_gap(prm, secondary[i], pt.depth);
     if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
@@ -656,7 +683,9 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   free(distance);
 }
 
-/* One pass: the nsec secondary nodes against their candidate segments.  `stiffness0` and
+/* One pass: the nsec secondary nodes against their candidate segments.  `used` are the
+ * nused segments that are someone's candidate (each once), whose boxes (6 values a
+ * segment of `boxes`, scratch) are found first.  `stiffness0` and
  * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
  * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
@@ -665,7 +694,8 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
  * [10] the sum of the normal forces' sizes (N). */
 void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const int64_t *restrict offsets, const int64_t *restrict candidates,
-                    const int64_t *restrict segs, const double *restrict stiffness0,
+                    const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
+                    double *restrict boxes, const double *restrict stiffness0,
                     const double *restrict depth, const double *restrict x,
                     const double *restrict v, const double *restrict mass,
                     const contact_params *prm,
@@ -678,6 +708,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
   double *distance = (double *)malloc(most * sizeof(double));
+  segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
@@ -685,7 +716,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
     if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
-                            depth, x, prm->reach, distance, &pt))
+                            depth, x, boxes, prm->reach, distance, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
       node_gap[i] = INFINITY;
