@@ -474,6 +474,13 @@ static void segment_boxes(int64_t nused, const int64_t *restrict used,
   }
 }
 
+/* A segment's closest point to a node (closest_on_segment): distance (m, INFINITY when not
+ * sought), point, weights and normal. */
+typedef struct
+{
+  double d, q[3], w[4], n[3];
+} segment_point;
+
 /* The squared distance (m^2) of p to a segment's box (segment_boxes): a lower bound of its
  * distance to the segment (which lies in the box).  At most one of the two terms of an
  * axis is positive (low <= high), so each is the distance along it, without a branch. */
@@ -496,8 +503,8 @@ INLINE double box_distance2(const double p[3], const double *restrict box)
 #define FAR (1.0 + 1e-6)
 
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
- * 0 if none is within reach.  `boxes` are the candidates' boxes (segment_boxes); `distance`
- * holds to - from values (scratch).
+ * 0 if none is within reach.  `boxes` are the candidates' boxes (segment_boxes); `near`
+ * holds to - from closest points (scratch).
  *
  * The segments whose distance is within BAND of the closest one's share the point, in
  * shares falling linearly from 1 to 0 over that band, as the triangles of a quadrilateral
@@ -514,23 +521,22 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               const int64_t *restrict candidates, const int64_t *restrict segs,
                               const double *restrict stiffness0, const double *restrict depth,
                               const double *restrict x, const double *restrict boxes,
-                              double reach, double *restrict distance, surface_point *pt)
+                              double reach, segment_point *restrict near, surface_point *pt)
 {
   double best = INFINITY;
   const double far2 = FAR * reach * FAR * reach;
   for (int64_t k = from; k < to; ++k)
   {
     const int64_t j = candidates[k];
+    segment_point *sp = near + (k - from);
     if (box_distance2(xs, boxes + 6 * j) > far2)
     {
-      distance[k - from] = INFINITY; /* out of reach and out of any band: as the exact
-                                        distance would be (see FAR) */
+      sp->d = INFINITY; /* out of reach and out of any band: as the exact distance would be
+                           (see FAR) */
       continue;
     }
-    double q[3], w[4], n[3];
-    const double dk = closest_on_segment(xs, segs + 4 * j, x, q, w, n);
-    distance[k - from] = dk;
-    best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
+    sp->d = closest_on_segment(xs, segs + 4 * j, x, sp->q, sp->w, sp->n);
+    best = sp->d < reach && sp->d < best ? sp->d : best; /* NaN is out of reach */
   }
   if (!(best < reach))
     return 0;
@@ -540,13 +546,14 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   pt->k0 = pt->depth = 0.0;
   for (int64_t k = from; k < to; ++k)
   {
-    const double dk = distance[k - from];
+    const segment_point *sp = near + (k - from);
+    const double dk = sp->d;
     const double share = band > 0.0 ? 1.0 - (dk - best) / band : (dk == best ? 1.0 : 0.0);
     if (!(share > 0.0))
       continue;
     const int64_t j = candidates[k], *seg = segs + 4 * j;
-    double q[3], w[4], n[3], r[3];
-    closest_on_segment(xs, seg, x, q, w, n);
+    const double *q = sp->q, *w = sp->w, *n = sp->n;
+    double r[3];
     csub(xs, q, r);
     along += share * cdot(r, n);
     for (int c = 0; c < 3; ++c)
@@ -663,14 +670,14 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   int64_t most = 1;
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  double *distance = (double *)malloc(most * sizeof(double));
+  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
   segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
     node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, x, boxes, prm->reach, distance, &pt))
+                            segs, stiffness0, depth, x, boxes, prm->reach, near, &pt))
       continue;
     const double g = pair_gap(prm, secondary[i], pt.depth);
     if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
@@ -680,7 +687,7 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
     out[1] += pt.d > 0.0 ? 0.0 : 1.0;
     out[2] = g - pt.d > out[2] ? g - pt.d : out[2];
   }
-  free(distance);
+  free(near);
 }
 
 /* One pass: the nsec secondary nodes against their candidate segments.  `used` are the
@@ -707,7 +714,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
   int64_t most = 1;
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  double *distance = (double *)malloc(most * sizeof(double));
+  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
   segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
@@ -716,7 +723,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
     if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
-                            depth, x, boxes, prm->reach, distance, &pt))
+                            depth, x, boxes, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
       node_gap[i] = INFINITY;
@@ -805,7 +812,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     out[7] += energy;
     out[10] += fn;
   }
-  free(distance);
+  free(near);
 }
 
 double contact_step(int64_t n, const double *restrict mass, double *restrict stiffness)
