@@ -54,6 +54,10 @@ __all__ = ["CONTACT_COLUMNS", "ContactInterface", "Pass"]
 
 # The penetration ratio p / gap beyond which the penalty stiffness stays at k0 / (1 - CAP).
 CAP = 0.99
+# The skin of the near lists, as a share of the margin: a pass goes through the candidates
+# whose box is within the reach and the skin of their node, listed again once some node
+# has moved a third of the skin (kernels/contact.c, contact_near).
+SKIN = 0.25
 
 CONTACT_COLUMNS = (
     ["time", "contact"]
@@ -93,6 +97,9 @@ class Pass:
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
         self.used = np.zeros(0, dtype=np.int64)  # the segments that are candidates (a sort's)
         self.boxes = np.zeros((len(self.segments), 6))  # their boxes, m (kernels/contact.c)
+        self.near_offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)  # the near
+        self.near = np.zeros(0, dtype=np.int64)  # list (contact_near) and its segments
+        self.near_used = np.zeros(0, dtype=np.int64)
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
         self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
         # inside the gap, growing back (kernels/contact.c); inf for the others
@@ -275,13 +282,14 @@ class ContactInterface:
         return self.ffi.from_buffer(kind, array)
 
     def _pass_pointers(self, ps: Pass) -> tuple:
-        """The arguments of contact_forces for pass ``ps`` after its number of nodes."""
+        """The arguments of contact_forces for pass ``ps`` after its number of nodes: its
+        near lists (``_list_near``)."""
         p = self._pointer
         x, v, mass, force, stiffness = self._surface[:5]
         return (
-            p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-            p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
-            p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth), x, v, mass,
+            p(ps.secondary, "int64_t[]"), p(ps.near_offsets, "int64_t[]"),
+            p(ps.near, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.near_used),
+            p(ps.near_used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth), x, v, mass,
             self._params, p(ps.tangential), p(ps.gaps), force,
             stiffness, p(ps.out),
         )  # fmt: skip
@@ -407,9 +415,36 @@ class ContactInterface:
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
             ps.used = np.unique(ps.candidates[:count])
-        self._passes = [self._pass_pointers(ps) for ps in passes]
         self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)
+        self._list_near()
+
+    def _list_near(self) -> None:
+        """The near lists of the passes (``contact_near``): the candidates whose box is
+        within the reach and the skin of their node now (this rank's own: the passes skip
+        the same candidates with them as without, whenever they are listed)."""
+        p, skin = self._pointer, SKIN * self.margin
+        limit = 1.000001 * self.reach + skin  # FAR reach (kernels/contact.c) and the skin
+        for ps in self.passes:
+            if len(ps.near) < len(ps.candidates):
+                ps.near = np.zeros(len(ps.candidates), dtype=np.int64)
+            count = self.lib.contact_near(
+                len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
+                p(ps.used, "int64_t[]"), p(ps.boxes), self._surface[0], limit,
+                p(ps.near_offsets, "int64_t[]"), p(ps.near, "int64_t[]"),
+            )  # fmt: skip
+            ps.near_used = np.unique(ps.near[:count])
+        self._passes = [self._pass_pointers(ps) for ps in self.passes]
+        self._near_at = self.x.copy()  # the local nodes' positions at the lists
+        self._near_pointer = self._pointer(self._near_at)
+        self._near_moved = (skin / 3.0) ** 2  # m^2: 1/3 > 1 / (1 + sqrt 3) of the skin
+
+    def _near_stale(self) -> bool:
+        """Whether some local node moved more than a third of the skin since the near lists
+        (this rank's own test: no exchange)."""
+        moved = self.lib.contact_moved(len(self.x), self._surface[0], self._near_pointer)
+        return not moved <= self._near_moved
         self.sorts += 1
 
     def _moved(self) -> bool:
@@ -447,6 +482,8 @@ class ContactInterface:
             self._sort()
         else:
             self._read_ghosts()
+            if self._near_stale():
+                self._list_near()
         self.force[:] = 0.0
         self._params.dt = s.dt_previous
         lib = self.lib

@@ -166,6 +166,10 @@ int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const
                      const double *reach, const double *x, int exclude,
                      const int64_t *node_offsets, const int64_t *node_segs, int64_t capacity,
                      int64_t *offsets, int64_t *candidates, int64_t *work);
+int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
+                     const int64_t *candidates, const int64_t *segs, int64_t nused,
+                     const int64_t *used, double *boxes, const double *x, double limit,
+                     int64_t *near_offsets, int64_t *near);
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                     const int64_t *candidates, const int64_t *segs, int64_t nused,
                     const int64_t *used, double *boxes, const double *stiffness0,

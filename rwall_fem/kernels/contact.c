@@ -10,6 +10,8 @@
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
  *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
  *   segment, whatever the grid.
+ * contact_near: the candidates near enough to their node to be met before the nodes have
+ *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
  * Both passes over the candidates take the list of the segments that are candidates of some
  * node (`used`) and room for their boxes (`boxes`, 6 a segment), found once a call.
@@ -494,6 +496,35 @@ INLINE double box_distance2(const double p[3], const double *restrict box)
     d2 += out * out;
   }
   return d2;
+}
+
+/* The near list: of the candidates of the nsec secondary nodes (offsets, candidates, from
+ * the sort), those whose box is within `limit` (m) of their node at positions x, into
+ * near_offsets (nsec + 1) and near (in the candidates' order); the boxes of the nused
+ * segments `used` (all the candidates') into `boxes`.  Between two lists, while no node
+ * has moved more than limit - FAR reach over 1 + sqrt 3 (a node and its segment's box
+ * faces, each up to that far along each axis), a candidate left out stays farther than
+ * FAR reach: the pass over the list skips exactly what it would skip over the candidates
+ * (ContactInterface, the skin).  Returns the length of the list. */
+int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
+                     const int64_t *restrict offsets, const int64_t *restrict candidates,
+                     const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
+                     double *restrict boxes, const double *restrict x, double limit,
+                     int64_t *restrict near_offsets, int64_t *restrict near)
+{
+  segment_boxes(nused, used, segs, x, boxes);
+  const double limit2 = limit * limit;
+  int64_t count = 0;
+  near_offsets[0] = 0;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    const double *xs = x + 3 * secondary[i];
+    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
+      if (!(box_distance2(xs, boxes + 6 * candidates[k]) > limit2)) /* NaN stays */
+        near[count++] = candidates[k];
+    near_offsets[i + 1] = count;
+  }
+  return count;
 }
 
 /* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
