@@ -417,6 +417,7 @@ class ContactInterface:
             ps.used = np.unique(ps.candidates[:count])
         self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)
+        self.sorts += 1
         self._list_near()
 
     def _list_near(self) -> None:
@@ -445,7 +446,6 @@ class ContactInterface:
         (this rank's own test: no exchange)."""
         moved = self.lib.contact_moved(len(self.x), self._surface[0], self._near_pointer)
         return not moved <= self._near_moved
-        self.sorts += 1
 
     def _moved(self) -> bool:
         """Whether some surface node moved more than half the margin since the latest sort
