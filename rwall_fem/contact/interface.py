@@ -297,8 +297,8 @@ class ContactInterface:
     def _read(self, s) -> None:
         """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state."""
         X, u, v, mass, _ = self._state
-        self.lib.contact_pack(self.n, self._rows[0], X, u, v, mass, self._packed)
-        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
+        self.lib.contact_gather(self.n, self._rows[0], X, u, v, mass, self._packed,
+                                *self._surface[:3])  # fmt: skip
 
     def _read_ghosts(self) -> None:
         """x^n, v^{n-1/2} and masses of the ghosts, from their owners."""

@@ -861,10 +861,12 @@ double contact_step(int64_t n, const double *restrict mass, double *restrict sti
   return smallest;
 }
 
-/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg). */
-void contact_pack(int64_t n, const int64_t *restrict rows, const double *restrict X,
-                  const double *restrict u, const double *restrict v,
-                  const double *restrict mass, double *restrict packed)
+/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg),
+ * and the same into the first n surface nodes' x, vs and ms (one sweep). */
+void contact_gather(int64_t n, const int64_t *restrict rows, const double *restrict X,
+                    const double *restrict u, const double *restrict v,
+                    const double *restrict mass, double *restrict packed, double *restrict x,
+                    double *restrict vs, double *restrict ms)
 {
   for (int64_t i = 0; i < n; ++i)
   {
@@ -872,10 +874,10 @@ void contact_pack(int64_t n, const int64_t *restrict rows, const double *restric
     double *p = packed + 7 * i;
     for (int c = 0; c < 3; ++c)
     {
-      p[c] = X[3 * r + c] + u[3 * r + c];
-      p[3 + c] = v[3 * r + c];
+      x[3 * i + c] = p[c] = X[3 * r + c] + u[3 * r + c];
+      vs[3 * i + c] = p[3 + c] = v[3 * r + c];
     }
-    p[6] = mass[r];
+    ms[i] = p[6] = mass[r];
   }
 }
 
