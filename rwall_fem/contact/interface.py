@@ -145,7 +145,8 @@ class ContactInterface:
         self.n = len(self.ids)  # the rank's owned surface nodes: the first local nodes
         self.mine = self.ids - self.owners.start  # their rows of the state
         self.where = np.arange(self.n, dtype=np.int64)  # their local indices
-        self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed)
+        self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed, to send)
+        self.x, self.v, self.mass = np.zeros((self.n, 3)), np.zeros((self.n, 3)), np.zeros(self.n)
         self._sorted_at = None  # positions of the owned surface nodes at the latest sort
         self._params = self.ffi.new("contact_params *")
         self._params.gap, self._params.cap = gap, CAP
@@ -300,11 +301,13 @@ class ContactInterface:
     def _read(self, s) -> None:
         """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state."""
         X, u, v, mass, _ = self._state
-        self.lib.contact_gather(self.n, self._rows[0], X, u, v, mass, self._packed,
-                                *self._surface[:3])  # fmt: skip
+        packed = self._packed if self.comm.size > 1 else self.ffi.NULL  # the table is sent
+        self.lib.contact_gather(self.n, self._rows[0], X, u, v, mass, packed, *self._surface[:3])
 
     def _read_ghosts(self) -> None:
         """x^n, v^{n-1/2} and masses of the ghosts, from their owners."""
+        if self.comm.size == 1:  # no ghosts
+            return
         g = len(self._ghosts.ids)
         self._ghosts.forward(self._table[: self.n], self._table[self.n :])
         self.lib.contact_unpack(g, self._pointer(self._ghost_rows, "int64_t[]"),
@@ -321,11 +324,12 @@ class ContactInterface:
         self._table = table
         self._packed = self._pointer(self._table)
         self._ghost_rows = np.arange(self.n, n, dtype=np.int64)
+        owned = (self.x[: self.n], self.v[: self.n], self.mass[: self.n])
         self.x, self.v, self.mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
+        self.x[: self.n], self.v[: self.n], self.mass[: self.n] = owned
         self.force, self.stiffness = np.zeros((n, 3)), np.zeros(n)
         self._surface = [self._pointer(a) for a in (self.x, self.v, self.mass, self.force,
                                                     self.stiffness, self._owned_force)]  # fmt: skip
-        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
         self._local_half = np.zeros(n)
         if self.half_thickness is not None:
             self._local_half[: self.n] = self.half_thickness

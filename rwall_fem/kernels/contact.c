@@ -861,8 +861,9 @@ double contact_step(int64_t n, const double *restrict mass, double *restrict sti
   return smallest;
 }
 
-/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg),
- * and the same into the first n surface nodes' x, vs and ms (one sweep). */
+/* The rows `rows` of the state into the first n surface nodes' x = X + u (m), vs (m/s) and
+ * ms (kg), and, unless `packed` is NULL (one rank: nothing to send), packed 7 values a node
+ * for the other ranks (one sweep). */
 void contact_gather(int64_t n, const int64_t *restrict rows, const double *restrict X,
                     const double *restrict u, const double *restrict v,
                     const double *restrict mass, double *restrict packed, double *restrict x,
@@ -871,14 +872,24 @@ void contact_gather(int64_t n, const int64_t *restrict rows, const double *restr
   for (int64_t i = 0; i < n; ++i)
   {
     const int64_t r = rows[i];
-    double *p = packed + 7 * i;
     for (int c = 0; c < 3; ++c)
     {
-      x[3 * i + c] = p[c] = X[3 * r + c] + u[3 * r + c];
-      vs[3 * i + c] = p[3 + c] = v[3 * r + c];
+      x[3 * i + c] = X[3 * r + c] + u[3 * r + c];
+      vs[3 * i + c] = v[3 * r + c];
     }
-    ms[i] = p[6] = mass[r];
+    ms[i] = mass[r];
   }
+  if (packed)
+    for (int64_t i = 0; i < n; ++i)
+    {
+      double *p = packed + 7 * i;
+      for (int c = 0; c < 3; ++c)
+      {
+        p[c] = x[3 * i + c];
+        p[3 + c] = vs[3 * i + c];
+      }
+      p[6] = ms[i];
+    }
 }
 
 /* Packed rows to the surface nodes `order` (their positions, velocities and masses). */
