@@ -9,7 +9,7 @@
    timed (processor time, each rank's, the slowest rank's sums): the whole step, the
    internal force, and the interface's ``accelerate`` (gather, bucket sort when due, near
    lists when due, the compiled passes over them, the nodal step, the forces added), with
-   the sort (near lists included) and the gather apart.
+   the sort (with the near lists made at it) and the gather apart.
    The contact's share is taken over the steps at or after ``--fold-time`` (folds in
    contact; the number of nodes in contact is given), as the median over blocks of
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
