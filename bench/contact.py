@@ -7,8 +7,9 @@
    true``, J2 at 5 points, 100 kg at 10 m/s) at about 10,000 and 100,000 quadrilaterals
    (``--tube-cells``; the element size from the cell count). Every step of the run is
    timed (processor time, each rank's, the slowest rank's sums): the whole step, the
-   internal force, and the interface's ``accelerate`` (gather, bucket sort when due, the
-   compiled passes, the nodal step, the forces added), with the sort and the gather apart.
+   internal force, and the interface's ``accelerate`` (gather, bucket sort when due, near
+   lists when due, the compiled passes over them, the nodal step, the forces added), with
+   the sort (with the near lists made at it) and the gather apart.
    The contact's share is taken over the steps at or after ``--fold-time`` (folds in
    contact; the number of nodes in contact is given), as the median over blocks of
    ``--block`` steps and over all of them, and over the first millisecond (no fold yet).
@@ -281,7 +282,7 @@ def tube_lines(results: dict, before: str, after: str) -> list[str]:
     lines = [f"### Tube crush with self-contact, {ranks}", "",
              f"Load average before {before}, after {after}; processor time per step (the "
              "slowest rank's), contact = the interface's `accelerate` (gather, sort when "
-             "due, passes, nodal step, forces added).", "",
+             "due, near lists when due, passes, nodal step, forces added).", "",
              "| cells | tube (mm) | steps | window | ms/step | internal force | **contact** | "
              "of it sort | of it gather | nodes in contact (mean / max) |",
              "|---:|---|---:|---|---:|---:|---:|---:|---:|---|"]  # fmt: skip

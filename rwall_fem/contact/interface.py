@@ -13,7 +13,10 @@ nodes it owns, against the segments that can reach them; each step it
    (one ``Allreduce`` of the largest move): every rank sends the segments it owns (those
    of its lowest-numbered node) whose box, widened by the reach and the margin, meets the
    box of another rank's secondary nodes to that rank, and lists its ghosts again; then it
-   sorts its secondary nodes' candidate segments (buckets, ``kernels/contact.c``);
+   sorts its secondary nodes' candidate segments (buckets, ``kernels/contact.c``); and
+   lists again, within them, the candidates near enough to be met before some node has
+   moved a skin (``_list_near``: at each sort, and when some local node has moved a third
+   of the skin since the last list; the same forces with or without);
 3. runs its passes (secondary nodes against main segments; two, each side against the
    other, by default) in compiled code over its own secondary nodes, adds the forces on
    its own nodes to a^n, and sends those on its ghosts back to their owners, who add them
@@ -54,6 +57,10 @@ __all__ = ["CONTACT_COLUMNS", "ContactInterface", "Pass"]
 
 # The penetration ratio p / gap beyond which the penalty stiffness stays at k0 / (1 - CAP).
 CAP = 0.99
+# The skin of the near lists, as a share of the margin: a pass goes through the candidates
+# whose box is within the reach and the skin of their node, listed again once some node
+# has moved a third of the skin (kernels/contact.c, contact_near).
+SKIN = 0.25
 
 CONTACT_COLUMNS = (
     ["time", "contact"]
@@ -91,6 +98,11 @@ class Pass:
         self.node_offsets = np.cumsum(self.node_offsets)
         self.offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
+        self.used = np.zeros(0, dtype=np.int64)  # the segments that are candidates (a sort's)
+        self.boxes = np.zeros((len(self.segments), 6))  # their boxes, m (kernels/contact.c)
+        self.near_offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)  # the near
+        self.near = np.zeros(0, dtype=np.int64)  # list (contact_near) and its segments
+        self.near_used = np.zeros(0, dtype=np.int64)
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
         self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
         # inside the gap, growing back (kernels/contact.c); inf for the others
@@ -133,7 +145,8 @@ class ContactInterface:
         self.n = len(self.ids)  # the rank's owned surface nodes: the first local nodes
         self.mine = self.ids - self.owners.start  # their rows of the state
         self.where = np.arange(self.n, dtype=np.int64)  # their local indices
-        self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed)
+        self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed, to send)
+        self.x, self.v, self.mass = np.zeros((self.n, 3)), np.zeros((self.n, 3)), np.zeros(self.n)
         self._sorted_at = None  # positions of the owned surface nodes at the latest sort
         self._params = self.ffi.new("contact_params *")
         self._params.gap, self._params.cap = gap, CAP
@@ -229,8 +242,9 @@ class ContactInterface:
             p = self._pointer
             self.lib.contact_initial_gaps(
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-                p(ps.depth), self._surface[0], self._params, p(ps.gaps), p(out),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
+                p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
+                self._surface[0], self._params, p(ps.gaps), p(out),
             )  # fmt: skip
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
@@ -272,24 +286,28 @@ class ContactInterface:
         return self.ffi.from_buffer(kind, array)
 
     def _pass_pointers(self, ps: Pass) -> tuple:
-        """The arguments of contact_forces for pass ``ps`` after its number of nodes."""
+        """The arguments of contact_forces for pass ``ps`` after its number of nodes: its
+        near lists (``_list_near``)."""
         p = self._pointer
         x, v, mass, force, stiffness = self._surface[:5]
         return (
-            p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-            p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
-            p(ps.depth), x, v, mass, self._params, p(ps.tangential), p(ps.gaps), force,
+            p(ps.secondary, "int64_t[]"), p(ps.near_offsets, "int64_t[]"),
+            p(ps.near, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.near_used),
+            p(ps.near_used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth), x, v, mass,
+            self._params, p(ps.tangential), p(ps.gaps), force,
             stiffness, p(ps.out),
         )  # fmt: skip
 
     def _read(self, s) -> None:
         """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state."""
         X, u, v, mass, _ = self._state
-        self.lib.contact_pack(self.n, self._rows[0], X, u, v, mass, self._packed)
-        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
+        packed = self._packed if self.comm.size > 1 else self.ffi.NULL  # the table is sent
+        self.lib.contact_gather(self.n, self._rows[0], X, u, v, mass, packed, *self._surface[:3])
 
     def _read_ghosts(self) -> None:
         """x^n, v^{n-1/2} and masses of the ghosts, from their owners."""
+        if self.comm.size == 1:  # no ghosts
+            return
         g = len(self._ghosts.ids)
         self._ghosts.forward(self._table[: self.n], self._table[self.n :])
         self.lib.contact_unpack(g, self._pointer(self._ghost_rows, "int64_t[]"),
@@ -306,11 +324,12 @@ class ContactInterface:
         self._table = table
         self._packed = self._pointer(self._table)
         self._ghost_rows = np.arange(self.n, n, dtype=np.int64)
+        owned = (self.x[: self.n], self.v[: self.n], self.mass[: self.n])
         self.x, self.v, self.mass = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
+        self.x[: self.n], self.v[: self.n], self.mass[: self.n] = owned
         self.force, self.stiffness = np.zeros((n, 3)), np.zeros(n)
         self._surface = [self._pointer(a) for a in (self.x, self.v, self.mass, self.force,
                                                     self.stiffness, self._owned_force)]  # fmt: skip
-        self.lib.contact_unpack(self.n, self._rows[1], self._packed, *self._surface[:3])
         self._local_half = np.zeros(n)
         if self.half_thickness is not None:
             self._local_half[: self.n] = self.half_thickness
@@ -402,10 +421,38 @@ class ContactInterface:
                 if count <= len(ps.candidates):
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
-        self._passes = [self._pass_pointers(ps) for ps in passes]
+            ps.used = np.unique(ps.candidates[:count])
         self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
+        self._list_near()
+
+    def _list_near(self) -> None:
+        """The near lists of the passes (``contact_near``): the candidates whose box is
+        within the reach and the skin of their node now (this rank's own: the passes skip
+        the same candidates with them as without, whenever they are listed)."""
+        p, skin = self._pointer, SKIN * self.margin
+        limit = 1.000001 * self.reach + skin  # FAR reach (kernels/contact.c) and the skin
+        for ps in self.passes:
+            if len(ps.near) < len(ps.candidates):
+                ps.near = np.zeros(len(ps.candidates), dtype=np.int64)
+            count = self.lib.contact_near(
+                len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
+                p(ps.used, "int64_t[]"), p(ps.boxes), self._surface[0], limit,
+                p(ps.near_offsets, "int64_t[]"), p(ps.near, "int64_t[]"),
+            )  # fmt: skip
+            ps.near_used = np.unique(ps.near[:count])
+        self._passes = [self._pass_pointers(ps) for ps in self.passes]
+        self._near_at = self.x.copy()  # the local nodes' positions at the lists
+        self._near_pointer = self._pointer(self._near_at)
+        self._near_moved = (skin / 3.0) ** 2  # m^2: 1/3 > 1 / (1 + sqrt 3) of the skin
+
+    def _near_stale(self) -> bool:
+        """Whether some local node moved more than a third of the skin since the near lists
+        (this rank's own test: no exchange)."""
+        moved = self.lib.contact_moved(len(self.x), self._surface[0], self._near_pointer)
+        return not moved <= self._near_moved
 
     def _moved(self) -> bool:
         """Whether some surface node moved more than half the margin since the latest sort
@@ -442,6 +489,8 @@ class ContactInterface:
             self._sort()
         else:
             self._read_ghosts()
+            if self._near_stale():
+                self._list_near()
         self.force[:] = 0.0
         self._params.dt = s.dt_previous
         lib = self.lib

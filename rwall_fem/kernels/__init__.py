@@ -166,18 +166,24 @@ int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const
                      const double *reach, const double *x, int exclude,
                      const int64_t *node_offsets, const int64_t *node_segs, int64_t capacity,
                      int64_t *offsets, int64_t *candidates, int64_t *work);
+int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
+                     const int64_t *candidates, const int64_t *segs, int64_t nused,
+                     const int64_t *used, double *boxes, const double *x, double limit,
+                     int64_t *near_offsets, int64_t *near);
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
-                    const int64_t *candidates, const int64_t *segs, const double *stiffness0,
+                    const int64_t *candidates, const int64_t *segs, int64_t nused,
+                    const int64_t *used, double *boxes, const double *stiffness0,
                     const double *depth, const double *x, const double *v,
                     const double *mass, const contact_params *prm, double *tangential,
                     double *node_gap, double *force, double *stiffness, double out[11]);
 void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
-                          const int64_t *candidates, const int64_t *segs,
-                          const double *stiffness0, const double *depth, const double *x,
+                          const int64_t *candidates, const int64_t *segs, int64_t nused,
+                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth, const double *x,
                           const contact_params *prm, double *node_gap, double out[3]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
-void contact_pack(int64_t n, const int64_t *rows, const double *X, const double *u,
-                  const double *v, const double *mass, double *packed);
+void contact_gather(int64_t n, const int64_t *rows, const double *X, const double *u,
+                    const double *v, const double *mass, double *packed, double *x,
+                    double *vs, double *ms);
 void contact_unpack(int64_t n, const int64_t *order, const double *packed, double *x,
                     double *v, double *mass);
 double contact_apply(int64_t n, const int64_t *rows, const int64_t *where, const double *force,

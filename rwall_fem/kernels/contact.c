@@ -10,7 +10,11 @@
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
  *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
  *   segment, whatever the grid.
+ * contact_near: the candidates near enough to their node to be met before the nodes have
+ *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
+ * Both passes over the candidates take the list of the segments that are candidates of some
+ * node (`used`) and room for their boxes (`boxes`, 6 a segment), found once a call.
  * contact_forces: one pass of the secondary nodes against their candidates: the closest
  *   point on the surface (closest_on_surface: the segments within a band of the closest
  *   distance blended, a quadrilateral as 4 triangles about its centre, the side from the
@@ -445,25 +449,82 @@ typedef struct
   double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
 } surface_point;
 
-/* The squared distance (m^2) of p to the box of segment `seg`'s corners: a lower bound of
- * its distance to the segment (which lies in the box), found with a few comparisons. */
-INLINE double box_distance2(const double p[3], const int64_t *seg, const double *x)
+/* The boxes of the segments `used` (nused of them, indices into segs) at positions x: 6
+ * values a segment in `boxes` (its corners' lowest x, y, z, then highest), the others'
+ * left as they are.  Once a pass, so that each candidate's test reads one row. */
+static void segment_boxes(int64_t nused, const int64_t *restrict used,
+                          const int64_t *restrict segs, const double *restrict x,
+                          double *restrict boxes)
 {
-  const int corners = seg[3] >= 0 ? 4 : 3;
+  for (int64_t u = 0; u < nused; ++u)
+  {
+    const int64_t j = used[u], *seg = segs + 4 * j;
+    const int corners = seg[3] >= 0 ? 4 : 3;
+    double *box = boxes + 6 * j;
+    for (int c = 0; c < 3; ++c)
+    {
+      double a = x[3 * seg[0] + c], b = a;
+      for (int k = 1; k < corners; ++k)
+      {
+        const double y = x[3 * seg[k] + c];
+        a = y < a ? y : a;
+        b = y > b ? y : b;
+      }
+      box[c] = a;
+      box[3 + c] = b;
+    }
+  }
+}
+
+/* A segment's closest point to a node (closest_on_segment): distance (m, INFINITY when not
+ * sought), point, weights and normal. */
+typedef struct
+{
+  double d, q[3], w[4], n[3];
+} segment_point;
+
+/* The squared distance (m^2) of p to a segment's box (segment_boxes): a lower bound of its
+ * distance to the segment (which lies in the box).  At most one of the two terms of an
+ * axis is positive (low <= high), so each is the distance along it, without a branch. */
+INLINE double box_distance2(const double p[3], const double *restrict box)
+{
   double d2 = 0.0;
   for (int c = 0; c < 3; ++c)
   {
-    double a = x[3 * seg[0] + c], b = a;
-    for (int k = 1; k < corners; ++k)
-    {
-      const double y = x[3 * seg[k] + c];
-      a = y < a ? y : a;
-      b = y > b ? y : b;
-    }
-    const double out = p[c] < a ? a - p[c] : (p[c] > b ? p[c] - b : 0.0);
+    const double below = box[c] - p[c], above = p[c] - box[3 + c];
+    const double out = (below > 0.0 ? below : 0.0) + (above > 0.0 ? above : 0.0);
     d2 += out * out;
   }
   return d2;
+}
+
+/* The near list: of the candidates of the nsec secondary nodes (offsets, candidates, from
+ * the sort), those whose box is within `limit` (m) of their node at positions x, into
+ * near_offsets (nsec + 1) and near (in the candidates' order); the boxes of the nused
+ * segments `used` (all the candidates') into `boxes`.  Between two lists, while no node
+ * has moved more than limit - FAR reach over 1 + sqrt 3 (a node and its segment's box
+ * faces, each up to that far along each axis), a candidate left out stays farther than
+ * FAR reach: the pass over the list skips exactly what it would skip over the candidates
+ * (ContactInterface, the skin).  Returns the length of the list. */
+int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
+                     const int64_t *restrict offsets, const int64_t *restrict candidates,
+                     const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
+                     double *restrict boxes, const double *restrict x, double limit,
+                     int64_t *restrict near_offsets, int64_t *restrict near)
+{
+  segment_boxes(nused, used, segs, x, boxes);
+  const double limit2 = limit * limit;
+  int64_t count = 0;
+  near_offsets[0] = 0;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    const double *xs = x + 3 * secondary[i];
+    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
+      if (!(box_distance2(xs, boxes + 6 * candidates[k]) > limit2)) /* NaN stays */
+        near[count++] = candidates[k];
+    near_offsets[i + 1] = count;
+  }
+  return count;
 }
 
 /* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
@@ -473,7 +534,8 @@ INLINE double box_distance2(const double p[3], const int64_t *seg, const double 
 #define FAR (1.0 + 1e-6)
 
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
- * 0 if none is within reach.  `distance` holds to - from values (scratch).
+ * 0 if none is within reach.  `boxes` are the candidates' boxes (segment_boxes); `near`
+ * holds to - from closest points (scratch).
  *
  * The segments whose distance is within BAND of the closest one's share the point, in
  * shares falling linearly from 1 to 0 over that band, as the triangles of a quadrilateral
@@ -489,24 +551,23 @@ INLINE double box_distance2(const double p[3], const int64_t *seg, const double 
 static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               const int64_t *restrict candidates, const int64_t *restrict segs,
                               const double *restrict stiffness0, const double *restrict depth,
-                              const double *restrict x, double reach, double *restrict distance,
-                              surface_point *pt)
+                              const double *restrict x, const double *restrict boxes,
+                              double reach, segment_point *restrict near, surface_point *pt)
 {
   double best = INFINITY;
   const double far2 = FAR * reach * FAR * reach;
   for (int64_t k = from; k < to; ++k)
   {
-    const int64_t *seg = segs + 4 * candidates[k];
-    if (box_distance2(xs, seg, x) > far2)
+    const int64_t j = candidates[k];
+    segment_point *sp = near + (k - from);
+    if (box_distance2(xs, boxes + 6 * j) > far2)
     {
-      distance[k - from] = INFINITY; /* out of reach and out of any band: as the exact
-                                        distance would be (see FAR) */
+      sp->d = INFINITY; /* out of reach and out of any band: as the exact distance would be
+                           (see FAR) */
       continue;
     }
-    double q[3], w[4], n[3];
-    const double dk = closest_on_segment(xs, seg, x, q, w, n);
-    distance[k - from] = dk;
-    best = dk < reach && dk < best ? dk : best; /* NaN is out of reach */
+    sp->d = closest_on_segment(xs, segs + 4 * j, x, sp->q, sp->w, sp->n);
+    best = sp->d < reach && sp->d < best ? sp->d : best; /* NaN is out of reach */
   }
   if (!(best < reach))
     return 0;
@@ -516,13 +577,14 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   pt->k0 = pt->depth = 0.0;
   for (int64_t k = from; k < to; ++k)
   {
-    const double dk = distance[k - from];
+    const segment_point *sp = near + (k - from);
+    const double dk = sp->d;
     const double share = band > 0.0 ? 1.0 - (dk - best) / band : (dk == best ? 1.0 : 0.0);
     if (!(share > 0.0))
       continue;
     const int64_t j = candidates[k], *seg = segs + 4 * j;
-    double q[3], w[4], n[3], r[3];
-    closest_on_segment(xs, seg, x, q, w, n);
+    const double *q = sp->q, *w = sp->w, *n = sp->n;
+    double r[3];
     csub(xs, q, r);
     along += share * cdot(r, n);
     for (int c = 0; c < 3; ++c)
@@ -629,7 +691,9 @@ INLINE double grown_gap(double *node_gap, double d, double gap)
  * largest initial penetration gap - d0 (m). */
 void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
                           const int64_t *restrict offsets, const int64_t *restrict candidates,
-                          const int64_t *restrict segs, const double *restrict stiffness0,
+                          const int64_t *restrict segs, int64_t nused,
+                          const int64_t *restrict used, double *restrict boxes,
+                          const double *restrict stiffness0,
                           const double *restrict depth, const double *restrict x,
                           const contact_params *prm, double *restrict node_gap, double out[3])
 {
@@ -637,13 +701,14 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   int64_t most = 1;
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  double *distance = (double *)malloc(most * sizeof(double));
+  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
+  segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
     node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, x, prm->reach, distance, &pt))
+                            segs, stiffness0, depth, x, boxes, prm->reach, near, &pt))
       continue;
     const double g = pair_gap(prm, secondary[i], pt.depth);
     if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
@@ -653,10 +718,12 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
     out[1] += pt.d > 0.0 ? 0.0 : 1.0;
     out[2] = g - pt.d > out[2] ? g - pt.d : out[2];
   }
-  free(distance);
+  free(near);
 }
 
-/* One pass: the nsec secondary nodes against their candidate segments.  `stiffness0` and
+/* One pass: the nsec secondary nodes against their candidate segments.  `used` are the
+ * nused segments that are someone's candidate (each once), whose boxes (6 values a
+ * segment of `boxes`, scratch) are found first.  `stiffness0` and
  * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
  * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
@@ -665,7 +732,8 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
  * [10] the sum of the normal forces' sizes (N). */
 void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const int64_t *restrict offsets, const int64_t *restrict candidates,
-                    const int64_t *restrict segs, const double *restrict stiffness0,
+                    const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
+                    double *restrict boxes, const double *restrict stiffness0,
                     const double *restrict depth, const double *restrict x,
                     const double *restrict v, const double *restrict mass,
                     const contact_params *prm,
@@ -677,7 +745,8 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
   int64_t most = 1;
   for (int64_t i = 0; i < nsec; ++i)
     most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  double *distance = (double *)malloc(most * sizeof(double));
+  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
+  segment_boxes(nused, used, segs, x, boxes);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
@@ -685,7 +754,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
     if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
-                            depth, x, prm->reach, distance, &pt))
+                            depth, x, boxes, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
       node_gap[i] = INFINITY;
@@ -774,7 +843,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     out[7] += energy;
     out[10] += fn;
   }
-  free(distance);
+  free(near);
 }
 
 double contact_step(int64_t n, const double *restrict mass, double *restrict stiffness)
@@ -792,22 +861,35 @@ double contact_step(int64_t n, const double *restrict mass, double *restrict sti
   return smallest;
 }
 
-/* The rows `rows` of the state, packed 7 values a node: x = X + u (m), v (m/s), mass (kg). */
-void contact_pack(int64_t n, const int64_t *restrict rows, const double *restrict X,
-                  const double *restrict u, const double *restrict v,
-                  const double *restrict mass, double *restrict packed)
+/* The rows `rows` of the state into the first n surface nodes' x = X + u (m), vs (m/s) and
+ * ms (kg), and, unless `packed` is NULL (one rank: nothing to send), packed 7 values a node
+ * for the other ranks (one sweep). */
+void contact_gather(int64_t n, const int64_t *restrict rows, const double *restrict X,
+                    const double *restrict u, const double *restrict v,
+                    const double *restrict mass, double *restrict packed, double *restrict x,
+                    double *restrict vs, double *restrict ms)
 {
   for (int64_t i = 0; i < n; ++i)
   {
     const int64_t r = rows[i];
-    double *p = packed + 7 * i;
     for (int c = 0; c < 3; ++c)
     {
-      p[c] = X[3 * r + c] + u[3 * r + c];
-      p[3 + c] = v[3 * r + c];
+      x[3 * i + c] = X[3 * r + c] + u[3 * r + c];
+      vs[3 * i + c] = v[3 * r + c];
     }
-    p[6] = mass[r];
+    ms[i] = mass[r];
   }
+  if (packed)
+    for (int64_t i = 0; i < n; ++i)
+    {
+      double *p = packed + 7 * i;
+      for (int c = 0; c < 3; ++c)
+      {
+        p[c] = x[3 * i + c];
+        p[3 + c] = vs[3 * i + c];
+      }
+      p[6] = ms[i];
+    }
 }
 
 /* Packed rows to the surface nodes `order` (their positions, velocities and masses). */
