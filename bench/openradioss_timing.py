@@ -10,7 +10,8 @@ without them the script says so in one line and stops (exit 0). Each deck
 (``../shared/peer-decks/gen_shell.py``: the tube at h 2.5 mm, Ishell 24; the same tube with
 self-contact, ``/INTER/TYPE7``, ``tubec``; the plate, Ishell 24, 20 m/s) runs ``--repeat``
 times in each code, alternately, and the medians are printed: OpenRadioss's engine (its
-starter not counted) with OMP_NUM_THREADS=1, its cycles from the last ``NC=`` line it prints;
+starter not counted) with OMP_NUM_THREADS=1, its cycles from the ``TOTAL NUMBER OF CYCLES`` line
+it prints;
 rwall_fem's time loop in this process (set-up not counted). CPU times, not wall times: the
 machine is shared, and a CPU time does not count the cycles other processes took; the
 1-minute load average before each deck is printed beside them. ``--keep DIR`` keeps
@@ -57,7 +58,8 @@ def openradioss(folder: Path, name: str, exe: Path) -> dict:
     command = [str(exe / ENGINE), "-i", f"{name}_0001.rad", "-nt", "1"]
     done = subprocess.run(command, cwd=folder, env=env, check=True, capture_output=True,
                           text=True)  # fmt: skip
-    cycles = re.findall(r"NC=\s*(\d+)", done.stdout)
+    # the closing count; the NC= progress lines come only every /PRINT cycles
+    cycles = re.findall(r"TOTAL NUMBER OF CYCLES\s*:\s*(\d+)", done.stdout)
     return {"cpu": children_cpu() - cpu, "wall": time.perf_counter() - wall,
             "cycles": int(cycles[-1]) if cycles else None}  # fmt: skip
 
