@@ -269,7 +269,9 @@ INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec 
  * (OpenRadioss's arguments of CZFINTN1 from MULAWC and M2CPLR): the mean and least over the
  * points through the thickness of E_t / E = H / (H + E) (1 at a point that did not flow this
  * step; ZCFAC), the mean flow stress (Pa; SIGY), and the mean stress N / t and M / t^2 (Pa;
- * GBUF%FOR, GBUF%MOM), both (xx, yy, xy). */
+ * GBUF%FOR, GBUF%MOM), both (xx, yy, xy).  As M2CPLR, the flow stress and its slope H are
+ * those of the plastic strain e before the step, the slope at e + 1e-7 (finite at e = 0;
+ * Johnson-Cook: with its thermal factor, not its rate factor). */
 typedef struct
 {
   vec mean_tangent, least_tangent, flow, membrane[3], bending[3];
@@ -288,8 +290,10 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     const int base = 2 + SHELL_POINT_SLOTS * pt;
     const vec e = load_slot(state, stride, b, base + 3);
     const vec T = p->thermal ? load_slot(state, stride, b, base + 4) : VZERO;
+    const vec factor = flow_factor(p, VZERO, T);
     vec slope;
-    flow += share * capped_flow_stress(p, e, flow_factor(p, VZERO, T), &slope);
+    flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
+    capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
     const vec tangent = vselect(e > eps_before[pt], slope / (slope + s->young), VZERO + 1.0);
     mean += share * tangent;
     least = vmin(least, tangent);
