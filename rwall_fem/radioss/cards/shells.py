@@ -159,8 +159,8 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     if ishell != 3:
         what = ("QEPH's physical stabilisation" if ishell in (12, 24) else
                 "Radioss's elastic hourglass forces (HELAS hm, with a quadratic viscosity)")
-        step = (", with QEPH's characteristic length of the step (its dn = 0.015)"
-                if ishell == 24 else "")  # fmt: skip
+        step = (", with QEPH's characteristic length of the step (its dn = 0.015) and its "
+                "yielding hourglass stresses (hourglass_yield)" if ishell == 24 else "")  # fmt: skip
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   f"warping correction, {what} as the elastic hourglass stiffness "
                   f"3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr{step}",
