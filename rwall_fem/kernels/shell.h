@@ -54,6 +54,8 @@ typedef struct
                               `thickness` points to); NULL: constant */
   int qeph_step;           /* quadrilaterals, 1: QEPH's characteristic length (Ishell 24) */
   double qeph_dn;          /* its numerical damping dn: the length times sqrt(1 + dn^2) - dn */
+  int qeph_hourglass;      /* quadrilaterals with hk > 0, elasto-plastic: QEPH's yielding
+                              hourglass forces (Ishell 24; shell_quad.c, qeph_hourglass_yield) */
 } shell_params;
 
 /* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one

@@ -43,6 +43,8 @@
  * hk (4/3) E' t, the normal-strain part of the fully integrated cell's in-plane bending),
  * 4 hk D A |b|^4 (out of plane) and hk (2/3) D A |b|^2 (rotations), E' = E / (1 - nu^2),
  * D = E' t^3 / 12, |b|^2 = sum b1^2 + b2^2; their work joins the hourglass energy.
+ * With s->qeph_hourglass (Radioss's QEPH, Ishell 24, elasto-plastic cells) these elastic
+ * hourglass forces yield as in OpenRadioss's CZFINTN1 (czfintn.F): see qeph_hourglass_yield.
  *
  * Rate form over the step dt = p->dt: the strain increments are dt times the velocity
  * strains of v, theta (v^{n-1/2}) in the mid-step configuration x - dt v / 2 (a rigid
@@ -263,13 +265,119 @@ INLINE void quad_resultant_forces(const quad_frame_t *g, int warping, const vec 
   add_global(g, fl, ml, fe);
 }
 
+/* What QEPH's hourglass yield needs of a cell's material after its update of the step
+ * (OpenRadioss's arguments of CZFINTN1 from MULAWC and M2CPLR): the mean and least over the
+ * points through the thickness of E_t / E = H / (H + E) (1 at a point that did not flow this
+ * step; ZCFAC), the mean flow stress (Pa; SIGY), and the mean stress N / t and M / t^2 (Pa;
+ * GBUF%FOR, GBUF%MOM), both (xx, yy, xy).  As M2CPLR, the flow stress and its slope H are
+ * those of the plastic strain e before the step, the slope at e + 1e-7 (finite at e = 0;
+ * Johnson-Cook: with its thermal factor, not its rate factor). */
+typedef struct
+{
+  vec mean_tangent, least_tangent, flow, membrane[3], bending[3];
+} qeph_material_t;
+
+/* qeph_material_t of a batch from its state rows after shell_update (plastic cells) and the
+ * points' plastic strains before it, eps_before; N, M the new resultants. */
+INLINE void qeph_material(const element_params *p, const shell_params *s, const batch_t *b,
+                          const double *restrict state, int64_t stride, const vec eps_before[],
+                          vec t, const vec N[3], const vec M[3], qeph_material_t *out)
+{
+  const double share = 1.0 / s->points;
+  vec mean = VZERO, least = VZERO + 1.0, flow = VZERO;
+  for (int pt = 0; pt < s->points; ++pt)
+  {
+    const int base = 2 + SHELL_POINT_SLOTS * pt;
+    const vec e = load_slot(state, stride, b, base + 3);
+    const vec T = p->thermal ? load_slot(state, stride, b, base + 4) : VZERO;
+    const vec factor = flow_factor(p, VZERO, T);
+    vec slope;
+    flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
+    capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
+    const vec tangent = vselect(e > eps_before[pt], slope / (slope + s->young), VZERO + 1.0);
+    mean += share * tangent;
+    least = vmin(least, tangent);
+  }
+  out->mean_tangent = mean;
+  out->least_tangent = least;
+  out->flow = flow;
+  for (int i = 0; i < 3; ++i)
+  {
+    out->membrane[i] = N[i] / t;
+    out->bending[i] = M[i] / (t * t);
+  }
+}
+
+/* sxx^2 + syy^2 - sxx syy + 3 sxy^2 (Pa^2). */
+INLINE vec qeph_mises2(const vec s[3])
+{
+  return s[0] * s[0] + s[1] * s[1] - s[0] * s[1] + 3.0 * s[2] * s[2];
+}
+
+/* The yield norm of CZFINTN1 of two hourglass stress pairs a = (V1, V2), c = (V7, V8) (the
+ * x and y modes), times COEF^2 = 0.85^2 (folded in by the caller): a.a + c.c terms and
+ * their cross term. */
+INLINE vec qeph_pair_norm(vec a1, vec a2, vec c1, vec c2)
+{
+  return a1 * a1 + a2 * a2 - a1 * a2 + c1 * c1 + c2 * c2 - c1 * c2
+         + vabs(a1 * (2.0 * c1 - c2) + a2 * (2.0 * c2 - c1));
+}
+
+/* QEPH's yielding hourglass forces (OpenRadioss's CZFINTN1, czfintn.F, for a material with a
+ * yield stress): the elastic increments dQ of the membrane (m = 0, 1) and bending (m = 3, 4)
+ * hourglass forces of the step are scaled by 1 - EH1 and 1 - EH2 (the out-of-plane mode,
+ * m = 2, and the viscous forces never yield).  The cell yields when one of its points
+ * flowed this step (E_t / E < 1), or, all elastic, when
+ *     SVM = S0 + 25 M0 > sigma_y^2,
+ *     S0 = |N / t|_VM^2 + 0.85^2 h(V_m),   M0 = |M / t^2|_VM^2 + (0.85 t / 16)^2 h(V_b),
+ * h as qeph_pair_norm, V the hourglass stresses (below); then
+ *     EH1 = max(0.999 min(S0 / sigma_y^2, 1), 1 - mean E_t / E)   (S0 = 0 if a point flowed),
+ *     EH2 = max(0.999, 1 - least E_t / E),
+ * each 0 if the work of the old forces on the step's increments (membrane, bending) is
+ * negative (unloading).  With the deck's hardening H = 300 MPa, E_t / E = H / (H + E) =
+ * 0.0014: 99.86 % of a flowing cell's membrane increment, and 99.9 % of its bending one,
+ * are taken back.  The hourglass stresses V are those of a square cell of side sqrt(A)
+ * (Radioss's VGLAS): E' 2 / sqrt(A) times the elastic hourglass displacement Q / k of the
+ * new forces (the stress at the cell's edge of the in-plane or out-of-plane bending that
+ * the mode is), the x mode (V, -nu V), the y mode (-nu V, V); the bending modes are the
+ * rotations about y and minus those about x (CZDEF's DHG3, DHG4).  old, dq, k: the forces
+ * before the step, the increments dt q and the stiffnesses of quad_hourglass; dQ in/out. */
+INLINE void qeph_hourglass_yield(const shell_params *s, const qeph_material_t *mat, vec area,
+                                 vec t, const vec old[5], const vec dq[5], const vec k[5],
+                                 vec dQ[5])
+{
+  const double Ep = s->young / (1.0 - s->poisson * s->poisson), nu = s->poisson;
+  const vec scale = (2.0 * Ep) / vsqrt(area);
+  vec V[5];
+  for (int m = 0; m < 5; ++m)
+    V[m] = scale * (old[m] + dQ[m]) / k[m];
+  const vec hm = qeph_pair_norm(V[0], -nu * V[0], -nu * V[1], V[1]);
+  const vec hb = qeph_pair_norm(V[4], -nu * V[4], nu * V[3], -V[3]);
+  const vec cm = (0.85 / 16.0) * t;
+  const vec flowing = VZERO + (1.0 - mat->least_tangent);
+  const vec yield2 = mat->flow * mat->flow;
+  const ivec elastic = flowing <= 0.0;
+  const vec S0 = vselect(elastic, qeph_mises2(mat->membrane) + (0.85 * 0.85) * hm, VZERO);
+  const vec M0 = qeph_mises2(mat->bending) + cm * cm * hb;
+  const ivec yields = ~elastic | (S0 + 25.0 * M0 > yield2);
+  vec eh1 = vmax(0.999 * vmin(S0 / vmax(yield2, VZERO + 1e-18), VZERO + 1.0),
+                 1.0 - mat->mean_tangent);
+  vec eh2 = vmax(VZERO + 0.999, flowing);
+  eh1 = vselect(yields & (old[0] * dq[0] + old[1] * dq[1] >= 0.0), eh1, VZERO);
+  eh2 = vselect(yields & (old[3] * dq[3] + old[4] * dq[4] >= 0.0), eh2, VZERO);
+  dQ[0] *= 1.0 - eh1;
+  dQ[1] *= 1.0 - eh1;
+  dQ[3] *= 1.0 - eh2;
+  dQ[4] *= 1.0 - eh2;
+}
+
 /* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
  * velocities vl (projected when warping) and angular velocities wl; returns their power, W. */
 INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double density,
                           double dt, vec thickness, int warping, const vec Ji[9],
                           const vec vl[4][3],
                           const vec wl[4][3], double *restrict state, int64_t stride,
-                          const batch_t *b, vec *restrict fe)
+                          const batch_t *b, const qeph_material_t *yielding, vec *restrict fe)
 {
   vec gx = VZERO, gy = VZERO;
   for (int I = 0; I < 4; ++I)
@@ -304,13 +412,20 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
     const vec kw = (4.0 * s->hk) * bending * g->area * bb * bb;
     const vec kr = (s->hk * 2.0 / 3.0) * bending * g->area * bb;
     const vec k[5] = {km, km, kw, kr, kr};
+    vec old[5], dq[5], dQ[5];
     for (int m = 0; m < 5; ++m)
     {
-      const vec old = load_slot(state, stride, b, s->hourglass_slot + m);
-      const vec dq = dt * q[m], dQ = k[m] * dq;
-      store_slot(state, stride, b, s->hourglass_slot + m, old + dQ);
-      work += (old + 0.5 * dQ) * dq;
-      Q[m] += old + dQ;
+      old[m] = load_slot(state, stride, b, s->hourglass_slot + m);
+      dq[m] = dt * q[m];
+      dQ[m] = k[m] * dq[m];
+    }
+    if (yielding)
+      qeph_hourglass_yield(s, yielding, g->area, thickness, old, dq, k, dQ);
+    for (int m = 0; m < 5; ++m)
+    {
+      store_slot(state, stride, b, s->hourglass_slot + m, old[m] + dQ[m]);
+      work += (old[m] + 0.5 * dQ[m]) * dq[m];
+      Q[m] += old[m] + dQ[m];
     }
   }
   vec fl[4][3], ml[4][2];
@@ -459,16 +574,25 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
       project_rigid(&g, Ji, vl);
     }
     quad_strain_rates(&g, vl, wl, d, k, gs);
-    vec hourglass = VZERO;
-    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
-      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, Ji, vl, wl, state, stride,
-                                 &b, fe);
     const vec mid_area = g.area;
     vec N[3], M[3], Q[2], elastic, dissipated, damage;
     const vec before =
         s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
+    /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
+     * MULAWC): the points' plastic strains before it */
+    const int qeph = plastic && s->qeph_hourglass && s->hk > 0.0;
+    vec eps_before[SHELL_MAX_POINTS];
+    for (int pt = 0; qeph && pt < s->points; ++pt)
+      eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
     shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
                  &damage);
+    qeph_material_t material;
+    if (qeph)
+      qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
+    vec hourglass = VZERO;
+    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
+      hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, Ji, vl, wl, state, stride,
+                                 &b, qeph ? &material : NULL, fe);
     if (s->new_thickness)
       shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
     quad_frame(x, &g);

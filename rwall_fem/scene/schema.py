@@ -854,9 +854,10 @@ _HOURGLASS_FORMS = ("physical", "stiffness", "viscous")
 SURFACE_CELLS = ("quadrilateral", "triangle")
 SHELL_KEYS = ("thickness", "formulation", "points", "hourglass_coefficients", "shear_factor",
               "failed_share", "thickness_change", "hourglass_stiffness",
-              "drilling_stiffness", "step_length")  # fmt: skip
+              "drilling_stiffness", "step_length", "hourglass_yield")  # fmt: skip
 # The shells' [element] keys of the quadrilateral's kernel only (shell_quad.c).
-QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length")
+QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length",
+                      "hourglass_yield")  # fmt: skip
 SOLID_KEYS = ("integration", "hourglass", "hourglass_coefficient")
 
 
@@ -963,6 +964,16 @@ class Element:
         "shape (0.894 of a square's side), times sqrt(1 + dn^2) - dn of its numerical "
         "damping dn = 0.015",
         default_doc="bt (Radioss's Ishell 24 and 12 read as qeph)",
+    )
+    hourglass_yield: bool | None = key(
+        Flag(),
+        None,
+        doc="quadrilateral shells with hourglass_stiffness, elasto-plastic materials: the "
+        "elastic hourglass forces yield as in Radioss's QEPH (Ishell 24): in a cell whose "
+        "points flow, or whose mean stresses with the hourglass stresses reach the yield "
+        "stress, the step's membrane increment is scaled by the mean E_t / E of its points "
+        "and the bending one by at most 0.001 (docs/theory.md)",
+        default_doc="false (elastic hourglass forces; Radioss's Ishell 24 reads as true)",
     )
 
 

@@ -71,6 +71,7 @@ class ShellSection:
         extra += (f", drilling springs {t.drilling_stiffness:g} G t A"
                   if t.drilling_stiffness > 0.0 else "")  # fmt: skip
         extra += ", QEPH's step length" if t.step_length == "qeph" else ""
+        extra += ", QEPH's yielding hourglass forces" if t.hourglass_yield else ""
         return (f"{FORMULATIONS[self.formulation]}, {self.points} points through "
                 f"{self.thickness:g} m{change}{share}{extra}")  # fmt: skip
 

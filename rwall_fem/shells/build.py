@@ -77,6 +77,7 @@ def _section(scene, i: int, spec, cell: str) -> ShellSection:
             hourglass_stiffness=element.hourglass_stiffness or 0.0,
             drilling_stiffness=element.drilling_stiffness or 0.0,
             step_length=element.step_length or "bt",
+            hourglass_yield=bool(element.hourglass_yield),
         )
     except ValueError as err:  # "element.<key>: ..." of the kernels, or a sentence
         said = str(err)

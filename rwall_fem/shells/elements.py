@@ -66,6 +66,7 @@ typedef struct {
   double *new_thickness;
   int qeph_step;
   double qeph_dn;
+  int qeph_hourglass;
 } shell_params;
 """
     + "".join(
@@ -129,12 +130,16 @@ class ShellTechnology:
     drilling_stiffness: float = 0.0
     # the characteristic length of the step (quadrilaterals, STEP_LENGTHS; shell_quad.c)
     step_length: str = "bt"
+    # QEPH's yielding elastic hourglass forces (quadrilaterals with hourglass_stiffness,
+    # elasto-plastic laws; shell_quad.c, qeph_hourglass_yield)
+    hourglass_yield: bool = False
 
     @classmethod
     def choose(cls, cell: str, formulation=None, points: int = 5,
                hourglass=(0.01, 0.01, 0.01), shear_factor: float = 5.0 / 6.0,
                hourglass_stiffness: float = 0.0,
-               drilling_stiffness: float = 0.0, step_length: str = "bt") -> ShellTechnology:
+               drilling_stiffness: float = 0.0, step_length: str = "bt",
+               hourglass_yield: bool = False) -> ShellTechnology:
         """The technology for ``cell`` from a scene's ``[element]`` choices; ValueError (one
         line, naming the key) for a combination that does not exist."""  # fmt: skip
         if cell not in FORMULATIONS:
@@ -167,7 +172,8 @@ class ShellTechnology:
         return cls(cell, formulation, int(points), (hm, hf, hr), float(shear_factor),
                    float(hourglass_stiffness) if quad else 0.0,
                    float(drilling_stiffness) if quad else 0.0,
-                   step_length if quad else "bt")  # fmt: skip
+                   step_length if quad else "bt",
+                   bool(hourglass_yield) and quad)  # fmt: skip
 
     def describe(self) -> str:
         """E.g. 'Belytschko-Lin-Tsay quadrilaterals with the BWC warping correction, ...'."""
@@ -177,6 +183,7 @@ class ShellTechnology:
         warp = " with the BWC warping correction" if self.formulation == "bwc" else ""
         hm, hf, hr = self.hourglass
         step = ", QEPH's step length" if self.step_length == "qeph" else ""
+        step += ", QEPH's yielding hourglass forces" if self.hourglass_yield else ""
         return f"{name}{warp}, viscous hourglass hm {hm:g} hf {hf:g} hr {hr:g}{step}"
 
 
@@ -250,6 +257,7 @@ class ShellKernel:
             self.history = np.zeros((8, n))
         s.hk = technology.hourglass_stiffness
         s.qeph_step, s.qeph_dn = int(technology.step_length == "qeph"), QEPH_DN
+        s.qeph_hourglass = int(technology.hourglass_yield)
         self.thickness_change = bool(thickness_change)
         if self.thickness_change:
             s.new_thickness = ffi.cast("double *", self.thickness.ctypes.data)
