@@ -973,7 +973,7 @@ class Element:
         "points flow, or whose mean stresses with the hourglass stresses reach the yield "
         "stress, the step's membrane increment is scaled by the mean E_t / E of its points "
         "and the bending one by at most 0.001 (docs/theory.md)",
-        default_doc="false (elastic hourglass forces; Radioss's Ishell 24 reads as true)",
+        default_doc="false (elastic hourglass forces; a deck's Ishell 24 does not set it: docs/radioss.md)",
     )
 
 

@@ -7,8 +7,7 @@ viscous hourglass control hm, hf, hr) with an elastic ``hourglass_stiffness``: 1
 (Radioss's Belytschko-Tsay, whose hourglass forces are elastic, CHVIS3) and 24 and 12
 (QEPH, Belytschko-Leviathan's physical stabilisation, read the same way) hk = 3
 :data:`HELAS` hm (1 - nu^2), the same stiffness on a square cell's membrane hourglass
-mode, 24 with QEPH's step (``step_length = "qeph"``) and its yielding hourglass forces
-(``hourglass_yield = true``, CZFINTN1); 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
+mode, 24 with QEPH's step (``step_length = "qeph"``); 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
 :data:`HOURGLASS_STIFFNESS`; a warning says what each is read as; a
 blank Ishell is 1, as in OpenRadioss's starter. Ish3n 1 and 2 (the C0 triangle) to
 ``"bsc"``. Iplas 0 (blank) or 2, Radioss's radial return for LAW2, is read as the exact
@@ -43,8 +42,7 @@ HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
 # square cell is hk E t / (12 (1 - nu^2)) on the same mode, so hk = 3 HELAS hm (1 - nu^2).
 HELAS = 0.5
 # The [element] keys of the quadrilaterals only, left out for triangles.
-_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length",
-                       "hourglass_yield")
+_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length")
 
 
 def _elements(deck: Deck, card: Card) -> None:
@@ -159,8 +157,8 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
     if ishell != 3:
         what = ("QEPH's physical stabilisation" if ishell in (12, 24) else
                 "Radioss's elastic hourglass forces (HELAS hm, with a quadratic viscosity)")
-        step = (", with QEPH's characteristic length of the step (its dn = 0.015) and its "
-                "yielding hourglass stresses (hourglass_yield)" if ishell == 24 else "")  # fmt: skip
+        step = (", with QEPH's characteristic length of the step (its dn = 0.015)"
+                if ishell == 24 else "")  # fmt: skip
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   f"warping correction, {what} as the elastic hourglass stiffness "
                   f"3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr{step}",
@@ -181,9 +179,8 @@ def shell_element(deck: Deck, pid: int, cell: str, poisson: float) -> tuple[dict
     if p["ishell"] != 3:  # Radioss's elastic hourglass forces (CHVIS3), QEPH read alike
         hm = element["hourglass_coefficients"][0]
         element["hourglass_stiffness"] = 3.0 * HELAS * hm * (1.0 - poisson**2)
-    if p["ishell"] == 24:  # QEPH's own characteristic length (CZCORC1, CNDT3), and its
-        element["step_length"] = "qeph"  # yielding hourglass stresses (CZFINTN1)
-        element["hourglass_yield"] = True
+    if p["ishell"] == 24:  # QEPH's own characteristic length (CZCORC1, CNDT3)
+        element["step_length"] = "qeph"
     if cell == "triangle":
         for name in _QUADRILATERAL_KEYS:
             element.pop(name, None)
