@@ -9,8 +9,8 @@ touch they move rigidly, so their mid-surfaces' separation d is the initial one 
 References independent of the code (``i7sti3.F``, ``i7cor3.F``):
 
 - the contact starts at the first step whose positions have d below the pair gap
-  g = max(floor, min(s_1, c, size h) + min(s_2, c, size h)), s = scale x t/2 each
-  plate's share, c = gap_max / 2, h = 0.5 mm, the floor min(scale x t, h / 2) (Radioss's
+  g = max(floor, min(min(s_1, size h) + min(s_2, size h), gap_max)), s = scale x t/2 each
+  plate's share, h = 0.5 mm, the floor min(scale x t, h / 2) (Radioss's
   default Gapmin, not bounded by Gap_max): d^n < g <= d^(n-1) (one step of travel,
   w dt = 1.7 um, 0.6 % of g);
 - the force at that step is the penalty law's at penetration p = g - d on every node in
@@ -101,8 +101,8 @@ def touch(directory, d0, contact, end_time, dt=None):
 
 def expected_gap(scale=1.0, gap_max=math.inf, share=0.4) -> float:
     """Radioss's pair gap of the two plates (one thickness, one mesh)."""
-    one = min(scale * 0.5 * T, share * H, 0.5 * gap_max)
-    return max(min(scale * T, 0.5 * H), 2.0 * one)
+    one = min(scale * 0.5 * T, share * H)
+    return max(min(scale * T, 0.5 * H), min(2.0 * one, gap_max))
 
 
 CASES = {
