@@ -16,7 +16,8 @@ variable, as Radioss's Igap 1: a node against a segment gets half the thickness 
 thickest shell at the node plus half the segment's (half the sum of the thicknesses),
 floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side); each
 shell's share is at most ``gap_size_share`` x its shortest side, scaled by ``gap_scale``
-and at most ``gap_max`` / 2 (Radioss Igap 2 and 3: :class:`GapShare`). A given ``gap`` is
+(Radioss Igap 2 and 3: :class:`GapShare`), and a pair's gap at most ``gap_max`` (Radioss
+Gap_max bounds the pair, ``i7cor3.F``). A given ``gap`` is
 constant (Radioss Igap 0). The penalty stiffness of each segment is bounded by
 ``stiffness_min`` and ``stiffness_max`` (Radioss Stmin, Stmax).
 
@@ -168,7 +169,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
         if spec.gap is None and half > 0.0:
-            interface.vary_gap(node_gap, nodes)
+            interface.vary_gap(node_gap, nodes, share.most)
         interface.start(state)
         left_out = {name: len(cut[name].segments) for name in parts
                     if name in cut and len(cut[name].segments)}  # fmt: skip
@@ -268,24 +269,24 @@ SIZE_SHARE = 0.4
 class GapShare:
     """How a shell's half thickness t/2 becomes its share of a variable gap (Radioss
     TYPE7 Igap 2 and 3, ``i7sti3.F``, ``i7cor3.F``): min(scale t/2, size x its shortest
-    side, cap) (m); ``cap`` is half the scene's ``gap_max`` (inf: none), so that a pair of
-    shares, the pair's gap, is at most ``gap_max``."""
+    side) (m); ``most`` is the scene's ``gap_max`` (m, inf: none), which bounds a pair's
+    gap, the sum of its two shares (``i7cor3.F``: min(GAP_S + GAP_M, GAPMAX))."""
 
     scale: float = 1.0
     size: float = SIZE_SHARE
-    cap: float = math.inf
+    most: float = math.inf
 
     @classmethod
     def of(cls, spec) -> GapShare:
         """The share of the ``[[contact]]`` table ``spec``."""
-        cap = math.inf if spec.gap_max is None else 0.5 * spec.gap_max
-        return cls(spec.gap_scale, spec.gap_size_share, cap)
+        most = math.inf if spec.gap_max is None else spec.gap_max
+        return cls(spec.gap_scale, spec.gap_size_share, most)
 
     def scene_keys(self) -> list[str]:
         """The ``[[contact]]`` keys that make this share differ from the default one."""
         default = GapShare()
         return [key for key, given, usual in (("gap_scale", self.scale, default.scale),
-                                              ("gap_max", self.cap, default.cap),
+                                              ("gap_max", self.most, default.most),
                                               ("gap_size_share", self.size, default.size))
                 if given != usual]  # fmt: skip
 
@@ -303,7 +304,7 @@ def _sized_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
     (-depth, half its thickness) as ``share`` makes it: at most ``share.size`` x its
     shortest side."""
     shell = s.depth < 0.0
-    half = np.minimum(np.minimum(share.scale * -s.depth, share.size * s.edge), share.cap)
+    half = np.minimum(share.scale * -s.depth, share.size * s.edge)
     return np.where(shell, -half, s.depth)
 
 
@@ -320,4 +321,4 @@ def _node_gaps(nodes: np.ndarray, surfaces: list[Surface],
         rows = np.searchsorted(nodes, ids[ids >= 0])
         np.maximum.at(out, rows, half[ids >= 0])
         np.minimum.at(size, rows, side[ids >= 0])
-    return np.minimum(np.minimum(share.scale * out, size), share.cap)
+    return np.minimum(share.scale * out, size)

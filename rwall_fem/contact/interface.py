@@ -150,6 +150,7 @@ class ContactInterface:
         self._sorted_at = None  # positions of the owned surface nodes at the latest sort
         self._params = self.ffi.new("contact_params *")
         self._params.gap, self._params.cap = gap, CAP
+        self._params.gap_max = math.inf
         self._params.friction, self._params.alpha = friction, alpha
         self._params.damping = damping
         self.damping = damping
@@ -252,14 +253,18 @@ class ContactInterface:
         deepest = self.comm.allreduce(deepest, op=MPI.MAX)
         self.starting_inside = (int(inside), int(behind), deepest)
 
-    def vary_gap(self, half_thickness: np.ndarray, nodes: np.ndarray) -> None:
-        """A variable gap (Radioss Igap 1): node s against a segment gets the larger of
-        :attr:`gap` (the floor) and ``half_thickness[s]`` plus the segment's half thickness
-        (a shell's: -depth; 0 for a solid's face); ``half_thickness`` (m) per surface node
-        ``nodes`` (half its thickest shell; the rank keeps its owned nodes')."""
+    def vary_gap(self, half_thickness: np.ndarray, nodes: np.ndarray,
+                 most: float = math.inf) -> None:  # fmt: skip
+        """A variable gap (Radioss Igap 1): node s against a segment gets
+        ``half_thickness[s]`` plus the segment's half thickness (a shell's: -depth; 0 for a
+        solid's face), at most ``most`` (m, Radioss Gap_max) and at least :attr:`gap` (the
+        floor); ``half_thickness`` (m) per surface node ``nodes`` (half its thickest shell;
+        the rank keeps its owned nodes')."""
         self.half_thickness = np.ascontiguousarray(
             half_thickness[np.searchsorted(nodes, self.ids)], dtype=np.float64)
-        self.gap_max = max(self.gap, float(half_thickness.max(initial=0.0)) + self.shell_half)
+        self._params.gap_max = most
+        pair = float(half_thickness.max(initial=0.0)) + self.shell_half
+        self.gap_max = max(self.gap, min(pair, most))
         self.reach = max(self.reach, self.gap_max)
         self._params.reach = self.reach
         self._sorted_at = None

@@ -156,7 +156,7 @@ double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const do
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
                         double out[2]);
 typedef struct {
-  double gap, cap, friction, damping, alpha, dt, reach;
+  double gap, cap, friction, damping, alpha, dt, reach, gap_max;
   const double *half_thickness;
   const double *share;
   const int8_t *planes;

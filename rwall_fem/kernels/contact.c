@@ -45,6 +45,7 @@ typedef struct
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+  double gap_max;  /* m: a pair's variable gap at most this (Radioss Gap_max; inf: none) */
   const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
                                   a constant gap (see pair_gap) */
   const double *share;          /* per surface node, or NULL (all 1): the share of the whole
@@ -405,13 +406,16 @@ static double closest_on_segment(const double p[3], const int64_t *seg, const do
 INLINE int two_sided(double depth) { return depth < 0.0; }
 
 /* The gap (m) of node s against a segment of depth `depth`: the interface's, or with
- * half_thickness (a variable gap, Radioss Igap 1) the larger of it (the floor, Gapmin) and
- * the node's half thickness plus the segment's (-depth for a shell, 0 for a solid's face). */
+ * half_thickness (a variable gap, Radioss Igap 1) the node's half thickness plus the
+ * segment's (-depth for a shell, 0 for a solid's face), at most gap_max and at least the
+ * interface's gap (the floor, Gapmin), as i7cor3.F bounds the pair:
+ * max(GAPMIN, min(GAP_S + GAP_M, GAPMAX)). */
 INLINE double pair_gap(const contact_params *prm, int64_t s, double depth)
 {
   if (!prm->half_thickness)
     return prm->gap;
-  const double pair = prm->half_thickness[s] + (two_sided(depth) ? -depth : 0.0);
+  double pair = prm->half_thickness[s] + (two_sided(depth) ? -depth : 0.0);
+  pair = pair < prm->gap_max ? pair : prm->gap_max;
   return pair > prm->gap ? pair : prm->gap;
 }
 

@@ -1298,8 +1298,8 @@ class ContactSpec:
         Real(low=0.0),
         None,
         unit="m",
-        doc="Radioss Gap_max: the variable gap of a pair at most this (each side's share at "
-        "most half of it), never below the floor gap",
+        doc="Radioss Gap_max: the variable gap of a pair (the sum of its two shares) at most "
+        "this, never below the floor gap",
         default_doc="no bound",
     )
     gap_size_share: float = key(

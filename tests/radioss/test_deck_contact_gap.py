@@ -131,15 +131,16 @@ def test_bad_values_are_one_line(fields, message, shared_dir):
 
 def test_the_deck_builds_the_bounded_interface(shared_dir):
     """Built: the floor min(Fscalegap x t, h / 2) = 0.5 mm is the gap (each share
-    min(0.5 x 0.5, 0.3 x 5, 0.4 / 2) = 0.2 mm, the pair 0.4 mm below it: Gap_max does not
-    lower the floor), k0 = E t = 2.1e8 N/m bounded by Stmax 100 kN/mm = 1e8 N/m."""
+    min(0.5 x 0.5, 0.3 x 5) = 0.25 mm, the pair min(0.5, Gap_max 0.4) = 0.4 mm below it:
+    Gap_max does not lower the floor), k0 = E t = 2.1e8 N/m bounded by Stmax 100 kN/mm =
+    1e8 N/m."""
     fields = [IGAP(3), FSCALE(0.5), GAPMAX(0.4), MESH(0.3), ISTF(2), STMAX(100)]
     scene = load_deck(tube(shared_dir, _set(*fields)))
     (interface,) = build_simulation(scene, comm, shared_dir / "built").contacts
     assert interface.gap == pytest.approx(5e-4, rel=1e-12)
     assert interface.gap_max == pytest.approx(5e-4, rel=1e-12)
     assert interface.k0_range == pytest.approx((1e8, 1e8), rel=1e-12)
-    assert interface.shell_half == pytest.approx(2e-4, rel=1e-12)  # each share
+    assert interface.shell_half == pytest.approx(2.5e-4, rel=1e-12)  # each share
 
 
 def test_a_solid_deck_leaves_the_shells_gap_fields_out(shared_dir, caplog):

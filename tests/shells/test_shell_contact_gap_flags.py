@@ -9,8 +9,8 @@ touch they move rigidly, so their mid-surfaces' separation d is the initial one 
 References independent of the code (``i7sti3.F``, ``i7cor3.F``):
 
 - the contact starts at the first step whose positions have d below the pair gap
-  g = max(floor, min(s_1, c, size h) + min(s_2, c, size h)), s = scale x t/2 each
-  plate's share, c = gap_max / 2, h = 0.5 mm, the floor min(scale x t, h / 2) (Radioss's
+  g = max(floor, min(min(s_1, size h) + min(s_2, size h), gap_max)), s = scale x t/2 each
+  plate's share, h = 0.5 mm, the floor min(scale x t, h / 2) (Radioss's
   default Gapmin, not bounded by Gap_max): d^n < g <= d^(n-1) (one step of travel,
   w dt = 1.7 um, 0.6 % of g);
 - the force at that step is the penalty law's at penetration p = g - d on every node in
@@ -101,8 +101,8 @@ def touch(directory, d0, contact, end_time, dt=None):
 
 def expected_gap(scale=1.0, gap_max=math.inf, share=0.4) -> float:
     """Radioss's pair gap of the two plates (one thickness, one mesh)."""
-    one = min(scale * 0.5 * T, share * H, 0.5 * gap_max)
-    return max(min(scale * T, 0.5 * H), 2.0 * one)
+    one = min(scale * 0.5 * T, share * H)
+    return max(min(scale * T, 0.5 * H), min(2.0 * one, gap_max))
 
 
 CASES = {
@@ -147,3 +147,62 @@ def test_the_force_starts_with_the_bounded_stiffness(bounds, k0, shared_dir):
           f"force {force:.6e} N, closed form {contacts * each:.6e} N")
     assert sim.contacts[0].k0_range == pytest.approx((k0, k0), rel=1e-12)
     assert force == pytest.approx(contacts * each, rel=1e-9)
+
+
+# Different shells: Radioss's Gap_max bounds a pair's variable gap, not each shell's share
+# (``[[contact]]`` gap_max; ``i7cor3.F``: GAPV = max(GAPMIN, min(GAP_S + GAP_M, GAPMAX))).
+#
+# Two parallel steel plates of different shells close at a constant speed w, both passes: the
+# lower 2 mm thick in 3 mm quadrilaterals (12 x 12 mm), the upper 0.5 mm thick in 2 mm
+# quadrilaterals (8 x 8 mm over its middle, its nodes a quarter cell off the lower's);
+# gap_max 0.8 mm. Until they touch they move rigidly, so their mid-surfaces' separation d is
+# the initial one less w t. The shares (t/2; the size share 0.4 x side, 1.2 and 0.8 mm, does
+# not bind) are 1 and 0.25 mm, the floor min(thinnest t, half the shortest side) = 0.5 mm, so
+# Radioss's pair gap is max(0.5, min(1 + 0.25, 0.8)) = 0.8 mm each way; a share capped at
+# gap_max / 2 would give 0.25 + 0.4 = 0.65 mm. The contact starts at the first step whose
+# positions have d below 0.8 mm: d^n < g <= d^(n-1) (one step of travel, under 1 % of g).
+GAP_MAX = 8e-4  # m
+PAIR_GAP = max(5e-4, min(1e-3 + 2.5e-4, GAP_MAX))  # Radioss's, hand-computed: 0.8 mm
+
+PAIR_GEO = """Point(1) = {{0, 0, 0}};
+ax[] = Extrude {{0.012, 0, 0}} {{ Point{{1}}; Layers{{4}}; Recombine; }};
+ay[] = Extrude {{0, 0.012, 0}} {{ Line{{ax[1]}}; Layers{{4}}; Recombine; }};
+Physical Surface("thick") = {{ay[1]}};
+Point(101) = {{0.00275, 0.00275, {d0}}};
+bx[] = Extrude {{0.008, 0, 0}} {{ Point{{101}}; Layers{{4}}; Recombine; }};
+by[] = Extrude {{0, 0.008, 0}} {{ Line{{bx[1]}}; Layers{{4}}; Recombine; }};
+Physical Surface("thin") = {{by[1]}};
+"""
+
+
+def test_the_contact_of_different_shells_starts_at_the_bounded_pair_gap(shared_dir):
+    d0 = 1.1e-3
+    directory = shared_dir / "pair_gap"
+    path = directory / "plates.geo"
+    if comm.rank == 0:
+        directory.mkdir(parents=True, exist_ok=True)
+        path.write_text(PAIR_GEO.format(d0=d0))
+    comm.Barrier()
+    raw = {
+        "run": {"end_time": (d0 - PAIR_GAP) / W + 2e-6},
+        "mesh": {"file": str(path)},
+        "material": STEEL,
+        "part": [{"name": "thick", "element": {"thickness": 2e-3},
+                  "initial": {"velocity": [0.0, 0.0, 0.5 * W]}},
+                 {"name": "thin", "element": {"thickness": 5e-4},
+                  "initial": {"velocity": [0.0, 0.0, -0.5 * W]}}],
+        "contact": [{"main": ["thick"], "secondary": ["thin"], "damping": 0.0,
+                     "gap_max": GAP_MAX}],
+        "output": {"plot": False, "frames": 0},
+    }  # fmt: skip
+    sim = build_simulation(parse_scene(raw, source="test"), comm, directory)
+    watch = FirstTouch(sim, d0)
+    assert sim.run() == "done"
+    k, contacts, _ = watch.touch
+    d = watch.separations
+    print(f"pair gap {PAIR_GAP:.4e} m, interface's largest {sim.contacts[0].gap_max:.4e} m; "
+          f"first contact at step {k}: d^n {d[k]:.6e} m, d^(n-1) {d[k - 1]:.6e} m, "
+          f"{contacts} nodes")
+    assert sim.contacts[0].gap_max == pytest.approx(PAIR_GAP, rel=1e-12)
+    assert d[k] < PAIR_GAP <= d[k - 1]
+    assert d[k - 1] - d[k] <= 1e-2 * PAIR_GAP
