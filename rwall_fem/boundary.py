@@ -34,6 +34,8 @@ class VelocityBoundary:
         self.nodes = np.asarray(nodes, dtype=np.int32)
         self.prescribed = PrescribedMotion(velocity)  # the velocity history
         self.axes = np.array(["xyz".index(c) for c in components])
+        # The prescribed values' places in a C-contiguous (nodes, 3) array, (nodes, axes)
+        self._flat = 3 * self.nodes.astype(np.int64)[:, None] + self.axes[None, :]
         self.impulse = np.zeros(3)  # reaction on this rank's nodes so far, N s
         self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
         self._reaction = None  # the latest step's reaction (N s), for its v^{n+1/2} half
@@ -52,21 +54,22 @@ class VelocityBoundary:
         """Book the v^{n+1/2} half of the work of the latest step's reaction with the
         velocities the nodes now have; before the masses change, and at every step."""
         if self._reaction is not None:
-            v_now = state.v[self.nodes[:, None], self.axes[None, :]]
+            v_now = state.v.reshape(-1)[self._flat]
             self.work += 0.5 * float(np.sum(self._reaction * v_now))
             self._reaction = None
 
     def constrain(self, state) -> None:
         """Set ``state.a`` of the prescribed components so that v^{n+1/2} = v_p(t_n +
         dt^{n+1/2}/2), the velocity update's step being dt^n (``state.dt_velocity``)."""
-        rows, cols = self.nodes[:, None], self.axes[None, :]
+        rows = self._flat  # of the (n, 3) arrays' values
         target = self.prescribed.predict(state.t, state.dt)[self.axes]
         self.settle(state)
-        v_old = state.v[rows, cols]
+        v_old = state.v.reshape(-1)[rows]
         m = state.mass[self.nodes][:, None]
         dt_v = state.dt_velocity
-        reaction = m * (target - v_old - dt_v * state.a[rows, cols])  # N s
-        state.a[rows, cols] = (target - v_old) / dt_v
+        a = state.a.reshape(-1)  # a view: the state is C-contiguous (the update asks it)
+        reaction = m * (target - v_old - dt_v * a[rows])  # N s
+        a[rows] = (target - v_old) / dt_v
         self.work += 0.5 * float(np.sum(reaction * v_old))
         self._reaction = reaction
         self.impulse[self.axes] += reaction.sum(axis=0)

@@ -398,7 +398,10 @@ class _Sums:
             self.total[name] = self._total[end - size : end].reshape(shape)
 
     def reduce(self) -> dict[str, np.ndarray]:
-        self.comm.Allreduce(self._local, self._total)
+        if self.comm.size == 1:  # the sums are this rank's
+            self._total[:] = self._local
+        else:
+            self.comm.Allreduce(self._local, self._total)
         return self.total
 
     def finite(self) -> bool:

@@ -68,6 +68,8 @@ _HORIZON = 16
 # sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
 # covers rounding (a float sum u + dt v moves u by at most twice the increment).
 _TRAVEL = 2.0 * math.sqrt(3.0)
+_EYE = np.eye(3)  # the identity of the main node's equations (read only)
+_EYE.flags.writeable = False
 
 
 def filter_alpha(friction_filter: tuple[str, float] | None, dt: float) -> float:
@@ -306,7 +308,7 @@ class RigidWall:
         final = wall_velocity
         if motion.dynamic:
             # The main node takes exactly what the nodes received (momentum to round-off).
-            final = predicted - self.comm.allreduce(impulse_sum) / motion.mass
+            final = predicted - self._summed(impulse_sum) / motion.mass
             final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
         before = motion.velocity
         motion.advance(final, dt)
@@ -403,13 +405,19 @@ class RigidWall:
         ``tied`` ones; ``extra`` impulses (N s) are given to the nodes on top."""
         m, n = passes.mass[:k, None], passes.normals[:k]
         vs, target = passes.predicted[:k], passes.target[:k]
-        P = np.where(tied[:, None, None], np.eye(3), np.einsum("ij,ik->ijk", n, n))
+        # The normals' outer products only where some node is not tied (np.where's values).
+        outer = 0.0 if tied.all() else np.einsum("ij,ik->ijk", n, n)
+        P = np.where(tied[:, None, None], _EYE, outer)
         matrix = np.einsum("i,ijk->jk", m[:, 0], P)
         rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
         if extra is not None:
             rhs -= extra.sum(axis=0)
-        total = self.comm.allreduce(np.concatenate([matrix.ravel(), rhs]))
+        total = self._summed(np.concatenate([matrix.ravel(), rhs]))
         mass, held = self.motion.mass, self.motion.held
-        matrix, rhs = mass * np.eye(3) + total[:9].reshape(3, 3), mass * predicted + total[9:]
-        matrix[held], rhs[held] = np.eye(3)[held], predicted[held]  # held components
+        matrix, rhs = mass * _EYE + total[:9].reshape(3, 3), mass * predicted + total[9:]
+        matrix[held], rhs[held] = _EYE[held], predicted[held]  # held components
         return np.linalg.solve(matrix, rhs)
+
+    def _summed(self, values: np.ndarray) -> np.ndarray:
+        """``values`` summed over the ranks (on one rank, themselves: no exchange)."""
+        return values if self.comm.size == 1 else self.comm.allreduce(values)

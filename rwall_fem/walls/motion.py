@@ -92,6 +92,8 @@ class PrescribedMotion(_Translating):
         self.previous_velocity = self.velocity.copy()
 
     def _at(self, t: float) -> np.ndarray:
+        if len(self.times) == 1:  # a constant velocity: no interpolation at each step
+            return self.values[0].copy()
         return np.array([np.interp(t, self.times, column) for column in self.values.T])
 
     def predict(self, t: float, dt: float) -> np.ndarray:
