@@ -329,12 +329,15 @@ class ElementForce(InternalForce):
                 else f"{family}_plastic"
             )
             state = (ptr(self.history), self.num_cells)
-            return functools.partial(getattr(self.lib, name), *common, ptr(v), self.params, *state,
+            call = functools.partial(getattr(self.lib, name), *common, ptr(v), self.params, *state,
                                      ptr(f), ptr(energy), ptr(step))  # fmt: skip
-        if t.integration == "reduced":
+        elif t.integration == "reduced":
             kernel = getattr(self.lib, f"hex8r_{model}_{t.hourglass}")
-            return functools.partial(kernel, *common, ptr(v), *rest)
-        return functools.partial(getattr(self.lib, f"{family}_{model}"), *common, *rest)
+            call = functools.partial(kernel, *common, ptr(v), *rest)
+        else:
+            call = functools.partial(getattr(self.lib, f"{family}_{model}"), *common, *rest)
+        call.keep = (self, u, v, f, energy, step)  # what the pointers point into
+        return call
 
     def _rebind(self) -> None:
         self._kernel = self._bind(self.u.array, self.v.array, self.f.array, self._energy, self.step)
