@@ -6,6 +6,7 @@ cycles and the loop-time ratio (1 thread / 1 rank each).
 
 DIR holds OpenRadioss's executables ``starter_linux64_gf`` and ``engine_linux64_gf``
 (default ``$OPENRADIOSS_PATH/exec``, else ``../openradioss-src/exec`` beside the clone);
+``bench/openradioss/build.sh SRC`` builds them from a snapshot of OpenRadioss's sources;
 without them the script says so in one line and stops (exit 0). Each deck
 (``../shared/peer-decks/gen_shell.py``: the tube at h 2.5 mm, Ishell 24; the same tube with
 self-contact, ``/INTER/TYPE7``, ``tubec``; the plate, Ishell 24, 20 m/s) runs ``--repeat``
