@@ -56,6 +56,8 @@ typedef struct
   double qeph_dn;          /* its numerical damping dn: the length times sqrt(1 + dn^2) - dn */
   int qeph_hourglass;      /* quadrilaterals with hk > 0, elasto-plastic: QEPH's yielding
                               hourglass forces (Ishell 24; shell_quad.c, qeph_hourglass_yield) */
+  int qeph_physical;       /* quadrilaterals, 1: QEPH's physical hourglass stiffness, 12 state
+                              rows from hourglass_slot (shell_quad.c, quad_hourglass_qeph) */
 } shell_params;
 
 /* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one

@@ -342,6 +342,27 @@ INLINE vec qeph_pair_norm(vec a1, vec a2, vec c1, vec c2)
  * the mode is), the x mode (V, -nu V), the y mode (-nu V, V); the bending modes are the
  * rotations about y and minus those about x (CZDEF's DHG3, DHG4).  old, dq, k: the forces
  * before the step, the increments dt q and the stiffnesses of quad_hourglass; dQ in/out. */
+/* The shares EH1, EH2 of the step's membrane and bending hourglass stress increments that
+ * CZFINTN1 takes back (qeph_hourglass_yield's rule) from the pair norms hm, hb of the new
+ * hourglass stresses (qeph_pair_norm, Pa^2, without COEF) and whether the old forces work
+ * positively on the increments (loading; unloading is elastic). */
+INLINE void qeph_yield_factors(const qeph_material_t *mat, vec t, vec hm, vec hb,
+                               ivec loading_m, ivec loading_b, vec *eh1, vec *eh2)
+{
+  const vec cm = (0.85 / 16.0) * t;
+  const vec flowing = VZERO + (1.0 - mat->least_tangent);
+  const vec yield2 = mat->flow * mat->flow;
+  const ivec elastic = flowing <= 0.0;
+  const vec S0 = vselect(elastic, qeph_mises2(mat->membrane) + (0.85 * 0.85) * hm, VZERO);
+  const vec M0 = qeph_mises2(mat->bending) + cm * cm * hb;
+  const ivec yields = ~elastic | (S0 + 25.0 * M0 > yield2);
+  const vec e1 = vmax(0.999 * vmin(S0 / vmax(yield2, VZERO + 1e-18), VZERO + 1.0),
+                      1.0 - mat->mean_tangent);
+  const vec e2 = vmax(VZERO + 0.999, flowing);
+  *eh1 = vselect(yields & loading_m, e1, VZERO);
+  *eh2 = vselect(yields & loading_b, e2, VZERO);
+}
+
 INLINE void qeph_hourglass_yield(const shell_params *s, const qeph_material_t *mat, vec area,
                                  vec t, const vec old[5], const vec dq[5], const vec k[5],
                                  vec dQ[5])
@@ -351,24 +372,133 @@ INLINE void qeph_hourglass_yield(const shell_params *s, const qeph_material_t *m
   vec V[5];
   for (int m = 0; m < 5; ++m)
     V[m] = scale * (old[m] + dQ[m]) / k[m];
-  const vec hm = qeph_pair_norm(V[0], -nu * V[0], -nu * V[1], V[1]);
-  const vec hb = qeph_pair_norm(V[4], -nu * V[4], nu * V[3], -V[3]);
-  const vec cm = (0.85 / 16.0) * t;
-  const vec flowing = VZERO + (1.0 - mat->least_tangent);
-  const vec yield2 = mat->flow * mat->flow;
-  const ivec elastic = flowing <= 0.0;
-  const vec S0 = vselect(elastic, qeph_mises2(mat->membrane) + (0.85 * 0.85) * hm, VZERO);
-  const vec M0 = qeph_mises2(mat->bending) + cm * cm * hb;
-  const ivec yields = ~elastic | (S0 + 25.0 * M0 > yield2);
-  vec eh1 = vmax(0.999 * vmin(S0 / vmax(yield2, VZERO + 1e-18), VZERO + 1.0),
-                 1.0 - mat->mean_tangent);
-  vec eh2 = vmax(VZERO + 0.999, flowing);
-  eh1 = vselect(yields & (old[0] * dq[0] + old[1] * dq[1] >= 0.0), eh1, VZERO);
-  eh2 = vselect(yields & (old[3] * dq[3] + old[4] * dq[4] >= 0.0), eh2, VZERO);
+  vec eh1, eh2;
+  qeph_yield_factors(mat, t, qeph_pair_norm(V[0], -nu * V[0], -nu * V[1], V[1]),
+                     qeph_pair_norm(V[4], -nu * V[4], nu * V[3], -V[3]),
+                     old[0] * dq[0] + old[1] * dq[1] >= 0.0,
+                     old[3] * dq[3] + old[4] * dq[4] >= 0.0, &eh1, &eh2);
   dQ[0] *= 1.0 - eh1;
   dQ[1] *= 1.0 - eh1;
   dQ[3] *= 1.0 - eh2;
   dQ[4] *= 1.0 - eh2;
+}
+
+/* QEPH's physical hourglass stiffness (Radioss's Ishell 24, OpenRadioss's CZDEF and
+ * CZFINTN1, czdef.F and czfintn.F; s->qeph_physical).  With the nodes' mid-points about the
+ * centroid MX13 = (x0 + x2) / 2, MX23 = (x1 + x2) / 2, MX34 = (x2 + x3) / 2 (MY.. alike),
+ * h = (1, -1, 1, -1), and the hourglass increments of the step
+ *     d1 = dt gamma.vx, d2 = dt gamma.vy            (membrane: CZDEF's VHG1, VHG2)
+ *     d3 = dt gamma.theta_y, d4 = -dt gamma.theta_x  (bending: VHG3, VHG4)
+ *     d5 = 4 dt (h.vz - MY13 S(tx) + MY23 S23(tx) - MX23 S23(ty) + MX13 S(ty)),
+ *     d6 = the same with MY34, MX34 and S34         (transverse shear: VHG5, VHG6),
+ * S the nodes' sum, S23 with the signs (1, 1, -1, -1), S34 with (1, -1, -1, 1) (d5 and d6
+ * vanish in any rigid motion and in the constant-twist mode w = a x y), the twelve
+ * hourglass stresses V (state rows s->hourglass_slot..+11, Pa) take the increments, with
+ * HXX = 4 MY34 / A, HYY = 4 MX34 / A, HXX_K = 4 MY23 / A, HYY_K = 4 MX23 / A, E' = E / (1 - nu^2),
+ *     V1 += E' (HXX d1 - nu HYY d2),   V2 += E' (HYY d2 - nu HXX d1),
+ *     V7 += E' (HXX_K d1 - nu HYY_K d2), V8 += E' (HYY_K d2 - nu HXX_K d1),
+ * V3, V4, V9, V10 the same of d3, d4, and with C = G k / 64 (k the shear factor)
+ *     V5 += C HXX d5, V6 += C HYY d5, V11 += C HXX_K d6, V12 += C HYY_K d6,
+ * (CZFINTN1's FAC1 = 1), the membrane and bending increments yielding as
+ * qeph_yield_factors with the norms of (V1, V2 | V7, V8) and (V3, V4 | V9, V10).  Their
+ * generalized forces, conjugate to d1 .. d6 (N, N m, N / m),
+ *     F1 = 4/3 t (MY34 V1 + MY23 V7),   F2 = 4/3 t (MX23 V8 + MX34 V2),
+ *     F3 = 4/3 t^3/12 (MY34 V3 + MY23 V9),  F4 = 4/3 t^3/12 (MX23 V10 + MX34 V4),
+ *     F5 = t/3 (MY34 V5 + MX34 V6),   F6 = t/3 (MY23 V11 + MX23 V12),
+ * act on the nodes through the transposed rates (as CZFINTN1's VF, VM).  On an a x c
+ * rectangle: F1 = 4/3 E' t (c / a) d1, the exact energy of the mode vx = x y / ... in plane
+ * stress (tests/shells/test_qeph_hourglass.py).  Adds F1 to Q[0], F2 to Q[1], -F4 to Q[3],
+ * F3 to Q[4] (the gamma modes) and the shear's nodal forces and moments to fz, ml; returns
+ * the work of the step, sum (F_old + F_new) d / 2 (J). */
+INLINE vec quad_hourglass_qeph(const quad_frame_t *g, const shell_params *s, double dt,
+                               vec t, const vec q[5], const vec vl[4][3], const vec wl[4][3],
+                               double *restrict state, int64_t stride, const batch_t *b,
+                               const qeph_material_t *yielding, vec Q[5], vec fz[4],
+                               vec ml[4][2])
+{
+  static const double S23[4] = {1.0, 1.0, -1.0, -1.0}, S34[4] = {1.0, -1.0, -1.0, 1.0};
+  const vec *X = g->x, *Y = g->y;
+  const vec mx13 = 0.5 * (X[0] + X[2]), mx23 = 0.5 * (X[1] + X[2]), mx34 = 0.5 * (X[2] + X[3]);
+  const vec my13 = 0.5 * (Y[0] + Y[2]), my23 = 0.5 * (Y[1] + Y[2]), my34 = 0.5 * (Y[2] + Y[3]);
+  vec hz = VZERO, sx = VZERO, sy = VZERO, s23x = VZERO, s23y = VZERO, s34x = VZERO,
+      s34y = VZERO;
+  for (int I = 0; I < 4; ++I)
+  {
+    hz += WARP_SIGN[I] * vl[I][2];
+    sx += wl[I][0], sy += wl[I][1];
+    s23x += S23[I] * wl[I][0], s23y += S23[I] * wl[I][1];
+    s34x += S34[I] * wl[I][0], s34y += S34[I] * wl[I][1];
+  }
+  const vec d[6] = {dt * q[0], dt * q[1], dt * q[4], -dt * q[3],
+                    (4.0 * dt) * (hz - my13 * sx + my23 * s23x - mx23 * s23y + mx13 * sy),
+                    (4.0 * dt) * (hz - my13 * sx + my34 * s34x - mx34 * s34y + mx13 * sy)};
+  const vec inv4 = 4.0 / g->area;
+  const vec hxx = inv4 * my34, hyy = inv4 * mx34, hxxk = inv4 * my23, hyyk = inv4 * mx23;
+  const double Ep = s->young / (1.0 - s->poisson * s->poisson), nu = s->poisson;
+  const double C = 0.5 * s->young / (1.0 + s->poisson) * s->shear_factor / 64.0;
+  vec V[12], dV[12];
+  for (int m = 0; m < 12; ++m)
+    V[m] = load_slot(state, stride, b, s->hourglass_slot + m);
+  /* V1, V2, V7, V8 (rows 0, 1, 6, 7) of d1, d2; V3, V4, V9, V10 (2, 3, 8, 9) of d3, d4 */
+  for (int j = 0; j < 2; ++j)
+  {
+    const vec da = d[2 * j], db = d[2 * j + 1];
+    dV[2 * j] = Ep * (hxx * da - nu * hyy * db);
+    dV[2 * j + 1] = Ep * (hyy * db - nu * hxx * da);
+    dV[6 + 2 * j] = Ep * (hxxk * da - nu * hyyk * db);
+    dV[7 + 2 * j] = Ep * (hyyk * db - nu * hxxk * da);
+  }
+  dV[4] = C * hxx * d[4], dV[5] = C * hyy * d[4];
+  dV[10] = C * hxxk * d[5], dV[11] = C * hyyk * d[5];
+  const vec c43 = (4.0 / 3.0) * t, c43b = c43 * (t * t / 12.0), c13 = t / 3.0;
+  vec F_old[6];
+  F_old[0] = c43 * (my34 * V[0] + my23 * V[6]);
+  F_old[1] = c43 * (mx23 * V[7] + mx34 * V[1]);
+  F_old[2] = c43b * (my34 * V[2] + my23 * V[8]);
+  F_old[3] = c43b * (mx23 * V[9] + mx34 * V[3]);
+  F_old[4] = c13 * (my34 * V[4] + mx34 * V[5]);
+  F_old[5] = c13 * (my23 * V[10] + mx23 * V[11]);
+  for (int m = 0; m < 12; ++m)
+    V[m] += dV[m];
+  if (yielding)
+  {
+    vec eh1, eh2;
+    qeph_yield_factors(yielding, t, qeph_pair_norm(V[0], V[1], V[6], V[7]),
+                       qeph_pair_norm(V[2], V[3], V[8], V[9]),
+                       F_old[0] * d[0] + F_old[1] * d[1] >= 0.0,
+                       F_old[2] * d[2] + F_old[3] * d[3] >= 0.0, &eh1, &eh2);
+    static const int MEMBRANE[4] = {0, 1, 6, 7}, BENDING[4] = {2, 3, 8, 9};
+    for (int j = 0; j < 4; ++j)
+    {
+      V[MEMBRANE[j]] -= eh1 * dV[MEMBRANE[j]];
+      V[BENDING[j]] -= eh2 * dV[BENDING[j]];
+    }
+  }
+  for (int m = 0; m < 12; ++m)
+    store_slot(state, stride, b, s->hourglass_slot + m, V[m]);
+  vec F[6];
+  F[0] = c43 * (my34 * V[0] + my23 * V[6]);
+  F[1] = c43 * (mx23 * V[7] + mx34 * V[1]);
+  F[2] = c43b * (my34 * V[2] + my23 * V[8]);
+  F[3] = c43b * (mx23 * V[9] + mx34 * V[3]);
+  F[4] = c13 * (my34 * V[4] + mx34 * V[5]);
+  F[5] = c13 * (my23 * V[10] + mx23 * V[11]);
+  vec work = VZERO;
+  for (int m = 0; m < 6; ++m)
+    work += 0.5 * (F_old[m] + F[m]) * d[m];
+  Q[0] += F[0];
+  Q[1] += F[1];
+  Q[3] -= F[3];
+  Q[4] += F[2];
+  /* the transverse shear's: d(d5)/dt over the nodes' vz, theta_x, theta_y, times F5 */
+  const vec f5 = 4.0 * F[4], f6 = 4.0 * F[5];
+  for (int I = 0; I < 4; ++I)
+  {
+    fz[I] = WARP_SIGN[I] * (f5 + f6);
+    ml[I][0] = f5 * (S23[I] * my23 - my13) + f6 * (S34[I] * my34 - my13);
+    ml[I][1] = f5 * (mx13 - S23[I] * mx23) + f6 * (mx13 - S34[I] * mx34);
+  }
+  return work;
 }
 
 /* The viscous hourglass forces of the cells of frame g (added to fe, global) from the local
@@ -400,7 +530,12 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   vec work = VZERO;
   for (int k = 0; k < 5; ++k)
     work += dt * Q[k] * q[k];
-  if (s->hk > 0.0)
+  vec fz[4] = {VZERO, VZERO, VZERO, VZERO}, ms[4][2] = {{VZERO, VZERO}, {VZERO, VZERO},
+                                                        {VZERO, VZERO}, {VZERO, VZERO}};
+  if (s->qeph_physical)
+    work += quad_hourglass_qeph(g, s, dt, thickness, q, vl, wl, state, stride, b, yielding, Q,
+                                fz, ms);
+  else if (s->hk > 0.0)
   {
     /* elastic hourglass forces, incremental in the cell's frame: dQ = k dt q */
     vec bb = VZERO;
@@ -433,8 +568,9 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   {
     for (int k = 0; k < 3; ++k)
       fl[I][k] = gamma[I] * Q[k];
-    ml[I][0] = gamma[I] * Q[3];
-    ml[I][1] = gamma[I] * Q[4];
+    fl[I][2] += fz[I];
+    ml[I][0] = gamma[I] * Q[3] + ms[I][0];
+    ml[I][1] = gamma[I] * Q[4] + ms[I][1];
   }
   if (warping)
     project_rigid_forces(g, Ji, fl);
@@ -580,7 +716,7 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
         s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
     /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
      * MULAWC): the points' plastic strains before it */
-    const int qeph = plastic && s->qeph_hourglass && s->hk > 0.0;
+    const int qeph = plastic && s->qeph_hourglass && (s->hk > 0.0 || s->qeph_physical);
     vec eps_before[SHELL_MAX_POINTS];
     for (int pt = 0; qeph && pt < s->points; ++pt)
       eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
@@ -590,7 +726,7 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     if (qeph)
       qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
     vec hourglass = VZERO;
-    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0)
+    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0 || s->qeph_physical)
       hourglass = quad_hourglass(&g, s, p->density, dt, t, warping, Ji, vl, wl, state, stride,
                                  &b, qeph ? &material : NULL, fe);
     if (s->new_thickness)

@@ -896,10 +896,12 @@ class Element:
         default_doc="a built-in plate's size[2]; required for a mesh file of surfaces",
     )
     formulation: str | None = key(
-        Choice(("bwc", "bt", "bsc")),
+        Choice(("bwc", "bt", "qeph", "bsc")),
         None,
         doc="shells: bwc, Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping "
-        "correction; bt, plain Belytschko-Lin-Tsay (quadrilaterals); bsc, the "
+        "correction; bt, plain Belytschko-Lin-Tsay (quadrilaterals); qeph, bwc with "
+        "Radioss's QEPH physical hourglass stiffness per mode (membrane, bending, "
+        "transverse shear; Ishell 24; not with hourglass_stiffness); bsc, the "
         "Belytschko-Stolarski-Carpenter triangle",
         default_doc="bwc on quadrilaterals, bsc on triangles",
     )
@@ -1694,7 +1696,7 @@ def element_fits_the_surface(where: str, given, cell: str) -> str | None:
                 return (f"{where}.{name}: is for quadrilateral shells (the triangle has no "
                         "such term), and the mesh has triangle cells: leave it out")  # fmt: skip
     formulation = given.get("formulation")
-    fits = {"quadrilateral": ("bt", "bwc"), "triangle": ("bsc",)}
+    fits = {"quadrilateral": ("bt", "bwc", "qeph"), "triangle": ("bsc",)}
     if shells and formulation is not None and formulation not in fits[cell]:
         return (f"{where}.formulation: {formulation!r} is not an element of {cell} cells; "
                 f"allowed: {', '.join(fits[cell])}")  # fmt: skip
@@ -1724,7 +1726,7 @@ def _pieces_instead_of_mesh(v, raw, fail):
 def _element_fits_shells_or_solids(v, raw, fail):
     """Shell keys (thickness, formulation, points, hourglass_coefficients, shear_factor, ...)
     for surface cells only, the solids' (integration, hourglass, hourglass_coefficient) for
-    volume cells only; formulation bt or bwc on quadrilaterals, bsc on triangles;
+    volume cells only; formulation bt, bwc or qeph on quadrilaterals, bsc on triangles;
     hourglass_stiffness, drilling_stiffness and step_length on quadrilaterals only. (For a
     mesh file the cells are known when the body is built.)"""
     mesh = v["mesh"]

@@ -41,6 +41,8 @@ FORMULATIONS = {
     "bwc": "Belytschko-Lin-Tsay quadrilateral shells with the Belytschko-Wong-Chiang "
     "warping correction",
     "bt": "Belytschko-Lin-Tsay quadrilateral shells",
+    "qeph": "Belytschko-Lin-Tsay quadrilateral shells with the warping correction and "
+    "QEPH's physical hourglass stiffness (Radioss Ishell 24)",
     "bsc": "Belytschko-Stolarski-Carpenter triangular shells",
 }
 

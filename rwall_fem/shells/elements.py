@@ -38,7 +38,9 @@ SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "she
            "shell_quad.c", "shell_tria.c")  # fmt: skip
 POINT_SLOTS = 5  # per point through the thickness: sxx, syy, sxy, eps_p, temperature
 MAX_POINTS = 10
-FORMULATIONS = {"quadrilateral": ("bwc", "bt"), "triangle": ("bsc",)}
+# "qeph": Radioss's QEPH (Ishell 24): BWC's warping correction with QEPH's physical
+# hourglass stiffness per mode (shell_quad.c, quad_hourglass_qeph)
+FORMULATIONS = {"quadrilateral": ("bwc", "bt", "qeph"), "triangle": ("bsc",)}
 FAMILY = {"quadrilateral": "quad", "triangle": "tria"}
 # The quadrilaterals' characteristic lengths of the step: "bt", Radioss's for its
 # Belytschko-Tsay shells (CDLEN3); "qeph", QEPH's (CZCORC1) with its default numerical
@@ -67,6 +69,7 @@ typedef struct {
   int qeph_step;
   double qeph_dn;
   int qeph_hourglass;
+  int qeph_physical;
 } shell_params;
 """
     + "".join(
@@ -166,6 +169,11 @@ class ShellTechnology:
             raise ValueError(
                 f"element.drilling_stiffness: must be >= 0, got {drilling_stiffness}"
             )
+        if formulation == "qeph" and hourglass_stiffness > 0.0:
+            raise ValueError(
+                "element.hourglass_stiffness: not with formulation = \"qeph\" "
+                "(QEPH's hourglass stiffness is its own)"
+            )
         if step_length not in STEP_LENGTHS:
             raise ValueError(f"element.step_length: {step_length!r}; allowed: {STEP_LENGTHS}")
         quad = cell == "quadrilateral"
@@ -180,7 +188,8 @@ class ShellTechnology:
         if self.cell == "triangle":
             return "Belytschko-Stolarski-Carpenter C0 triangles"
         name = "Belytschko-Lin-Tsay quadrilaterals"
-        warp = " with the BWC warping correction" if self.formulation == "bwc" else ""
+        warp = " with the BWC warping correction" if self.formulation != "bt" else ""
+        warp += ", QEPH's physical hourglass stiffness" if self.formulation == "qeph" else ""
         hm, hf, hr = self.hourglass
         step = ", QEPH's step length" if self.step_length == "qeph" else ""
         step += ", QEPH's yielding hourglass forces" if self.hourglass_yield else ""
@@ -241,7 +250,8 @@ class ShellKernel:
         # the step L_c / c is sqrt(1 - nu^2) times longer than with the plate speed.
         s.bar_speed = math.sqrt(E / rho)
         s.hm, s.hf, s.hr = technology.hourglass
-        s.warping = int(technology.formulation == "bwc")
+        s.warping = int(technology.formulation in ("bwc", "qeph"))
+        s.qeph_physical = int(technology.formulation == "qeph")
         if not 0.0 < failed_share <= 1.0:
             raise ValueError(f"element.failed_share: must be in (0, 1], got {failed_share}")
         s.fail_fraction = failed_share
@@ -261,9 +271,11 @@ class ShellKernel:
         self.thickness_change = bool(thickness_change)
         if self.thickness_change:
             s.new_thickness = ffi.cast("double *", self.thickness.ctypes.data)
-        if s.hk > 0.0:  # the elastic hourglass forces, in rows after the others
+        if s.hk > 0.0 or s.qeph_physical:  # the elastic hourglass forces (QEPH's 12
+            # hourglass stresses), in rows after the others
             s.hourglass_slot = len(self.history)
-            self.history = np.concatenate([self.history, np.zeros((5, n))])
+            rows = 12 if s.qeph_physical else 5
+            self.history = np.concatenate([self.history, np.zeros((rows, n))])
         s.kd = technology.drilling_stiffness
         if s.kd > 0.0:  # the nodal drilling moments, in rows after the others
             s.drill_slot = len(self.history)
