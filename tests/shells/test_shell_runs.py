@@ -46,11 +46,12 @@ def plate(cell="quadrilateral", size=(0.1, 0.05, 0.002), h=0.01, end_time=1e-4, 
 TWISTED = {"hourglass_stiffness": 0.5, "drilling_stiffness": 0.01}
 
 
-@pytest.mark.parametrize("element", [{}, TWISTED], ids=["viscous", "stiffness-and-drilling"])
+@pytest.mark.parametrize("element", [{}, TWISTED, {"formulation": "qeph"}],
+                         ids=["viscous", "stiffness-and-drilling", "qeph"])  # fmt: skip
 def test_a_free_plate_translating_and_spinning_stores_no_strain(shared_dir, element):
     """1,000 steps of a plate spinning at Omega (about 1.1 rad in all) while it translates;
-    with the elastic hourglass stiffness and the drilling springs of the scene too (a rigid
-    motion loads neither)."""
+    with the elastic hourglass stiffness and the drilling springs of the scene too, and with
+    QEPH's physical hourglass stiffness (a rigid motion loads none)."""
     raw = plate(end_time=1.0, element=element)
     scene = parse_scene(copy.deepcopy(raw), source="test")
     sim = build_simulation(scene, comm, shared_dir)
