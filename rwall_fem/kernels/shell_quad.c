@@ -410,8 +410,8 @@ INLINE void qeph_hourglass_yield(const shell_params *s, const qeph_material_t *m
  * stress (tests/shells/test_qeph_hourglass.py).  Adds F1 to Q[0], F2 to Q[1], -F4 to Q[3],
  * F3 to Q[4] (the gamma modes) and the shear's nodal forces and moments to fz, ml; returns
  * the work of the step, sum (F_old + F_new) d / 2 (J). */
-INLINE vec quad_hourglass_qeph(const quad_frame_t *g, const shell_params *s, double dt,
-                               vec t, const vec q[5], const vec vl[4][3], const vec wl[4][3],
+INLINE vec quad_hourglass_qeph(const quad_frame_t *g, const shell_params *s, double density,
+                               double dt, vec t, const vec q[5], const vec vl[4][3], const vec wl[4][3],
                                double *restrict state, int64_t stride, const batch_t *b,
                                const qeph_material_t *yielding, vec Q[5], vec fz[4],
                                vec ml[4][2])
@@ -429,9 +429,12 @@ INLINE vec quad_hourglass_qeph(const quad_frame_t *g, const shell_params *s, dou
     s23x += S23[I] * wl[I][0], s23y += S23[I] * wl[I][1];
     s34x += S34[I] * wl[I][0], s34y += S34[I] * wl[I][1];
   }
-  const vec d[6] = {dt * q[0], dt * q[1], dt * q[4], -dt * q[3],
-                    (4.0 * dt) * (hz - my13 * sx + my23 * s23x - mx23 * s23y + mx13 * sy),
-                    (4.0 * dt) * (hz - my13 * sx + my34 * s34x - mx34 * s34y + mx13 * sy)};
+  const vec r[6] = {q[0], q[1], q[4], -q[3],
+                    4.0 * (hz - my13 * sx + my23 * s23x - mx23 * s23y + mx13 * sy),
+                    4.0 * (hz - my13 * sx + my34 * s34x - mx34 * s34y + mx13 * sy)};
+  vec d[6];
+  for (int m = 0; m < 6; ++m)
+    d[m] = dt * r[m];
   const vec inv4 = 4.0 / g->area;
   const vec hxx = inv4 * my34, hyy = inv4 * mx34, hxxk = inv4 * my23, hyyk = inv4 * mx23;
   const double Ep = s->young / (1.0 - s->poisson * s->poisson), nu = s->poisson;
@@ -486,6 +489,30 @@ INLINE vec quad_hourglass_qeph(const quad_frame_t *g, const shell_params *s, dou
   vec work = VZERO;
   for (int m = 0; m < 6; ++m)
     work += 0.5 * (F_old[m] + F[m]) * d[m];
+  /* QEPH's viscous hourglass forces (CZFINTN1's SS1_V .. SC6_V, booked in its hourglass
+   * energy EVIS): with mu = dn sqrt(rho A) / A and the rates r = d / dt,
+   *   F1 += t mu (sqrt(E') 16/3 (MY34^2 + MY23^2) r1 - sqrt(nu E') 16/3 (MY34 MX34 + MY23 MX23) r2),
+   * F2 alike, F3, F4 the same of r3, r4 times t^2 sqrt(12) / 12, and
+   *   F5 += t mu sqrt(G k / 12) (MY34^2 + MX34^2) r5 / 4, F6 with MY23, MX23 */
+  const vec mu = s->qeph_dn * vsqrt(density * g->area) / g->area;
+  const vec vxx = (16.0 / 3.0) * (my34 * my34 + my23 * my23),
+            vyy = (16.0 / 3.0) * (mx23 * mx23 + mx34 * mx34),
+            vxy = (-16.0 / 3.0) * (my34 * mx34 + my23 * mx23);
+  const vec cxx = (sqrt(Ep) * mu) * vxx, cyy = (sqrt(Ep) * mu) * vyy,
+            cxy = (sqrt(nu * Ep) * mu) * vxy;
+  const vec gz = (sqrt(64.0 * C / 12.0) * mu) * t; /* sqrt(G k / 12) HVL t / A */
+  vec Fv[6];
+  Fv[0] = t * (cxx * r[0] + cxy * r[1]);
+  Fv[1] = t * (cyy * r[1] + cxy * r[0]);
+  Fv[2] = (t * t * t / 12.0 * sqrt(12.0)) * (cxx * r[2] + cxy * r[3]);
+  Fv[3] = (t * t * t / 12.0 * sqrt(12.0)) * (cyy * r[3] + cxy * r[2]);
+  Fv[4] = 0.25 * gz * (my34 * my34 + mx34 * mx34) * r[4];
+  Fv[5] = 0.25 * gz * (mx23 * mx23 + my23 * my23) * r[5];
+  for (int m = 0; m < 6; ++m)
+  {
+    work += Fv[m] * d[m];
+    F[m] += Fv[m];
+  }
   Q[0] += F[0];
   Q[1] += F[1];
   Q[3] -= F[3];
@@ -533,7 +560,7 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s, double d
   vec fz[4] = {VZERO, VZERO, VZERO, VZERO}, ms[4][2] = {{VZERO, VZERO}, {VZERO, VZERO},
                                                         {VZERO, VZERO}, {VZERO, VZERO}};
   if (s->qeph_physical)
-    work += quad_hourglass_qeph(g, s, dt, thickness, q, vl, wl, state, stride, b, yielding, Q,
+    work += quad_hourglass_qeph(g, s, density, dt, thickness, q, vl, wl, state, stride, b, yielding, Q,
                                 fz, ms);
   else if (s->hk > 0.0)
   {

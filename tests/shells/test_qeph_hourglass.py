@@ -15,7 +15,8 @@ element keeps the normal strains and curvatures of the mode, as QEPH does):
 the internal nodal forces of a step are h_I / 4 K dt s for the first two (the mode's pattern) and
 h_I K dt s / 4 summed as sum_I h_I f_I = K dt s for the shear. A constant twist
 (w = alpha x y with the rotations of zero transverse shear) is physical, not an
-hourglass mode: no hourglass stress; nor does any rigid motion make one.
+hourglass mode: no hourglass stress; nor does any rigid motion make one. QEPH's viscous
+hourglass forces (its numerical damping dn) are checked against its rule by hand.
 
 On a body: the dented plate of test_hourglass_yield with QEPH's hourglass and its yield
 closes its books to round-off (the hourglass energy is the forces' work), 1 and 2 ranks
@@ -48,12 +49,14 @@ H = np.array([1.0, -1.0, 1.0, -1.0])
 DT, S = 1e-9, 0.3  # the step (s) and the mode's rate (m/s or rad/s): a tiny motion
 
 
-def one_step(velocity, spin):
+def one_step(velocity, spin, dn=0.0):
     """The nodal forces and moments of one step of the given nodal velocities and
-    angular velocities (4 x 3) from rest, the hourglass energy, and the kernel."""
+    angular velocities (4 x 3) from rest, the hourglass energy, and the kernel; QEPH's
+    numerical damping dn (0: the elastic forces alone)."""
     technology = ShellTechnology.choose("quadrilateral", formulation="qeph",
                                         hourglass=(0.0, 0.0, 0.0))  # fmt: skip
     k = ShellKernel(ELASTIC, technology, np.array([[0, 1, 2, 3]], np.int32), T)
+    k.shell.qeph_dn = dn
     f, m, energy = np.zeros((4, 3)), np.zeros((4, 3)), np.zeros(4)
     k.run(DT, RECTANGLE, DT * velocity, velocity, spin, f, m, energy=energy)
     return f, m, energy, k
@@ -100,6 +103,20 @@ def test_the_transverse_shear_mode_takes_its_mindlin_energy():
     assert H @ f[:, 2] == pytest.approx(stiffness * DT * S, rel=1e-6)
     assert f[:, 2] == pytest.approx(H * stiffness * DT * S / 4, rel=1e-6)
     assert energy[1] == pytest.approx(0.5 * stiffness * (DT * S) ** 2, rel=1e-6)
+
+
+def test_the_viscous_forces_follow_qeph_damping():
+    """QEPH's viscous hourglass forces (CZFINTN1, dn = 0.015) worked by hand on the
+    rectangle's membrane x mode (MY34 = c / 2, MY23 = MX34 = 0):
+    F = t dn sqrt(rho A) / A sqrt(E') 16/3 (c / 2)^2 s on top of the elastic K dt s,
+    within 1e-6; the step's hourglass energy grows by F_viscous dt s."""
+    dn = 0.015
+    f0, _, e0, _ = one_step(pattern(0, S * H), np.zeros((4, 3)))
+    f, _, e, _ = one_step(pattern(0, S * H), np.zeros((4, 3)), dn=dn)
+    area = A * C
+    viscous = T * dn * math.sqrt(RHO * area) / area * math.sqrt(EP) * 16 / 3 * (C / 2) ** 2 * S
+    assert f[:, 0] - f0[:, 0] == pytest.approx(H / 4 * viscous, rel=1e-6)
+    assert e[1] - e0[1] == pytest.approx(viscous * DT * S, rel=1e-6)
 
 
 def test_a_constant_twist_and_rigid_motions_make_no_hourglass_stress():
