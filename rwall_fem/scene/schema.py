@@ -970,12 +970,13 @@ class Element:
     hourglass_yield: bool | None = key(
         Flag(),
         None,
-        doc="quadrilateral shells with hourglass_stiffness, elasto-plastic materials: the "
-        "elastic hourglass forces yield as in Radioss's QEPH (Ishell 24): in a cell whose "
-        "points flow, or whose mean stresses with the hourglass stresses reach the yield "
-        "stress, the step's membrane increment is scaled by the mean E_t / E of its points "
-        "and the bending one by at most 0.001 (docs/theory.md)",
-        default_doc="false (elastic hourglass forces; a deck's Ishell 24 does not set it: docs/radioss.md)",
+        doc="quadrilateral shells with hourglass_stiffness or formulation qeph, "
+        "elasto-plastic materials: the elastic hourglass forces yield as in Radioss's QEPH "
+        "(Ishell 24): in a cell whose points flow, or whose mean stresses with the hourglass "
+        "stresses reach the yield stress, the step's membrane increment is scaled by the "
+        "mean E_t / E of its points and the bending one by at most 0.001 (docs/theory.md)",
+        default_doc="false (elastic hourglass forces; a deck's Ishell 24 sets it with "
+        "formulation qeph: docs/radioss.md)",
     )
 
 

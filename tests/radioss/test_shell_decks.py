@@ -249,8 +249,8 @@ def test_idrill_and_ishell_3_map_onto_the_quadrilaterals_kernel(ishell, idrill, 
 
 @pytest.mark.parametrize("ishell", [1, 24])
 def test_ishell_24_takes_qeph_step_length(ishell, shared_dir):
-    """Ishell 24 (QEPH): QEPH's characteristic length of the step, with dn = 0.015 (the
-    compiled kernel's); Ishell 1: Radioss's Belytschko-Tsay length. The body's first
+    """Ishell 24 (QEPH): formulation "qeph" with its hourglass yield (no hm, hf, hr) and
+    QEPH's characteristic length of the step, with dn = 0.015 (the compiled kernel's); Ishell 1: Radioss's Belytschko-Tsay length. The body's first
     step is 0.9 of its smallest cell's L_c / sqrt(E / rho) by the rule."""
 
     def edit(lines):
@@ -259,10 +259,15 @@ def test_ishell_24_takes_qeph_step_length(ishell, shared_dir):
     scene = load_deck(written(plate_deck(), shared_dir, edit))
     qeph = ishell == 24
     assert scene.element.step_length == ("qeph" if qeph else None)
+    # Ishell 24: QEPH's own hourglass forces with their yield; hm, hf, hr not read
+    assert scene.element.formulation == ("qeph" if qeph else "bwc")
+    assert bool(scene.element.hourglass_yield) == qeph
     sim = build_simulation(scene, comm, shared_dir)
     elements = sim.internal.elements[0]
     compiled = elements.kernel.shell
     assert (compiled.qeph_step, compiled.qeph_dn) == (int(qeph), 0.015)
+    assert (compiled.qeph_physical, compiled.qeph_hourglass) == (int(qeph), int(qeph))
+    assert (compiled.hm, compiled.hk) == ((0.0, 0.0) if qeph else (0.01, compiled.hk))
     side = comm.allreduce(elements.length0.min() if len(elements.length0) else np.inf, op=MPI.MIN)
     square = 1 / math.sqrt(2 * (0.78 + 0.22 * (3.413 * 0.2929) ** 3) * 1.25 / 2)
     factor = square * (math.sqrt(1 + 0.015**2) - 0.015) if qeph else 1.0
@@ -275,7 +280,7 @@ def test_ishell_24_takes_qeph_step_length(ishell, shared_dir):
     said = []
     load_deck(written(plate_deck(), shared_dir, other_dn), report=said)
     warned = [w for w in said[0].warnings if "dn = 0.02" in w]
-    assert len(warned) == int(qeph) and all("takes dn = 0.015" in w for w in warned)
+    assert len(warned) == int(qeph) and all("take dn = 0.015" in w for w in warned)
 
 
 def test_idrill_other_than_1_and_2_is_refused(shared_dir):

@@ -1,13 +1,15 @@
 """Shell elements and their property: /SHELL, /SH3N and /PROP/SHELL (/PROP/TYPE1), whose
 blank fields take /DEF_SHELL's values (read at the end, wherever the cards are).
 
-Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): every Ishell to
-``"bwc"`` (Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and
-viscous hourglass control hm, hf, hr) with an elastic ``hourglass_stiffness``: 1, 2 and 4
-(Radioss's Belytschko-Tsay, whose hourglass forces are elastic, CHVIS3) and 24 and 12
-(QEPH, Belytschko-Leviathan's physical stabilisation, read the same way) hk = 3
-:data:`HELAS` hm (1 - nu^2), the same stiffness on a square cell's membrane hourglass
-mode, 24 with QEPH's step (``step_length = "qeph"``); 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
+Ishell maps onto the shells' formulations (``docs/radioss.md``, "Shells"): Ishell 24 to
+``"qeph"`` (QEPH: the warping correction with QEPH's physical hourglass stiffness per mode,
+its yield and its viscosity, OpenRadioss's CZFINTN1; hm, hf, hr not read, as in Radioss)
+with QEPH's step (``step_length = "qeph"``); the others to ``"bwc"``
+(Belytschko-Lin-Tsay with the Belytschko-Wong-Chiang warping correction and viscous
+hourglass control hm, hf, hr) with an elastic ``hourglass_stiffness``: 1, 2 and 4
+(Radioss's Belytschko-Tsay, whose hourglass forces are elastic, CHVIS3) and 12 (read the
+same way) hk = 3 :data:`HELAS` hm (1 - nu^2), the same stiffness on a square cell's
+membrane hourglass mode; 3 (the elasto-plastic hourglass stiffness, orthogonal to the rigid modes)
 :data:`HOURGLASS_STIFFNESS`; a warning says what each is read as; a
 blank Ishell is 1, as in OpenRadioss's starter. Ish3n 1 and 2 (the C0 triangle) to
 ``"bsc"``. Iplas 0 (blank) or 2, Radioss's radial return for LAW2, is read as the exact
@@ -30,9 +32,9 @@ __all__ = ["DRILLING_STIFFNESS", "HELAS", "HOURGLASS_STIFFNESS", "ISHELL", "STAR
            "finish", "shell_element"]
 
 # Ishell -> the scene's formulation of quadrilaterals.
-ISHELL = {1: "bwc", 2: "bwc", 3: "bwc", 4: "bwc", 12: "bwc", 24: "bwc"}
-_ISHELL_TEXT = "1, 2, 3, 4 (Belytschko-Tsay), 12 and 24 (read as Belytschko-Lin-Tsay with the " \
-    "warping correction)"  # fmt: skip
+ISHELL = {1: "bwc", 2: "bwc", 3: "bwc", 4: "bwc", 12: "bwc", 24: "qeph"}
+_ISHELL_TEXT = "1, 2, 3, 4 (Belytschko-Tsay), 12 (read as Belytschko-Lin-Tsay with the " \
+    "warping correction) and 24 (QEPH)"  # fmt: skip
 # Ishell 3's elastic hourglass stiffness and Idrill 1's drilling springs (a G t A per node):
 # the constants with which the twisted beam passes (docs/theory.md, "Warping").
 HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
@@ -42,7 +44,8 @@ HOURGLASS_STIFFNESS, DRILLING_STIFFNESS = 0.5, 0.01
 # square cell is hk E t / (12 (1 - nu^2)) on the same mode, so hk = 3 HELAS hm (1 - nu^2).
 HELAS = 0.5
 # The [element] keys of the quadrilaterals only, left out for triangles.
-_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length")
+_QUADRILATERAL_KEYS = ("hourglass_stiffness", "drilling_stiffness", "step_length",
+                       "hourglass_yield")  # fmt: skip
 
 
 def _elements(deck: Deck, card: Card) -> None:
@@ -154,18 +157,16 @@ def _shell_property(deck: Deck, raw: dict) -> dict:
                   "Radioss returns a LAW2 material's plane stress radially (a scaled trial "
                   "stress, cgrtails.F and m2cplr.F); rwall_fem's return is the exact one of "
                   "Iplas 1", third)  # fmt: skip
-    if ishell != 3:
-        what = ("QEPH's physical stabilisation" if ishell in (12, 24) else
+    if ishell not in (3, 24):
+        what = ("QEPH's physical stabilisation" if ishell == 12 else
                 "Radioss's elastic hourglass forces (HELAS hm, with a quadratic viscosity)")
-        step = (", with QEPH's characteristic length of the step (its dn = 0.015)"
-                if ishell == 24 else "")  # fmt: skip
         deck.warn(card, f"Ishell = {ishell}: read as Belytschko-Lin-Tsay shells with the "
                   f"warping correction, {what} as the elastic hourglass stiffness "
-                  f"3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr{step}",
+                  f"3 HELAS hm (1 - nu^2), HELAS = 0.5, and linear viscous hm, hf, hr",
                   first)  # fmt: skip
-        if ishell == 24 and raw["dn"] and raw["dn"] != 0.015:
-            deck.warn(card, f"dn = {raw['dn']:g}: QEPH's numerical damping is not applied; "
-                      "its step takes dn = 0.015", first)  # fmt: skip
+    if ishell == 24 and raw["dn"] and raw["dn"] != 0.015:
+        deck.warn(card, f"dn = {raw['dn']:g}: QEPH's numerical damping is not applied; "
+                  "its step and hourglass viscosity take dn = 0.015", first)  # fmt: skip
     return {"kind": "shell", "ishell": ishell, "ish3n": ish3n, "where": card.header.where,
             "line": first.where, "element": element}  # fmt: skip
 
@@ -176,11 +177,17 @@ def shell_element(deck: Deck, pid: int, cell: str, poisson: float) -> tuple[dict
     p = deck.properties[pid]
     element = dict(p["element"])
     element["formulation"] = "bsc" if cell == "triangle" else ISHELL[p["ishell"]]
-    if p["ishell"] != 3:  # Radioss's elastic hourglass forces (CHVIS3), QEPH read alike
+    if p["ishell"] not in (3, 24):  # Radioss's elastic hourglass forces (CHVIS3)
         hm = element["hourglass_coefficients"][0]
         element["hourglass_stiffness"] = 3.0 * HELAS * hm * (1.0 - poisson**2)
-    if p["ishell"] == 24:  # QEPH's own characteristic length (CZCORC1, CNDT3)
+    if p["ishell"] == 24:  # QEPH: its own characteristic length (CZCORC1, CNDT3) and its
+        # physical hourglass stiffness with its yield and viscosity (CZFINTN1), where hm,
+        # hf, hr are not read (hm_read_prop01.F: Hm becomes Dn)
         element["step_length"] = "qeph"
+        if cell == "quadrilateral":
+            element.pop("hourglass_stiffness", None)
+            element["hourglass_coefficients"] = [0.0, 0.0, 0.0]
+            element["hourglass_yield"] = True
     if cell == "triangle":
         for name in _QUADRILATERAL_KEYS:
             element.pop(name, None)
