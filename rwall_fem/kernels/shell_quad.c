@@ -293,8 +293,10 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     const vec factor = flow_factor(p, VZERO, T);
     vec slope;
     flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
-    capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
-    const vec tangent = vselect(e > eps_before[pt], slope / (slope + s->young), VZERO + 1.0);
+    const ivec flowed = e > eps_before[pt];
+    if (shell_any(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
+      capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
+    const vec tangent = vselect(flowed, slope / (slope + s->young), VZERO + 1.0);
     mean += share * tangent;
     least = vmin(least, tangent);
   }
