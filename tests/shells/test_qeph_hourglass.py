@@ -20,7 +20,8 @@ hourglass forces (its numerical damping dn) are checked against its rule by hand
 
 On a body: the dented plate of test_hourglass_yield with QEPH's hourglass and its yield
 closes its books to round-off (the hourglass energy is the forces' work), 1 and 2 ranks
-give the same energies to 1e-10; the spinning plate of test_shell_runs stores nothing with
+give the same energies to 1e-10, a resumed run equals the uninterrupted one bit for bit;
+the spinning plate of test_shell_runs stores nothing with
 it (that file).
 """
 
@@ -32,6 +33,7 @@ import pytest
 from conftest import run
 from mpi4py import MPI
 from test_hourglass_yield import dent_scene
+from test_hourglass_yield import test_a_resumed_dent_equals_the_uninterrupted_run as resumed
 
 from rwall_fem.shells.elements import ShellKernel, ShellTechnology
 
@@ -165,3 +167,17 @@ def test_a_dented_plate_with_qeph_closes_its_books_on_any_ranks(shared_dir, tmp_
         assert mine.shape == table.shape
         assert np.abs(mine[:, 1:] - table[:, 1:]).max() <= 1e-10 * np.abs(table[:, 1:]).max()
     assert math.isfinite(energy["hourglass"])
+
+
+def test_a_resumed_qeph_dent_equals_the_uninterrupted_run(shared_dir, monkeypatch):
+    """The dent's resume test with QEPH's twelve hourglass stresses in the state: the
+    resumed run equals the uninterrupted one bit for bit."""
+    import test_hourglass_yield
+
+    def qeph_scene():
+        raw = dent_scene()
+        raw["element"] = {"formulation": "qeph", "hourglass_yield": True}
+        return raw
+
+    monkeypatch.setattr(test_hourglass_yield, "dent_scene", qeph_scene)
+    resumed(shared_dir, monkeypatch)
