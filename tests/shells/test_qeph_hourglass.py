@@ -181,3 +181,12 @@ def test_a_resumed_qeph_dent_equals_the_uninterrupted_run(shared_dir, monkeypatc
 
     monkeypatch.setattr(test_hourglass_yield, "dent_scene", qeph_scene)
     resumed(shared_dir, monkeypatch)
+
+
+def test_qeph_refuses_the_bwc_hourglass_stiffness_and_triangles():
+    """formulation "qeph" has its own hourglass stiffness: hourglass_stiffness beside it is
+    refused in one line naming the key; on triangles the formulation is refused."""
+    with pytest.raises(ValueError, match=r"^element\.hourglass_stiffness: not with"):
+        ShellTechnology.choose("quadrilateral", formulation="qeph", hourglass_stiffness=0.5)
+    with pytest.raises(ValueError, match=r"^element\.formulation: 'qeph' is not for triangle"):
+        ShellTechnology.choose("triangle", formulation="qeph")
