@@ -396,7 +396,7 @@ class Body(PartedBody):
                     lib.interface_work,
                     rows,
                     ffi.cast("int32_t *", self._shared.ctypes.data),
-                    ffi.cast("double *", self._interface_force[k].ctypes.data),
+                    ffi.cast("double *", self._interface_force[k].ctypes.data),  # kept, in place
                     ffi.cast("double *", self.v.array.ctypes.data),
                 )
             )

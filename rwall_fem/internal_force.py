@@ -190,7 +190,7 @@ class InternalForce:
         self.estimate_every_step = True
         self.below = np.zeros(self.num_cells, dtype=np.int32)
         self.below_step = np.zeros(self.num_cells)
-        self._factor = factor
+        self._factor = factor  # the kernels read it: mass scaling changes it in place only
         p, ffi = self.params, self.ffi
         p.step_factor = ffi.cast("double *", factor.ctypes.data)
         p.step_floor = floor
@@ -214,6 +214,8 @@ class InternalForce:
         self.erosion = e = ErodedCells(self.V, self.cells)
         p, ffi = self.params, self.ffi
         p.erode = 1
+        # e.listed and e.work are filled in place, a checkpoint's too; e.live is replaced and
+        # bound again (_remove_eroded, restore_state)
         p.eroded = ffi.cast("int32_t *", e.listed.ctypes.data)
         p.cell_work = ffi.cast("double *", e.work.ctypes.data)
         p.cell_stride = self.num_cells

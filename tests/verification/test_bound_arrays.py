@@ -137,8 +137,9 @@ def assert_bound(sim) -> None:
         for name, where in expected.items():
             struct = force.kernel.shell if name == "thickness" else p
             assert address(ffi, getattr(struct, name)) == where, name
-        held = {at(x) for x in (force.u.array, force.v.array, force.f.array, force._energy,
-                                force.step, force.cells, force.X, force.history, *fields)}  # fmt: skip
+        arrays = (force.u.array, force.v.array, force.f.array, force._energy, force.step,
+                  force.cells, force.X, force.history, *fields)  # fmt: skip
+        held = {at(x) for x in arrays}
         call = force._kernel
         pointers = [x for x in call.args if isinstance(x, ffi.CData) and x not in structs]
         assert {address(ffi, x) for x in pointers} <= held
