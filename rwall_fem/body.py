@@ -34,6 +34,7 @@ from mpi4py import MPI
 from rwall_fem import _compat
 from rwall_fem.elements import ElementForce, GhostedField, Technology
 from rwall_fem.erosion import ErodedParts, ErodingBody
+from rwall_fem.internal_force import acceleration_pass
 from rwall_fem.kernels import STEP_SLOTS
 
 __all__ = [
@@ -335,15 +336,8 @@ class Body(PartedBody):
         self.f.scatter_reverse_add()
         if not self._alone:
             self._combine_steps()
-        if self._acceleration is None:
-            lib, ffi = self.elements[0].lib, self.elements[0].ffi
-            self._acceleration = functools.partial(
-                lib.internal_acceleration,
-                len(state.inv_mass),
-                ffi.cast("double *", self.f.array.ctypes.data),
-                ffi.cast("double *", state.inv_mass.ctypes.data),
-                ffi.cast("double *", state.a.ctypes.data),
-            )
+        self._acceleration = acceleration_pass(self._acceleration, self.f.array,
+                                               state.inv_mass, state.a)  # fmt: skip
         self._acceleration()
 
     def book(self, state, first: float, second: float) -> None:
@@ -402,7 +396,7 @@ class Body(PartedBody):
                     lib.interface_work,
                     rows,
                     ffi.cast("int32_t *", self._shared.ctypes.data),
-                    ffi.cast("double *", self._interface_force[k].ctypes.data),
+                    ffi.cast("double *", self._interface_force[k].ctypes.data),  # kept, in place
                     ffi.cast("double *", self.v.array.ctypes.data),
                 )
             )

@@ -34,7 +34,12 @@ from mpi4py import MPI
 
 from rwall_fem import _compat
 from rwall_fem.erosion import ErodedCells
-from rwall_fem.internal_force import InternalForce, set_failure, set_flow_stress
+from rwall_fem.internal_force import (
+    InternalForce,
+    acceleration_pass,
+    set_failure,
+    set_flow_stress,
+)
 from rwall_fem.kernels import HOURGLASS, MODELS, POINT_SLOTS, STEP_SLOTS, load
 
 __all__ = ["ElementForce", "GhostedField", "Technology"]
@@ -247,6 +252,11 @@ class ElementForce(InternalForce):
         self.params.live = self.ffi.cast("int32_t *", self._computed.ctypes.data)
         self._rebind()
 
+    def erode_below(self, floor: float) -> None:
+        if self._computed is not None:  # params.live lists the computed cells, not the live
+            raise ValueError("the cells of a force with deactivated cells cannot erode")
+        super().erode_below(floor)
+
     @property
     def energy_names(self) -> tuple[str, ...]:
         """The energies the force stores: ``"internal"``, ``"hourglass"`` with hourglass
@@ -396,14 +406,8 @@ class ElementForce(InternalForce):
         self.f.array.fill(0.0)
         self.compute(state)
         self.f.scatter_reverse_add()
-        if self._accelerate is None:
-            self._accelerate = functools.partial(
-                self.lib.internal_acceleration,
-                len(state.inv_mass),
-                self.ffi.cast("double *", self.f.array.ctypes.data),
-                self.ffi.cast("double *", state.inv_mass.ctypes.data),
-                self.ffi.cast("double *", state.a.ctypes.data),
-            )
+        self._accelerate = acceleration_pass(self._accelerate, self.f.array, state.inv_mass,
+                                             state.a)  # fmt: skip
         self._accelerate()
 
     def forces(self, u: np.ndarray) -> np.ndarray:

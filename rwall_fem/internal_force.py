@@ -5,6 +5,8 @@
 - :func:`set_flow_stress` and :func:`set_failure` put a material's flow-stress law and
   failure criterion into the kernels' ``element_params`` (``kernels/plasticity.h``,
   ``kernels/failure.h``).
+- :func:`acceleration_pass` binds the compiled pass a = -f / m to a force's arrays and a
+  state's.
 - :class:`InternalForce` is the part of a force over some cells that does not depend on
   the element: one kernel pass per step (:meth:`~InternalForce.compute`), the energies
   the kernels book, what they noted of the cells' stable steps (``kernels/step.h``), the
@@ -17,11 +19,13 @@ arrays alone.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from rwall_fem.kernels import FAILURE
+from rwall_fem.kernels import FAILURE, load
 
-__all__ = ["HARDENING", "InternalForce", "set_failure", "set_flow_stress"]
+__all__ = ["HARDENING", "InternalForce", "acceleration_pass", "set_failure", "set_flow_stress"]
 
 # The flow-stress laws of the kernels (kernels/plasticity.h).
 HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
@@ -71,6 +75,24 @@ def set_failure(p, failure, slot: int) -> None:
         for i, value in enumerate(constants):
             p.damage_constants[i] = value
         p.damage_reference_rate = failure.reference_strain_rate
+
+
+def acceleration_pass(bound, f: np.ndarray, inv_mass: np.ndarray, a: np.ndarray):
+    """The compiled pass a = -f inv_mass over the rows of ``inv_mass``
+    (``internal_acceleration``: f and a (n, 3), N and m/s^2, or moments (N m) and angular
+    accelerations (rad/s^2); inv_mass 1/kg or 1/(kg m^2)) on these very arrays: ``bound``
+    (an earlier result, or None) when it is theirs, else the pass bound anew. It keeps the
+    arrays its pointers point into, and is bound again when it is handed other ones
+    (another state, or a state's array replaced) instead of writing into the old ones,
+    freed or not."""
+    arrays = (f, inv_mass, a)
+    if bound is not None and all(x is y for x, y in zip(bound.keep, arrays, strict=True)):
+        return bound
+    ffi, lib = load()
+    call = functools.partial(lib.internal_acceleration, len(inv_mass),
+                             *(ffi.cast("double *", x.ctypes.data) for x in arrays))  # fmt: skip
+    call.keep = arrays  # what the pointers point into
+    return call
 
 
 class InternalForce:
@@ -168,7 +190,7 @@ class InternalForce:
         self.estimate_every_step = True
         self.below = np.zeros(self.num_cells, dtype=np.int32)
         self.below_step = np.zeros(self.num_cells)
-        self._factor = factor
+        self._factor = factor  # the kernels read it: mass scaling changes it in place only
         p, ffi = self.params, self.ffi
         p.step_factor = ffi.cast("double *", factor.ctypes.data)
         p.step_floor = floor
@@ -192,6 +214,8 @@ class InternalForce:
         self.erosion = e = ErodedCells(self.V, self.cells)
         p, ffi = self.params, self.ffi
         p.erode = 1
+        # e.listed and e.work are filled in place, a checkpoint's too; e.live is replaced and
+        # bound again (_remove_eroded, restore_state)
         p.eroded = ffi.cast("int32_t *", e.listed.ctypes.data)
         p.cell_work = ffi.cast("double *", e.work.ctypes.data)
         p.cell_stride = self.num_cells

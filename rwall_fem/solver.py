@@ -235,11 +235,25 @@ class CentralDifference:
     """
 
     def __init__(self, state: State, internal=None):
+        self._out = np.zeros(9)
+        self._integral = np.zeros(3)  # momentum integral of the finished steps, kg m
+        books = internal is not None and getattr(internal, "books_work", False)
+        self._internal = internal if books else None
+        self._force = internal.nodal_force if books else None
+        self._labels = getattr(internal, "labels", None) if books else None
+        self._part_sums = internal.part_sums if self._labels is not None else None
+        self._bind(state)
+
+    @staticmethod
+    def _state_arrays(state: State) -> tuple:
+        return state.mass, state.a, state.v, state.u, state.momentum_integral
+
+    def _bind(self, state: State) -> None:
+        """Bind the pass to the arrays of ``state``, keeping them (the pass holds pointers
+        to them)."""
         from rwall_fem.kernels import load
 
         ffi, lib = load()
-        self._out = np.zeros(9)
-        self._integral = np.zeros(3)  # momentum integral of the finished steps, kg m
 
         def ptr(array, kind="double *"):
             return ffi.cast(kind, array.ctypes.data) if array is not None else ffi.NULL
@@ -247,19 +261,19 @@ class CentralDifference:
         for name in ("u", "v", "a"):
             if not getattr(state, name).flags.c_contiguous:
                 raise ValueError(f"state.{name} must be a C-contiguous (n, 3) array")
-        books = internal is not None and getattr(internal, "books_work", False)
-        self._internal = internal if books else None
-        force = internal.nodal_force if books else None
-        labels = getattr(internal, "labels", None) if books else None
-        self._part_sums = internal.part_sums if labels is not None else None
-        self._pass = functools.partial(lib.central_difference, len(state.mass))
+        self._bound = self._state_arrays(state)
+        mass, a, v, u, momentum = self._bound
+        self._pass = functools.partial(lib.central_difference, len(mass))
         self._arrays = (
-            ptr(state.mass), ptr(state.a), ptr(state.v), ptr(state.u), ptr(force),
-            ptr(self._out), ptr(self._integral), ptr(state.momentum_integral),
-            ptr(labels, "int32_t *"), ptr(self._part_sums),
+            ptr(mass), ptr(a), ptr(v), ptr(u), ptr(self._force), ptr(self._out),
+            ptr(self._integral), ptr(momentum), ptr(self._labels, "int32_t *"),
+            ptr(self._part_sums),
         )  # fmt: skip
 
     def __call__(self, state: State) -> None:
+        arrays = self._state_arrays(state)
+        if not all(x is y for x, y in zip(arrays, self._bound, strict=True)):
+            self._bind(state)  # another state, or one whose arrays were replaced
         if self._part_sums is not None:
             self._part_sums[:] = 0.0
         self._pass(state.dt_velocity, state.dt, *self._arrays)

@@ -16,6 +16,13 @@ Flags: ``-O3 -march=native`` (the host's vector instructions) when the compiler
 accepts them, else portable ``-O3``; ``-fopenmp-simd`` lets the per-cell loops
 over a batch of cells become SIMD instructions without an OpenMP runtime.
 
+The kernels read and write NumPy arrays through raw pointers. A pass bound once and
+called every step (a ``functools.partial``, a pointer in ``element_params``) is kept next
+to the arrays it points into (a pointer from ``ffi.cast`` keeps nothing alive; one from
+``ffi.from_buffer`` keeps its array), and those arrays change in place only
+(``x[...] = ``; a checkpoint's values too): an array replaced is bound again before the
+next call (``tests/verification/test_bound_arrays.py``).
+
 Each compile happens in a private temporary folder and the finished module is
 moved into the cache with one atomic rename, so concurrent processes (MPI ranks
 starting together) never load a half-written file. Its name carries the digest of

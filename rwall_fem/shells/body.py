@@ -20,7 +20,6 @@ energy the kernels report), and the rotations' shadow kinetic energy
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -31,7 +30,8 @@ from rwall_fem import _compat
 from rwall_fem.elements import GhostedField
 from rwall_fem.body import PartedBody, held_nodes
 from rwall_fem.erosion import ErodedParts
-from rwall_fem.kernels import STEP_SLOTS, load
+from rwall_fem.internal_force import acceleration_pass
+from rwall_fem.kernels import STEP_SLOTS
 
 __all__ = ["FORMULATIONS", "ShellBody", "ShellSection"]
 
@@ -168,18 +168,11 @@ class ShellBody(PartedBody):
         self.m.scatter_reverse_add()
         if not self._alone:
             self._combine_steps()
-        if self._acceleration is None:
-            ffi, lib = load()
-
-            def ptr(array):
-                return ffi.cast("double *", array.ctypes.data)
-
-            self._acceleration = (
-                functools.partial(lib.internal_acceleration, len(state.inv_mass),
-                                  ptr(self.f.array), ptr(state.inv_mass), ptr(state.a)),
-                functools.partial(lib.internal_acceleration, len(self.inv_inertia),
-                                  ptr(self.m.array), ptr(self.inv_inertia), ptr(self.alpha)),
-            )  # fmt: skip
+        translations, rotations = self._acceleration or (None, None)
+        self._acceleration = (
+            acceleration_pass(translations, self.f.array, state.inv_mass, state.a),
+            acceleration_pass(rotations, self.m.array, self.inv_inertia, self.alpha),
+        )
         for pass_ in self._acceleration:
             pass_()
         if self._free is not None:
