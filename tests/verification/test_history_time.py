@@ -18,6 +18,7 @@ import pytest
 from conftest import bar_scene, run
 from mpi4py import MPI
 from test_contact import two_bars
+from test_time_step import crush_scene
 
 from rwall_fem import build_simulation, parse_scene
 from rwall_fem.output.wall_table import WALL_COLUMNS
@@ -173,3 +174,18 @@ def test_a_resume_between_rows_equals_the_uninterrupted_run(shared_dir):
         assert {k: v for k, v in a.items() if k != "wall_seconds"} == {
             k: v for k, v in b.items() if k != "wall_seconds"
         }
+
+
+def test_a_run_stopped_by_dt_min_ends_with_its_row(shared_dir):
+    """The crushed copper bar stopped by run.dt_min: rows at the first step at or after
+    0.4 us, and one at the step that stopped the run (its time is the
+    summary's), between multiples."""
+    raw = crush_scene(dt_min=1e-7)
+    raw["output"] = {"plot": False, "history_time": 4e-7}
+    sim = run(raw, shared_dir)
+    assert sim.status.startswith("stopped") and "run.dt_min" in sim.status
+    times = sim.history.energy[:, 0]
+    assert times[-1] == sim.history.summary["time"] == sim.state.t
+    reached = np.floor(times / 4e-7 + 1e-9)
+    assert np.array_equal(reached[:-1], np.arange(len(times) - 1)) and len(times) > 6
+    assert times[-1] - reached[-1] * 4e-7 > sim.state.dt  # the stop is no multiple's step
