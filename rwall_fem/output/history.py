@@ -13,7 +13,7 @@ complete lines up to its last flush, and memory stays flat however long the run.
 Samples are due every ``history_interval`` steps or, with ``history_time``, at the first
 step at or after each multiple of that time (:mod:`~rwall_fem.output.schedule`), and at the
 first and the last step (a stop by the time step, a guard or a signal included). A step
-that is not a sample costs nothing here: what is booked between samples is booked by the
+that is not a sample costs a comparison of times here: what is booked between samples is booked by the
 effects themselves (works and impulses are integrals summed every step; energies and
 forces are read at the samples), and the ranks, which agree on the time, agree on the
 samples without exchanging a word.
