@@ -67,7 +67,7 @@ from rwall_fem.meshing import (
 )
 from rwall_fem.output.folder import ResultsFolder, check_folder
 from rwall_fem.output.guards import Guards
-from rwall_fem.output.history import History
+from rwall_fem.output.history import History, history_schedule
 from rwall_fem.output.run_log import RunLog, cycle_schedule
 from rwall_fem.output.summary import truthful_when_interrupted
 from rwall_fem.provenance import git_hash
@@ -516,7 +516,7 @@ def _add_recorders(
     sim.history = History(
         sim,
         directory,
-        every=scene.output.history_interval,
+        schedule=history_schedule(scene.output),
         guards=guards,
         plot=scene.output.plot,
         units=parse_system(scene.output.units),

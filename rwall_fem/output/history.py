@@ -10,8 +10,16 @@ Rows stream to disk (:mod:`~rwall_fem.output.tables`) in whole lines, at least e
 ``FLUSH_SECONDS`` of wall time and when the run ends or stops, so a killed run leaves
 complete lines up to its last flush, and memory stays flat however long the run.
 
+Samples are due every ``history_interval`` steps or, with ``history_time``, at the first
+step at or after each multiple of that time (:mod:`~rwall_fem.output.schedule`), and at the
+first and the last step (a stop by the time step, a guard or a signal included). A step
+that is not a sample costs a comparison of times here: what is booked between samples is booked by the
+effects themselves (works and impulses are integrals summed every step; energies and
+forces are read at the samples), and the ranks, which agree on the time, agree on the
+samples without exchanging a word.
+
 Stop signals (SIGTERM, SIGINT) are honoured within about ``POLL_SECONDS`` of wall time
-whatever ``history_interval`` is: between samples the ranks also agree, at steps they
+whatever the history's interval is: between samples the ranks also agree, at steps they
 all derive from the measured time per step, on whether any of them received one (one
 small ``Allreduce``); if so the step becomes a sample and the run stops there. Open
 MPI's ``mpirun`` sends SIGTERM one second before SIGKILL: that second is enough.
@@ -33,23 +41,31 @@ from rwall_fem import interrupts
 from rwall_fem.output import OutputError
 from rwall_fem.output.energy import TINY, EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
-from rwall_fem.output.schedule import Every
+from rwall_fem.output.schedule import Every, Interval
 from rwall_fem.output.summary import momentum, reserve_summary, run_summary, write_summary
 from rwall_fem.output.tables import CsvTable
 from rwall_fem.output.units import column_scales, summary_in
 from rwall_fem.output.wall_table import WALL_COLUMNS, WallTable
 from rwall_fem.units import SI, UnitSystem
 
-__all__ = ["FLUSH_SECONDS", "POLL_SECONDS", "History"]
+__all__ = ["FLUSH_SECONDS", "POLL_SECONDS", "History", "history_schedule"]
 
 FLUSH_SECONDS = 1.0  # longest wall time between writes of the CSV files, s
 POLL_SECONDS = 0.1  # longest wall time between agreements on stop signals, s
 SIGNALS = ("SIGTERM", "SIGINT")  # the stop requests the ranks agree on
 
 
+def history_schedule(output) -> Every | Interval:
+    """When the rows are due, from the scene's ``[output]``: at the multiples of
+    ``history_time`` (s) if given, else every ``history_interval`` steps."""
+    if output.history_time is not None:
+        return Interval(output.history_time)
+    return Every(output.history_interval)
+
+
 class History:
-    """Recorder of the energies and wall forces every ``every`` steps (and at the last
-    step) of ``sim``, into ``directory``; it writes the run summary when closed.
+    """Recorder of the energies and wall forces of ``sim`` into ``directory`` when its
+    ``schedule`` says (and at the last step); it writes the run summary when closed.
 
     :attr:`energy` and :meth:`wall` read the samples back from the files as arrays
     (collective calls; in the files' ``units``), :attr:`summary` is the summary once the
@@ -57,11 +73,11 @@ class History:
     :attr:`balance` is the energy balance.
     """
 
-    def __init__(self, sim, directory: Path, *, every: int, guards: Guards, plot: bool = False,
-                 units: UnitSystem = SI):  # fmt: skip
+    def __init__(self, sim, directory: Path, *, schedule: Every | Interval, guards: Guards,
+                 plot: bool = False, units: UnitSystem = SI):  # fmt: skip
         self.directory = Path(directory)
         self.units = units  # of the files (:mod:`~rwall_fem.output.units`); SI in memory
-        self.steps = Every(every)
+        self.steps = schedule
         self.guards = guards
         self.plot = plot  # draw histories.png at the end
         comm, walls = sim.comm, sim.walls
@@ -151,6 +167,7 @@ class History:
         stopping = sim.step_size.stop_reason is not None
         if not (self.steps.due(s) or stopping) and not self._stop_requested(sim, s):
             return
+        self.steps.taken(s)
         local = self._sums.local
         local["kinetic"][...] = s.kinetic - sum(r.nodal_kinetic(s) for r in self.rigid)
         for name, value in sim.internal.energies(s).items():
@@ -262,8 +279,9 @@ class History:
         return bool(total["signals"].any())
 
     def checkpoint_state(self) -> dict[str, np.ndarray]:
-        """The energy balance, the wall table, the momentum of the start and how many rows
-        ``energy.csv`` and ``walls.csv`` have; both files are flushed first, so that they
+        """The energy balance, the wall table, the momentum of the start, how many rows
+        ``energy.csv`` and ``walls.csv`` have and (``history_time``) the next multiple of
+        the interval due; both files are flushed first, so that they
         hold those rows when the checkpoint exists (OutputError if they cannot be)."""
         self._flush()
         for table in self._tables:
@@ -271,6 +289,8 @@ class History:
                 raise table.error
         rows = [self._energy_csv.count, self._walls_csv.count]
         arrays = {"initial_momentum": self.initial_momentum, "rows": np.array(rows)}
+        if isinstance(self.steps, Interval):
+            arrays["next_row"] = np.array(self.steps.next)
         if self._contacts_csv is not None:
             arrays["contact_rows"] = np.array(self._contacts_csv.count)
         arrays |= {f"balance_{k}": v for k, v in self.balance.checkpoint_state().items()}
@@ -287,6 +307,8 @@ class History:
         self.wall_table.restore_state(
             {k.removeprefix("walls_"): v for k, v in arrays.items() if k.startswith("walls_")}
         )
+        if isinstance(self.steps, Interval):
+            self.steps.next = int(arrays["next_row"])
         energy_rows, wall_rows = arrays["rows"].tolist()
         latest = self._energy_csv.resume(energy_rows) or ()
         self._walls_csv.resume(wall_rows)

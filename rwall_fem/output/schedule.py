@@ -1,13 +1,18 @@
-"""When a recorder samples: every k-th step, or at times spread over the run.
+"""When a recorder samples: every k-th step, at times spread over the run, or at the
+multiples of a time interval.
 
 The step varies, so outputs asked for at times are written at the first step at or after
-each time (Radioss's ``/ANIM/DT``, LS-DYNA's ``*DATABASE`` intervals), the last one at the run's
-last step; outputs never change the steps.
+each time (Radioss's ``/ANIM/DT`` and ``/TFILE``, LS-DYNA's ``*DATABASE`` intervals), the last
+one at the run's last step; outputs never change the steps. A schedule decides from the
+step's number or time alone, which every rank has alike, so the ranks sample at the same
+steps without exchanging anything.
 """
 
 from __future__ import annotations
 
-__all__ = ["Every", "Times"]
+import math
+
+__all__ = ["Every", "Interval", "Times"]
 
 
 class Every:
@@ -49,3 +54,27 @@ class Times:
             self.next = self.count
         while self.next < self.count and state.t >= self.time(self.next) - 1e-9 * state.dt:
             self.next += 1
+
+
+class Interval:
+    """The multiples 0, T, 2T, ... of ``interval`` T (s): a recorder is due at the first step
+    at or after each of them (the run's first step is at 0) and at the run's last step.
+    Several multiples passed in one step give one sample. :attr:`next` is the index of the
+    next multiple (what a checkpoint keeps)."""
+
+    def __init__(self, interval: float):
+        self.interval = interval
+        self.next = 0
+
+    def _reached(self, state) -> bool:
+        # A step that lands on a multiple up to round-off (a sum of steps) counts.
+        return state.t >= self.next * self.interval - 1e-9 * state.dt
+
+    def due(self, state) -> bool:
+        return state.last or self._reached(state)
+
+    def taken(self, state) -> None:
+        """A sample was taken at this step: go past every multiple it reached."""
+        if self._reached(state):
+            reached = math.floor((state.t + 1e-9 * state.dt) / self.interval)
+            self.next = max(self.next + 1, reached + 1)

@@ -192,6 +192,7 @@ def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None 
     if isinstance(outcome, str):
         raise DeckError(outcome)
     raw = outcome.raw
+    _history_overridden(raw, overrides)
     for item in overrides:
         apply_override(raw, item, str(path))
     deck_units(raw, outcome.work_units, str(path))
@@ -201,6 +202,16 @@ def load_deck(path: str | Path, overrides=(), comm=None, *, report: list | None 
     else:
         report.append(outcome)
     return scene
+
+
+def _history_overridden(raw: dict, overrides) -> None:
+    """A ``--set`` of ``output.history_interval`` (steps) or ``output.history_time`` (s)
+    replaces what the deck gave of the other (/TFILE's time, or a row every step)."""
+    given = {item.partition("=")[0].strip() for item in overrides}
+    output = raw.get("output", {})
+    for key, other in (("history_interval", "history_time"), ("history_time", "history_interval")):
+        if f"output.{key}" in given:
+            output.pop(other, None)
 
 
 def deck_units(raw: dict, work_units, source: str) -> None:

@@ -124,9 +124,11 @@ def scene_of(deck: Deck) -> SceneParts:
                 "spread over the whole run"
             )
     if deck.history_interval is not None:
+        del raw["output"]["history_interval"]
+        raw["output"]["history_time"] = deck.history_interval
         facts.append(
-            f"/TFILE {deck.history_interval:g} s: energy.csv and walls.csv get a row every "
-            "step (rwall_fem's history interval counts steps)"
+            f"/TFILE {deck.history_interval:g} s: output.history_time, a row of energy.csv, "
+            "walls.csv (and contacts.csv) at the first step at or after each multiple"
         )
 
     by_parts = _groups_as_parts(deck, parts) if separate else {}

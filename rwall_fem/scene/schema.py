@@ -1456,7 +1456,19 @@ class Output:
         Integer(low=0), 0, doc="snapshots of displacement, velocity, von Mises in fields.xdmf"
     )
     history_interval: int = key(
-        Integer(low=1), 1, doc="steps between rows of energy.csv and walls.csv"
+        Integer(low=1),
+        1,
+        doc="steps between rows of energy.csv, walls.csv and contacts.csv (and the first and "
+        "last steps)",
+    )
+    history_time: float | None = key(
+        Real(low=0.0),
+        None,
+        unit="s",
+        doc="time between rows of energy.csv, walls.csv and contacts.csv instead: a row at "
+        "the first step at or after each multiple of it, and at the first and last steps "
+        "(Radioss /TFILE, LS-DYNA *DATABASE_GLSTAT)",
+        default_doc="rows by history_interval",
     )
     print_interval: int | None = key(
         Integer(low=1),
@@ -1513,6 +1525,15 @@ def _output_units(v, raw, fail):
         parse_system(v["units"])
     except ValueError as err:
         fail("units", f"{show(v['units'])}: {err}")
+
+
+@rule(Output, json=[{"not": {"required": ["history_interval", "history_time"]}}])
+def _one_history_interval(v, raw, fail):
+    """history_interval (steps) and history_time (s) are two ways to space the rows of
+    the histories: one of them."""
+    if "history_interval" in raw and "history_time" in raw:
+        fail("history_time", "give history_interval (steps) or history_time (s) between "
+             "history rows, not both")  # fmt: skip
 
 
 # Checkpoints are large files written and synced by every rank: a wall-time interval

@@ -207,3 +207,29 @@ def test_cards_in_local_units_of_a_unit_card(shared_dir):
     assert a.walls[0].secondary.search_distance == pytest.approx(1.0, rel=1e-14)
     assert a.walls[0] == replace(b.walls[0], normal_point=a.walls[0].normal_point)
     assert a.walls[0].normal_point == pytest.approx(b.walls[0].normal_point, rel=1e-14)
+
+
+def test_tfile_spaces_the_history_rows_in_time(shared_dir):
+    """/TFILE's dt_his (work units, ms) is output.history_time (s); without /TFILE a row
+    every step; a --set of output.history_interval replaces the deck's interval (and one
+    of output.history_time a deck's row every step) instead of clashing with it. The run
+    writes its rows at the first step at or after each multiple of 1 us, the first and
+    the last steps."""
+    d = controls(engine=["/TFILE", "0.001"])
+    scene, _ = loaded(d, shared_dir)
+    assert scene.output.history_time == pytest.approx(1e-6, rel=1e-12)
+    without, _ = loaded(plain(), shared_dir)
+    assert (without.output.history_time, without.output.history_interval) == (None, 1)
+    steps, _ = loaded(d, shared_dir, ["output.history_interval=3"])
+    assert (steps.output.history_time, steps.output.history_interval) == (None, 3)
+    timed, _ = loaded(plain(), shared_dir, ["output.history_time=2e-6"])
+    assert timed.output.history_time == 2e-6
+    sim = run(replace(scene, output=replace(scene.output, plot=False)), shared_dir / "tfile")
+    times = sim.history.energy[:, 0]
+    dt = sim.history.summary["time_step"]["smallest"]
+    reached = np.floor(times / 1e-6 + 1e-9)  # the multiples of 1 us reached at each row
+    assert dt < 1e-6 and times[0] == 0
+    assert times[-1] == pytest.approx(scene.run.end_time, abs=dt)  # the last step
+    assert np.array_equal(reached[:-1], np.arange(len(times) - 1))  # each multiple once
+    assert reached[-1] - reached[-2] in (0, 1)
+    assert np.all(times[1:-1] - reached[1:-1] * 1e-6 < dt)  # at the first step after it
