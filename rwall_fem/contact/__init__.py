@@ -12,12 +12,12 @@ faces join; eroded shells leave.
 
 On a body of shells the segments are the shells, both sides active
 (:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
-variable, as Radioss's Igap 1: a node against a segment gets half the thickness of the
+variable, as Radioss's Igap 3: a node against a segment gets half the thickness of the
 thickest shell at the node plus half the segment's (half the sum of the thicknesses),
-floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side); each
-shell's share is at most ``gap_size_share`` x its shortest side, scaled by ``gap_scale``
-(Radioss Igap 2 and 3: :class:`GapShare`), and a pair's gap at most ``gap_max`` (Radioss
-Gap_max bounds the pair, ``i7cor3.F``). A given ``gap`` is
+scaled by ``gap_scale``, at most ``gap_size_share`` x the sum of the shortest sides of the
+node's shells and of the segment, and at most ``gap_max`` (Radioss Igap 3's bounds of the
+pair, ``i7cor3.F``: :class:`GapShare`), floored at Radioss's default Gapmin,
+min(thinnest shell, half the shortest side). A given ``gap`` is
 constant (Radioss Igap 0). The penalty stiffness of each segment is bounded by
 ``stiffness_min`` and ``stiffness_max`` (Radioss Stmin, Stmax).
 
@@ -144,7 +144,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                                          + [s.nodes for s in here]))  # fmt: skip
         edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
-        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
+        node_gap, node_size = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
 
         def passes(sides=sides, nodes=nodes, spec=spec, share=share) -> list[Pass]:
@@ -155,8 +155,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 out.append(Pass(
                     np.searchsorted(nodes, sec.nodes).astype(np.int64),
                     np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
-                    _bounded_stiffness(spec, seg.stiffness), _sized_depth(seg, share),
-                    exclude,
+                    _bounded_stiffness(spec, seg.stiffness), _scaled_depth(seg, share),
+                    exclude, _segment_sizes(seg, share),
                 ))  # fmt: skip
             return out
 
@@ -169,7 +169,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
         if spec.gap is None and half > 0.0:
-            interface.vary_gap(node_gap, nodes, share.most)
+            interface.vary_gap(node_gap, node_size, nodes, share.most)
         interface.start(state)
         left_out = {name: len(cut[name].segments) for name in parts
                     if name in cut and len(cut[name].segments)}  # fmt: skip
@@ -258,19 +258,22 @@ def _gap_floor(sides, edge: float, scale: float = 1.0) -> float:
     return min(scale * float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
 
 
-# A shell's share of a variable gap is at most this fraction of its shortest side (Radioss
-# TYPE7 Igap 3's default %mesh_size, i7sti3.F; LS-DYNA's automatic contacts alike): a
-# node then stays clear of its own flat sheet beyond its neighbouring segments. A scene's
-# ``gap_size_share`` (a deck's %mesh_size) changes it.
+# A pair's variable gap is at most this fraction of the sum of the shortest sides of the
+# node's shells and of the segment (Radioss TYPE7 Igap 3's default %mesh_size, i7sti3.F;
+# LS-DYNA's automatic contacts alike): a node then stays clear of its own flat sheet
+# beyond its neighbouring segments. A scene's ``gap_size_share`` (a deck's %mesh_size)
+# changes it.
 SIZE_SHARE = 0.4
 
 
 @dataclass(frozen=True)
 class GapShare:
-    """How a shell's half thickness t/2 becomes its share of a variable gap (Radioss
-    TYPE7 Igap 2 and 3, ``i7sti3.F``, ``i7cor3.F``): min(scale t/2, size x its shortest
-    side) (m); ``most`` is the scene's ``gap_max`` (m, inf: none), which bounds a pair's
-    gap, the sum of its two shares (``i7cor3.F``: min(GAP_S + GAP_M, GAPMAX))."""
+    """How the shells' half thicknesses t/2 make a pair's variable gap (Radioss TYPE7
+    Igap 3, ``i7sti3.F``, ``i7cor3.F``): each side's thickness share scale x t/2 (GAP_S,
+    GAP_M) and size share size x its shortest side (GAP_S_L, GAP_M_L: a node's, the least
+    over its shells), the pair's gap min(sum of the thickness shares, sum of the size
+    shares, ``most``) (m; ``most`` the scene's ``gap_max``, inf: none), never below the
+    floor."""
 
     scale: float = 1.0
     size: float = SIZE_SHARE
@@ -299,26 +302,30 @@ def _bounded_stiffness(spec, stiffness: np.ndarray) -> np.ndarray:
     return np.clip(spec.stiffness_scale * stiffness, spec.stiffness_min, high)
 
 
-def _sized_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
-    """The depths of the segments of ``s`` (m) with each shell's share of a variable gap
-    (-depth, half its thickness) as ``share`` makes it: at most ``share.size`` x its
-    shortest side."""
-    shell = s.depth < 0.0
-    half = np.minimum(share.scale * -s.depth, share.size * s.edge)
-    return np.where(shell, -half, s.depth)
+def _scaled_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
+    """The depths of the segments of ``s`` (m) with each shell's thickness share of a
+    variable gap (-depth, half its thickness) scaled by ``share.scale``."""
+    return np.where(s.depth < 0.0, share.scale * s.depth, s.depth)
+
+
+def _segment_sizes(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
+    """The size share of each segment of ``s`` in a variable gap (m, Radioss GAP_M_L):
+    ``share.size`` x a shell's shortest side; inf (none) for a solid's face."""
+    return np.where(s.depth < 0.0, share.size * s.edge, np.inf)
 
 
 def _node_gaps(nodes: np.ndarray, surfaces: list[Surface],
-               share: GapShare = GapShare()) -> np.ndarray:  # fmt: skip
-    """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
-    solid's), as ``share`` makes it: at most ``share.size`` x the shortest side of the
-    shells at it."""
+               share: GapShare = GapShare()) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Each surface node's thickness share of a variable gap (m, Radioss GAP_S): half the
+    thickness of the thickest shell at it (0 at a solid's) x ``share.scale``; and its size
+    share (m, GAP_S_L): ``share.size`` x the shortest side of the shells at it (inf at a
+    solid's)."""
     out, size = np.zeros(len(nodes)), np.full(len(nodes), np.inf)
     for s in surfaces:
         half = np.repeat(np.maximum(-s.depth, 0.0), 4)
-        side = np.repeat(np.where(s.depth < 0.0, share.size * s.edge, np.inf), 4)
+        side = np.repeat(_segment_sizes(s, share), 4)
         ids = s.segments.ravel()
         rows = np.searchsorted(nodes, ids[ids >= 0])
         np.maximum.at(out, rows, half[ids >= 0])
         np.minimum.at(size, rows, side[ids >= 0])
-    return np.minimum(share.scale * out, size)
+    return share.scale * out, size

@@ -158,6 +158,7 @@ void largest_components(int64_t n, const int64_t *nodes, const double *v, const 
 typedef struct {
   double gap, cap, friction, damping, alpha, dt, reach, gap_max;
   const double *half_thickness;
+  const double *node_size;
   const double *share;
   const int8_t *planes;
 } contact_params;
@@ -173,12 +174,13 @@ int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offs
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                     const int64_t *candidates, const int64_t *segs, int64_t nused,
                     const int64_t *used, double *boxes, const double *stiffness0,
-                    const double *depth, const double *x, const double *v,
+                    const double *depth, const double *size, const double *x, const double *v,
                     const double *mass, const contact_params *prm, double *tangential,
                     double *node_gap, double *force, double *stiffness, double out[11]);
 void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                           const int64_t *candidates, const int64_t *segs, int64_t nused,
-                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth, const double *x,
+                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth,
+                          const double *size, const double *x,
                           const contact_params *prm, double *node_gap, double out[3]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
 void contact_gather(int64_t n, const int64_t *rows, const double *X, const double *u,

@@ -1305,8 +1305,8 @@ class ContactSpec:
     gap_size_share: float = key(
         Real(low=0.0, high=1.0),
         0.4,
-        doc="Radioss %mesh_size (Igap 3): each shell's share of the variable gap at most "
-        "this fraction of its shortest side (of the shells at a node)",
+        doc="Radioss %mesh_size (Igap 3): a pair's variable gap at most this fraction of the "
+        "sum of the shortest sides of the node's shells and of the segment",
     )
     stiffness_scale: float = key(
         Real(low=0.0),

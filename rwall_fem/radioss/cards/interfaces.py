@@ -161,8 +161,8 @@ def _variable_gap(deck: Deck, card: Card, igap: int, scale: float, bound: float,
 
 
 def _size_share(deck: Deck, card: Card, igap: int, share: float) -> float:
-    """%mesh_size: each shell's share of the variable gap at most this fraction of its
-    shortest side, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
+    """%mesh_size: a pair's variable gap at most this fraction of the sum of the node's and
+    the segment's shortest sides, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
     line with Igap 0 to 2 (as Radioss does; with Igap 1 and 2 0.4 kept, the cap of every
     variable gap)."""
     if not 0.0 <= share <= 1.0:
