@@ -146,8 +146,14 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
         node_gap, node_size = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
+        variable = spec.gap is None and half > 0.0
+        removal = None
+        if spec.exclude_within_gap:
+            removal = _Removal(_start_positions(solid, owned, nodes), node_gap, node_size,
+                               variable, gap, share.most)  # fmt: skip
 
-        def passes(sides=sides, nodes=nodes, spec=spec, share=share) -> list[Pass]:
+        def passes(sides=sides, nodes=nodes, spec=spec, share=share,
+                   removal=removal) -> list[Pass]:  # fmt: skip
             """The passes of the interface from its sides' surfaces as they are."""
             out = []
             for sec_parts, seg_parts, exclude in sides:
@@ -158,6 +164,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                     _bounded_stiffness(spec, seg.stiffness), _scaled_depth(seg, share),
                     exclude, _segment_sizes(seg, share),
                 ))  # fmt: skip
+                if removal is not None:
+                    out[-1].removed = removal.lists(out[-1])
             return out
 
         common = dict(
@@ -168,7 +176,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
             interface = ErodingContact(f"contact[{i}]", nodes, here, passes, **common)
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
-        if spec.gap is None and half > 0.0:
+        if variable:
             interface.vary_gap(node_gap, node_size, nodes, share.most)
         interface.start(state)
         left_out = {name: len(cut[name].segments) for name in parts
@@ -196,6 +204,58 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                     )
         interfaces.append(interface)
     return interfaces
+
+
+def _start_positions(solid, owned: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """The positions at the start (m, rows of 3) of the surface nodes ``nodes`` (global
+    numbers, sorted), from every rank (collective)."""
+    mine = np.flatnonzero(np.isin(owned, nodes))
+    pieces = solid.comm.allgather((owned[mine], solid.X[mine]))
+    ids = np.concatenate([p[0] for p in pieces])
+    x = np.concatenate([np.asarray(p[1]).reshape(-1, 3) for p in pieces])
+    return np.ascontiguousarray(x[np.argsort(ids)][np.searchsorted(np.sort(ids), nodes)])
+
+
+@dataclass
+class _Removal:
+    """Radioss Irem_gap 2 (``exclude_within_gap``): the nodes each segment of a pass leaves
+    out of its search, those within sqrt 2 x their pair gap of it along the mesh
+    (``kernels/contact_remove.c``), from the surface nodes' positions at the start
+    ``positions`` (m), their thickness and size shares ``node_gap``, ``node_size`` (m) of a
+    ``variable`` gap, the constant gap (or the variable one's floor) ``gap`` and its bound
+    ``most`` (m)."""
+
+    positions: np.ndarray
+    node_gap: np.ndarray
+    node_size: np.ndarray
+    variable: bool
+    gap: float
+    most: float
+
+    def lists(self, ps: Pass) -> tuple[np.ndarray, np.ndarray]:
+        """The lists of pass ``ps`` (over the surface nodes), as :attr:`Pass.removed`."""
+        from rwall_fem.kernels import load
+
+        ffi, lib = load()
+        p = ffi.from_buffer
+        n, segs = len(self.positions), np.ascontiguousarray(ps.segments, dtype=np.int64)
+        secondary = np.zeros(n, dtype=np.int8)
+        secondary[ps.secondary] = 1
+        seg_gap = np.ascontiguousarray(np.where(ps.depth < 0.0, -ps.depth, 0.0))
+        seg_size = np.ascontiguousarray(ps.size, dtype=np.float64)
+        offsets = np.zeros(len(segs) + 1, dtype=np.int64)
+        removed = np.zeros(8 * len(segs) + 1, dtype=np.int64)
+        while True:
+            count = lib.contact_remove_lists(
+                len(segs), p("int64_t[]", segs), n, p("double[]", self.positions),
+                p("int8_t[]", secondary), p("double[]", seg_gap), p("double[]", seg_size),
+                p("double[]", self.node_gap), p("double[]", self.node_size),
+                int(self.variable), self.gap, self.most, len(removed),
+                p("int64_t[]", offsets), p("int64_t[]", removed),
+            )  # fmt: skip
+            if count <= len(removed):
+                return offsets, removed[:count].copy()
+            removed = np.zeros(count, dtype=np.int64)
 
 
 def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray]]) -> None:

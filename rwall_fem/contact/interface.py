@@ -76,7 +76,9 @@ class Pass:
     nodes) against segments (rows of 4 indices, -1 as the 4th of a triangle) with their
     stiffness k0 (N/m), depth (m) and size share of a variable gap (m, ``kernels/contact.c``
     pair_gap; default inf: none); ``exclude``: a node is kept off its own segments'
-    neighbours (self-contact).
+    neighbours (self-contact); ``removed``: the nodes each segment leaves out of its search
+    (Radioss Irem_gap 2, ``kernels/contact_remove.c``), as offsets (segments + 1) and node
+    indices (sorted per segment), or None.
     """
 
     secondary: np.ndarray
@@ -85,6 +87,7 @@ class Pass:
     depth: np.ndarray
     exclude: bool = False
     size: np.ndarray | None = None
+    removed: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self):
         if self.size is None:
@@ -118,7 +121,8 @@ class _Share:
     """This rank's share of a pass, kept from sort to sort: its secondary nodes (global
     numbers, sorted) with their friction force (N) and own gap (m), and the segments it
     owns (global numbers), with their places in the whole pass, stiffness, depth and size
-    share."""
+    share; the nodes each segment of the whole pass leaves out (global numbers, CSR as
+    :attr:`Pass.removed`; every rank holds all of them) or None."""
 
     secondary: np.ndarray
     tangential: np.ndarray
@@ -129,6 +133,7 @@ class _Share:
     depth: np.ndarray
     exclude: bool
     size: np.ndarray
+    removed: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class ContactInterface:
@@ -235,9 +240,13 @@ class ContactInterface:
         segments = np.where(ps.segments >= 0, nodes[np.maximum(ps.segments, 0)], -1)
         lowest = np.where(segments >= 0, segments, np.iinfo(np.int64).max).min(axis=1)
         owned = owners.mine(lowest)
+        removed = None
+        if ps.removed is not None:
+            removed = (ps.removed[0], nodes[ps.removed[1]].astype(np.int64))
         return _Share(secondary, tangential, gaps, segments[owned].astype(np.int64),
                       np.flatnonzero(owned).astype(np.int64), ps.stiffness[owned].copy(),
-                      ps.depth[owned].copy(), ps.exclude, ps.size[owned].copy())  # fmt: skip
+                      ps.depth[owned].copy(), ps.exclude, ps.size[owned].copy(),
+                      removed)  # fmt: skip
 
     def start(self, s) -> None:
         """The gaps of the nodes that start inside the gap (Radioss TYPE7 Inacti = 6,
@@ -427,18 +436,22 @@ class ContactInterface:
                       self._to_local(ints[here, 2:]), received[here, 6].copy(),
                       received[here, 7].copy(), sh.exclude, received[here, 8].copy())  # fmt: skip
             ps.tangential, ps.gaps = sh.tangential, sh.gaps
+            if sh.removed is not None:
+                ps.removed = self._removed_here(sh.removed, ints[here, 1])
             passes.append(ps)
         self.passes = passes
         lib, p = self.lib, self._pointer
         for ps in passes:
             reach = np.full(len(ps.segments), widen)
+            removed = ((p(ps.removed[0], "int64_t[]"), p(ps.removed[1], "int64_t[]"))
+                       if ps.removed is not None else (self.ffi.NULL, self.ffi.NULL))
             while True:
                 work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
                 count = lib.contact_sort(
                     len(ps.secondary), p(ps.secondary, "int64_t[]"), len(ps.segments),
                     p(ps.segments, "int64_t[]"), p(reach), p(self.x), int(ps.exclude),
                     p(ps.node_offsets, "int64_t[]"), p(ps.node_segs, "int64_t[]"),
-                    len(ps.candidates), p(ps.offsets, "int64_t[]"),
+                    *removed, len(ps.candidates), p(ps.offsets, "int64_t[]"),
                     p(ps.candidates, "int64_t[]"), p(work, "int64_t[]"),
                 )  # fmt: skip
                 if count <= len(ps.candidates):
@@ -449,6 +462,24 @@ class ContactInterface:
         self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
         self._list_near()
+
+    def _removed_here(self, removed: tuple[np.ndarray, np.ndarray],
+                      places: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """The nodes the segments at ``places`` of the whole pass (sorted) leave out
+        (``removed``: the whole pass's, global numbers) that are this rank's secondary
+        nodes' candidates: its owned ones, as local indices, sorted per segment (CSR)."""
+        offsets, ids = removed
+        counts = offsets[places + 1] - offsets[places]
+        ends = np.cumsum(counts)
+        rows = np.arange(int(ends[-1]) if len(ends) else 0) + np.repeat(offsets[places]
+                                                                         - ends + counts, counts)
+        segment = np.repeat(np.arange(len(places)), counts)
+        ids = ids[rows]
+        mine = self.owners.mine(ids)
+        local = np.searchsorted(self.ids, ids[mine]).astype(np.int64)
+        kept = np.bincount(segment[mine], minlength=len(places))
+        return (np.concatenate([[0], np.cumsum(kept)]).astype(np.int64),
+                np.ascontiguousarray(local))  # fmt: skip
 
     def _list_near(self) -> None:
         """The near lists of the passes (``contact_near``): the candidates whose box is

@@ -60,7 +60,7 @@ log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
            "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
-           "friction.h", "wall.c", "contact.c")  # fmt: skip
+           "friction.h", "wall.c", "contact.c", "contact_remove.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -165,8 +165,14 @@ typedef struct {
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
                      const double *reach, const double *x, int exclude,
-                     const int64_t *node_offsets, const int64_t *node_segs, int64_t capacity,
+                     const int64_t *node_offsets, const int64_t *node_segs,
+                     const int64_t *removed_offsets, const int64_t *removed, int64_t capacity,
                      int64_t *offsets, int64_t *candidates, int64_t *work);
+int64_t contact_remove_lists(int64_t nseg, const int64_t *segs, int64_t nnodes, const double *x,
+                             const int8_t *secondary, const double *seg_gap,
+                             const double *seg_size, const double *node_gap,
+                             const double *node_size, int variable, double gap, double gap_max,
+                             int64_t capacity, int64_t *offsets, int64_t *removed);
 int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                      const int64_t *candidates, const int64_t *segs, int64_t nused,
                      const int64_t *used, double *boxes, const double *x, double limit,

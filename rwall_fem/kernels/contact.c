@@ -8,8 +8,9 @@
  * contact_sort: the candidate segments of each secondary node, by buckets (spatial hashing):
  *   the secondary nodes go into a grid of cubes, each segment is tested against the nodes
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
- *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
- *   segment, whatever the grid.
+ *   neighbours are left out when `exclude` (self-contact), and the nodes each segment's
+ *   list leaves out (`removed`, Radioss Irem_gap 2: contact_remove.c).  The lists come
+ *   sorted by segment, whatever the grid.
  * contact_near: the candidates near enough to their node to be met before the nodes have
  *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
@@ -103,14 +104,33 @@ static int excluded(int64_t s, const int64_t *seg, const int64_t *node_offsets,
   return 0;
 }
 
+/* Whether node s is in the sorted list [from, to). */
+static int listed(int64_t s, const int64_t *from, const int64_t *to)
+{
+  while (from < to)
+  {
+    const int64_t *mid = from + (to - from) / 2;
+    if (*mid == s)
+      return 1;
+    if (*mid < s)
+      from = mid + 1;
+    else
+      to = mid;
+  }
+  return 0;
+}
+
 /* Candidates of the nsec secondary nodes `secondary` among the nseg segments `segs`, each
- * widened by reach[j] (m), at positions x.  Fills offsets (nsec + 1) and up to `capacity`
+ * widened by reach[j] (m), at positions x; segment j leaves out the nodes
+ * removed[removed_offsets[j] .. removed_offsets[j + 1]) (sorted; removed NULL: none).
+ * Fills offsets (nsec + 1) and up to `capacity`
  * candidates (segment indices, sorted per node); `work` holds 2 nsec + 2 capacity + 1
  * int64.  Returns the number of candidates (more than capacity: call again with room). */
 int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t nseg,
                      const int64_t *restrict segs, const double *restrict reach,
                      const double *restrict x, int exclude, const int64_t *restrict node_offsets,
-                     const int64_t *restrict node_segs, int64_t capacity,
+                     const int64_t *restrict node_segs, const int64_t *restrict removed_offsets,
+                     const int64_t *restrict removed, int64_t capacity,
                      int64_t *restrict offsets, int64_t *restrict candidates,
                      int64_t *restrict work)
 {
@@ -230,6 +250,8 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
             for (int k = 0; k < 4; ++k)
               own |= seg[k] == s;
             if (own || (exclude && excluded(s, seg, node_offsets, node_segs, segs)))
+              continue;
+            if (removed && listed(s, removed + removed_offsets[j], removed + removed_offsets[j + 1]))
               continue;
             if (count < capacity)
             {

@@ -16,7 +16,7 @@ Fscalegap ``gap_scale`` and Gap_max ``gap_max``, with Igap 3 %mesh_size
 ``gap_size_share`` (on shells: a solid's face adds no thickness, and a warning line says
 they are left out). Stfac is ``stiffness_scale``, with Istf 2 to 5 Stmin and Stmax
 ``stiffness_min`` and ``stiffness_max``, Fric ``friction`` (Ifiltr, Xfreq its filter),
-VIS_S ``damping``.
+VIS_S ``damping``, Irem_gap 2 ``exclude_within_gap``.
 """
 
 from __future__ import annotations
@@ -87,6 +87,8 @@ def _common(deck: Deck, inter, main: list[DeckPart], where: str) -> dict:
         table["stiffness_min"] = inter.stiffness_min
     if inter.stiffness_max:
         table["stiffness_max"] = inter.stiffness_max
+    if inter.exclude_within_gap:
+        table["exclude_within_gap"] = True
     if inter.igap == 0:
         table["gap"] = inter.gap_min or _default_gap(deck, main)
         return table

@@ -1308,6 +1308,13 @@ class ContactSpec:
         doc="Radioss %mesh_size (Igap 3): a pair's variable gap at most this fraction of the "
         "sum of the shortest sides of the node's shells and of the segment",
     )
+    exclude_within_gap: bool = key(
+        Flag(),
+        False,
+        doc="Radioss Irem_gap 2: each segment leaves out of its search the nodes within "
+        "sqrt(2) x their pair gap of it along the mesh, at the start (self-contact of a mesh "
+        "finer than the gap; beyond a node's own segments and their neighbours)",
+    )
     stiffness_scale: float = key(
         Real(low=0.0),
         1.0,
