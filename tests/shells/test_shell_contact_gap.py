@@ -114,3 +114,48 @@ def test_without_the_cap_the_fine_sheet_touches_itself(shared_dir, monkeypatch):
           f"{sim.contacts[0].gap_max:.3e} m")
     assert sim.contacts[0].gap_max == pytest.approx(1.5e-3, rel=1e-9)
     assert inside >= nodes // 2
+
+
+# A constant gap larger than the mesh: Radioss Irem_gap 2 (``exclude_within_gap``). With
+# gap = 1.2 mm (2.4 cells) every node is within the gap of its sheet's coplanar shells two
+# cells away (1 mm), beyond the neighbours it is kept off. Worked by hand: each segment
+# leaves out the nodes within sqrt 2 x 1.2 = 1.70 mm of it along the mesh; a coplanar shell
+# within 1.2 mm of a node in the plane has its nearest node at most (2, 1) cells away, 1.21
+# mm along the mesh (a diagonal and a side): left out, every one. So with the lists no node
+# starts inside the gap or meets its sheet, and the cantilever's run is the run without
+# contact, on any number of ranks (the lists travel with the segments).
+LARGE_GAP = {"self": True, "gap": 1.2e-3}
+
+
+@pytest.mark.parametrize("within", [False, True], ids=["neighbours_only", "exclude_within_gap"])
+def test_a_gap_larger_than_the_mesh_with_the_lists(within, shared_dir):
+    raw = sheet(True, False)
+    raw["contact"] = [LARGE_GAP | ({"exclude_within_gap": True} if within else {})]
+    sim = build_simulation(parse_scene(raw, source="test"), comm, shared_dir)
+    nodes = comm.allreduce(len(sim.state.X))
+    inside = starting_inside(sim)
+    print(f"gap 1.2 mm, exclude_within_gap {within}: {inside} of {nodes} nodes start inside")
+    if not within:
+        assert inside >= nodes // 2
+        return
+    watch = InContact(sim)
+    assert sim.run() == "done"
+    drift = comm.allreduce(float(np.abs(sim.state.v - V0).max(initial=0.0)), op=MPI.MAX)
+    assert inside == 0 and watch.most == 0
+    assert drift <= 1e-12 * np.linalg.norm(V0)
+
+
+def test_a_bending_sheet_with_the_lists_is_the_run_without_contact(shared_dir):
+    raw = sheet(True, True)
+    raw["contact"] = [LARGE_GAP | {"exclude_within_gap": True}]
+    sim = build_simulation(parse_scene(raw, source="test"), comm, shared_dir / "lists")
+    watch = InContact(sim)
+    assert sim.run() == "done"
+    free, _ = run_sheet(shared_dir / "free", contact=False, clamped=True)
+    scale = comm.allreduce(float(np.abs(free.state.u).max(initial=0.0)), op=MPI.MAX)
+    differ = comm.allreduce(float(np.abs(sim.state.u - free.state.u).max(initial=0.0)),
+                            op=MPI.MAX)  # fmt: skip
+    print(f"bending sheet, gap 1.2 mm with the lists: most in contact {watch.most}, "
+          f"against no contact {differ:.2e} m of {scale:.2e} m")
+    assert watch.most == 0 and starting_inside(sim) == 0
+    assert differ <= 1e-12 * scale
