@@ -12,12 +12,12 @@ faces join; eroded shells leave.
 
 On a body of shells the segments are the shells, both sides active
 (:func:`~rwall_fem.contact.surface.shell_surface`); without a given ``gap`` the gap is
-variable, as Radioss's Igap 1: a node against a segment gets half the thickness of the
+variable, as Radioss's Igap 3: a node against a segment gets half the thickness of the
 thickest shell at the node plus half the segment's (half the sum of the thicknesses),
-floored at Radioss's default Gapmin, min(thinnest shell, half the shortest side); each
-shell's share is at most ``gap_size_share`` x its shortest side, scaled by ``gap_scale``
-(Radioss Igap 2 and 3: :class:`GapShare`), and a pair's gap at most ``gap_max`` (Radioss
-Gap_max bounds the pair, ``i7cor3.F``). A given ``gap`` is
+scaled by ``gap_scale``, at most ``gap_size_share`` x the sum of the shortest sides of the
+node's shells and of the segment, and at most ``gap_max`` (Radioss Igap 3's bounds of the
+pair, ``i7cor3.F``: :class:`GapShare`), floored at Radioss's default Gapmin,
+min(thinnest shell, half the shortest side). A given ``gap`` is
 constant (Radioss Igap 0). The penalty stiffness of each segment is bounded by
 ``stiffness_min`` and ``stiffness_max`` (Radioss Stmin, Stmax).
 
@@ -144,10 +144,16 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                                          + [s.nodes for s in here]))  # fmt: skip
         edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
         half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
-        node_gap = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
+        node_gap, node_size = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
+        variable = spec.gap is None and half > 0.0
+        removal = None
+        if spec.exclude_within_gap:
+            removal = _Removal(_start_positions(solid, owned, nodes), node_gap, node_size,
+                               variable, gap, share.most)  # fmt: skip
 
-        def passes(sides=sides, nodes=nodes, spec=spec, share=share) -> list[Pass]:
+        def passes(sides=sides, nodes=nodes, spec=spec, share=share,
+                   removal=removal) -> list[Pass]:  # fmt: skip
             """The passes of the interface from its sides' surfaces as they are."""
             out = []
             for sec_parts, seg_parts, exclude in sides:
@@ -155,9 +161,11 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                 out.append(Pass(
                     np.searchsorted(nodes, sec.nodes).astype(np.int64),
                     np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
-                    _bounded_stiffness(spec, seg.stiffness), _sized_depth(seg, share),
-                    exclude,
+                    _bounded_stiffness(spec, seg.stiffness), _scaled_depth(seg, share),
+                    exclude, _segment_sizes(seg, share),
                 ))  # fmt: skip
+                if removal is not None:
+                    out[-1].removed = removal.lists(out[-1])
             return out
 
         common = dict(
@@ -168,8 +176,8 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
             interface = ErodingContact(f"contact[{i}]", nodes, here, passes, **common)
         else:
             interface = ContactInterface(f"contact[{i}]", nodes, passes(), **common)
-        if spec.gap is None and half > 0.0:
-            interface.vary_gap(node_gap, nodes, share.most)
+        if variable:
+            interface.vary_gap(node_gap, node_size, nodes, share.most)
         interface.start(state)
         left_out = {name: len(cut[name].segments) for name in parts
                     if name in cut and len(cut[name].segments)}  # fmt: skip
@@ -196,6 +204,58 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                     )
         interfaces.append(interface)
     return interfaces
+
+
+def _start_positions(solid, owned: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """The positions at the start (m, rows of 3) of the surface nodes ``nodes`` (global
+    numbers, sorted), from every rank (collective)."""
+    mine = np.flatnonzero(np.isin(owned, nodes))
+    pieces = solid.comm.allgather((owned[mine], solid.X[mine]))
+    ids = np.concatenate([p[0] for p in pieces])
+    x = np.concatenate([np.asarray(p[1]).reshape(-1, 3) for p in pieces])
+    return np.ascontiguousarray(x[np.argsort(ids)][np.searchsorted(np.sort(ids), nodes)])
+
+
+@dataclass
+class _Removal:
+    """Radioss Irem_gap 2 (``exclude_within_gap``): the nodes each segment of a pass leaves
+    out of its search, those within sqrt 2 x their pair gap of it along the mesh
+    (``kernels/contact_remove.c``), from the surface nodes' positions at the start
+    ``positions`` (m), their thickness and size shares ``node_gap``, ``node_size`` (m) of a
+    ``variable`` gap, the constant gap (or the variable one's floor) ``gap`` and its bound
+    ``most`` (m)."""
+
+    positions: np.ndarray
+    node_gap: np.ndarray
+    node_size: np.ndarray
+    variable: bool
+    gap: float
+    most: float
+
+    def lists(self, ps: Pass) -> tuple[np.ndarray, np.ndarray]:
+        """The lists of pass ``ps`` (over the surface nodes), as :attr:`Pass.removed`."""
+        from rwall_fem.kernels import load
+
+        ffi, lib = load()
+        p = ffi.from_buffer
+        n, segs = len(self.positions), np.ascontiguousarray(ps.segments, dtype=np.int64)
+        secondary = np.zeros(n, dtype=np.int8)
+        secondary[ps.secondary] = 1
+        seg_gap = np.ascontiguousarray(np.where(ps.depth < 0.0, -ps.depth, 0.0))
+        seg_size = np.ascontiguousarray(ps.size, dtype=np.float64)
+        offsets = np.zeros(len(segs) + 1, dtype=np.int64)
+        removed = np.zeros(8 * len(segs) + 1, dtype=np.int64)
+        while True:
+            count = lib.contact_remove_lists(
+                len(segs), p("int64_t[]", segs), n, p("double[]", self.positions),
+                p("int8_t[]", secondary), p("double[]", seg_gap), p("double[]", seg_size),
+                p("double[]", self.node_gap), p("double[]", self.node_size),
+                int(self.variable), self.gap, self.most, len(removed),
+                p("int64_t[]", offsets), p("int64_t[]", removed),
+            )  # fmt: skip
+            if count <= len(removed):
+                return offsets, removed[:count].copy()
+            removed = np.zeros(count, dtype=np.int64)
 
 
 def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray]]) -> None:
@@ -258,19 +318,22 @@ def _gap_floor(sides, edge: float, scale: float = 1.0) -> float:
     return min(scale * float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
 
 
-# A shell's share of a variable gap is at most this fraction of its shortest side (Radioss
-# TYPE7 Igap 3's default %mesh_size, i7sti3.F; LS-DYNA's automatic contacts alike): a
-# node then stays clear of its own flat sheet beyond its neighbouring segments. A scene's
-# ``gap_size_share`` (a deck's %mesh_size) changes it.
+# A pair's variable gap is at most this fraction of the sum of the shortest sides of the
+# node's shells and of the segment (Radioss TYPE7 Igap 3's default %mesh_size, i7sti3.F;
+# LS-DYNA's automatic contacts alike): a node then stays clear of its own flat sheet
+# beyond its neighbouring segments. A scene's ``gap_size_share`` (a deck's %mesh_size)
+# changes it.
 SIZE_SHARE = 0.4
 
 
 @dataclass(frozen=True)
 class GapShare:
-    """How a shell's half thickness t/2 becomes its share of a variable gap (Radioss
-    TYPE7 Igap 2 and 3, ``i7sti3.F``, ``i7cor3.F``): min(scale t/2, size x its shortest
-    side) (m); ``most`` is the scene's ``gap_max`` (m, inf: none), which bounds a pair's
-    gap, the sum of its two shares (``i7cor3.F``: min(GAP_S + GAP_M, GAPMAX))."""
+    """How the shells' half thicknesses t/2 make a pair's variable gap (Radioss TYPE7
+    Igap 3, ``i7sti3.F``, ``i7cor3.F``): each side's thickness share scale x t/2 (GAP_S,
+    GAP_M) and size share size x its shortest side (GAP_S_L, GAP_M_L: a node's, the least
+    over its shells), the pair's gap min(sum of the thickness shares, sum of the size
+    shares, ``most``) (m; ``most`` the scene's ``gap_max``, inf: none), never below the
+    floor."""
 
     scale: float = 1.0
     size: float = SIZE_SHARE
@@ -299,26 +362,30 @@ def _bounded_stiffness(spec, stiffness: np.ndarray) -> np.ndarray:
     return np.clip(spec.stiffness_scale * stiffness, spec.stiffness_min, high)
 
 
-def _sized_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
-    """The depths of the segments of ``s`` (m) with each shell's share of a variable gap
-    (-depth, half its thickness) as ``share`` makes it: at most ``share.size`` x its
-    shortest side."""
-    shell = s.depth < 0.0
-    half = np.minimum(share.scale * -s.depth, share.size * s.edge)
-    return np.where(shell, -half, s.depth)
+def _scaled_depth(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
+    """The depths of the segments of ``s`` (m) with each shell's thickness share of a
+    variable gap (-depth, half its thickness) scaled by ``share.scale``."""
+    return np.where(s.depth < 0.0, share.scale * s.depth, s.depth)
+
+
+def _segment_sizes(s: Surface, share: GapShare = GapShare()) -> np.ndarray:
+    """The size share of each segment of ``s`` in a variable gap (m, Radioss GAP_M_L):
+    ``share.size`` x a shell's shortest side; inf (none) for a solid's face."""
+    return np.where(s.depth < 0.0, share.size * s.edge, np.inf)
 
 
 def _node_gaps(nodes: np.ndarray, surfaces: list[Surface],
-               share: GapShare = GapShare()) -> np.ndarray:  # fmt: skip
-    """Each surface node's gap (m): half the thickness of the thickest shell at it (0 at a
-    solid's), as ``share`` makes it: at most ``share.size`` x the shortest side of the
-    shells at it."""
+               share: GapShare = GapShare()) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Each surface node's thickness share of a variable gap (m, Radioss GAP_S): half the
+    thickness of the thickest shell at it (0 at a solid's) x ``share.scale``; and its size
+    share (m, GAP_S_L): ``share.size`` x the shortest side of the shells at it (inf at a
+    solid's)."""
     out, size = np.zeros(len(nodes)), np.full(len(nodes), np.inf)
     for s in surfaces:
         half = np.repeat(np.maximum(-s.depth, 0.0), 4)
-        side = np.repeat(np.where(s.depth < 0.0, share.size * s.edge, np.inf), 4)
+        side = np.repeat(_segment_sizes(s, share), 4)
         ids = s.segments.ravel()
         rows = np.searchsorted(nodes, ids[ids >= 0])
         np.maximum.at(out, rows, half[ids >= 0])
         np.minimum.at(size, rows, side[ids >= 0])
-    return np.minimum(share.scale * out, size)
+    return share.scale * out, size

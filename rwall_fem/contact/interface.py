@@ -74,8 +74,11 @@ CONTACT_COLUMNS = (
 class Pass:
     """Secondary nodes (indices into the interface's surface nodes, or a rank's local
     nodes) against segments (rows of 4 indices, -1 as the 4th of a triangle) with their
-    stiffness k0 (N/m) and depth (m); ``exclude``: a node is kept off its own segments'
-    neighbours (self-contact).
+    stiffness k0 (N/m), depth (m) and size share of a variable gap (m, ``kernels/contact.c``
+    pair_gap; default inf: none); ``exclude``: a node is kept off its own segments'
+    neighbours (self-contact); ``removed``: the nodes each segment leaves out of its search
+    (Radioss Irem_gap 2, ``kernels/contact_remove.c``), as offsets (segments + 1) and node
+    indices (sorted per segment), or None.
     """
 
     secondary: np.ndarray
@@ -83,8 +86,12 @@ class Pass:
     stiffness: np.ndarray
     depth: np.ndarray
     exclude: bool = False
+    size: np.ndarray | None = None
+    removed: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self):
+        if self.size is None:
+            self.size = np.full(len(self.segments), np.inf)
         # The segments of each surface node (CSR), for the exclusion of neighbours.
         nodes = self.segments.ravel()
         seg = np.repeat(np.arange(len(self.segments), dtype=np.int64), 4)
@@ -113,7 +120,9 @@ class Pass:
 class _Share:
     """This rank's share of a pass, kept from sort to sort: its secondary nodes (global
     numbers, sorted) with their friction force (N) and own gap (m), and the segments it
-    owns (global numbers), with their places in the whole pass, stiffness and depth."""
+    owns (global numbers), with their places in the whole pass, stiffness, depth and size
+    share; the nodes each segment of the whole pass leaves out (global numbers, CSR as
+    :attr:`Pass.removed`; every rank holds all of them) or None."""
 
     secondary: np.ndarray
     tangential: np.ndarray
@@ -123,6 +132,8 @@ class _Share:
     stiffness: np.ndarray
     depth: np.ndarray
     exclude: bool
+    size: np.ndarray
+    removed: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class ContactInterface:
@@ -155,6 +166,7 @@ class ContactInterface:
         self._params.damping = damping
         self.damping = damping
         self.half_thickness = None  # m per owned surface node (vary_gap)
+        self.node_size = None  # m per owned surface node (vary_gap)
         self.mirrored = None  # the owned surface nodes' shares and planes (mirror)
         self.dt_limit = math.inf  # the nodal stable step of the latest pass on this rank, s
         self.sorts = 0
@@ -198,6 +210,7 @@ class ContactInterface:
         k0 = np.concatenate([ps.stiffness for ps in passes])
         self.k0_range = (float(k0.min(initial=np.inf)), float(k0.max(initial=0.0)))
         self.shell_half = max(-float(ps.depth.min(initial=0.0)) for ps in passes)
+        self.size_most = max(float(ps.size.max(initial=0.0)) for ps in passes)
         # The segments within this distance of a node compete for it, whatever their own
         # depth, so that the closest (the best aligned) decides; the sort finds them all.
         self.reach = max([self.gap, *(float(ps.depth.max(initial=0.0)) for ps in passes)])
@@ -227,9 +240,13 @@ class ContactInterface:
         segments = np.where(ps.segments >= 0, nodes[np.maximum(ps.segments, 0)], -1)
         lowest = np.where(segments >= 0, segments, np.iinfo(np.int64).max).min(axis=1)
         owned = owners.mine(lowest)
+        removed = None
+        if ps.removed is not None:
+            removed = (ps.removed[0], nodes[ps.removed[1]].astype(np.int64))
         return _Share(secondary, tangential, gaps, segments[owned].astype(np.int64),
                       np.flatnonzero(owned).astype(np.int64), ps.stiffness[owned].copy(),
-                      ps.depth[owned].copy(), ps.exclude)  # fmt: skip
+                      ps.depth[owned].copy(), ps.exclude, ps.size[owned].copy(),
+                      removed)  # fmt: skip
 
     def start(self, s) -> None:
         """The gaps of the nodes that start inside the gap (Radioss TYPE7 Inacti = 6,
@@ -245,7 +262,7 @@ class ContactInterface:
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
                 p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
                 p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
-                self._surface[0], self._params, p(ps.gaps), p(out),
+                p(ps.size), self._surface[0], self._params, p(ps.gaps), p(out),
             )  # fmt: skip
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
@@ -253,18 +270,24 @@ class ContactInterface:
         deepest = self.comm.allreduce(deepest, op=MPI.MAX)
         self.starting_inside = (int(inside), int(behind), deepest)
 
-    def vary_gap(self, half_thickness: np.ndarray, nodes: np.ndarray,
+    def vary_gap(self, half_thickness: np.ndarray, size: np.ndarray, nodes: np.ndarray,
                  most: float = math.inf) -> None:  # fmt: skip
-        """A variable gap (Radioss Igap 1): node s against a segment gets
+        """A variable gap (Radioss Igap 3, ``i7cor3.F``): node s against a segment gets
         ``half_thickness[s]`` plus the segment's half thickness (a shell's: -depth; 0 for a
-        solid's face), at most ``most`` (m, Radioss Gap_max) and at least :attr:`gap` (the
-        floor); ``half_thickness`` (m) per surface node ``nodes`` (half its thickest shell;
-        the rank keeps its owned nodes')."""
-        self.half_thickness = np.ascontiguousarray(
-            half_thickness[np.searchsorted(nodes, self.ids)], dtype=np.float64)
+        solid's face), at most ``size[s]`` plus the segment's size share (the passes' size)
+        and ``most`` (m, Radioss Gap_max), at least :attr:`gap` (the floor);
+        ``half_thickness`` and ``size`` (m) per surface node ``nodes`` (half its thickest
+        shell, %mesh_size x the shortest side of its shells; the rank keeps its owned
+        nodes')."""
+        rows = np.searchsorted(nodes, self.ids)
+        self.half_thickness = np.ascontiguousarray(half_thickness[rows], dtype=np.float64)
+        self.node_size = np.ascontiguousarray(size[rows], dtype=np.float64)
         self._params.gap_max = most
+        # The largest pair gap (Radioss's GAP, i7sti3.F: min(GAPS_MX + GAPM_MX, GAPS_L_MX
+        # + GAPM_L_MX), within the floor and Gap_max)
         pair = float(half_thickness.max(initial=0.0)) + self.shell_half
-        self.gap_max = max(self.gap, min(pair, most))
+        sizes = float(size.max(initial=0.0)) + self.size_most
+        self.gap_max = max(self.gap, min(pair, sizes, most))
         self.reach = max(self.reach, self.gap_max)
         self._params.reach = self.reach
         self._sorted_at = None
@@ -298,7 +321,8 @@ class ContactInterface:
         return (
             p(ps.secondary, "int64_t[]"), p(ps.near_offsets, "int64_t[]"),
             p(ps.near, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.near_used),
-            p(ps.near_used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth), x, v, mass,
+            p(ps.near_used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
+            p(ps.size), x, v, mass,
             self._params, p(ps.tangential), p(ps.gaps), force,
             stiffness, p(ps.out),
         )  # fmt: skip
@@ -339,6 +363,9 @@ class ContactInterface:
         if self.half_thickness is not None:
             self._local_half[: self.n] = self.half_thickness
             self._params.half_thickness = self._pointer(self._local_half)
+            self._local_size = np.full(n, np.inf)
+            self._local_size[: self.n] = self.node_size
+            self._params.node_size = self._pointer(self._local_size)
         if self.mirrored is not None:
             share, planes = self.mirrored
             self._local_share, self._local_planes = np.ones(n), np.zeros(n, dtype=np.int8)
@@ -389,11 +416,11 @@ class ContactInterface:
             ints = np.column_stack([np.full(len(seg), k), sh.places[seg], sh.segments[seg]])
             rows.append((np.column_stack([np.ascontiguousarray(ints, dtype=np.int64)
                                           .view(np.float64), sh.stiffness[seg],
-                                          sh.depth[seg]]), rank))  # fmt: skip
-        records = np.concatenate([r for r, _ in rows]) if rows else np.zeros((0, 8))
+                                          sh.depth[seg], sh.size[seg]]), rank))  # fmt: skip
+        records = np.concatenate([r for r, _ in rows]) if rows else np.zeros((0, 9))
         ranks = np.concatenate([r for _, r in rows]).astype(np.int64) if rows else np.zeros(0, int)
-        received = send_rows(self.comm, records.reshape(-1, 8), ranks)
-        self.sent += 8 * 8 * int(np.count_nonzero(ranks != self.comm.rank))
+        received = send_rows(self.comm, records.reshape(-1, 9), ranks)
+        self.sent += 9 * 8 * int(np.count_nonzero(ranks != self.comm.rank))
         ints = np.ascontiguousarray(received[:, :6]).view(np.int64)
         # Every node of the segments near this rank's secondary nodes: those of other ranks
         # are its ghosts.
@@ -407,20 +434,24 @@ class ContactInterface:
             here = here[np.argsort(ints[here, 1])]  # in their order in the whole pass
             ps = Pass(np.searchsorted(self.ids, sh.secondary).astype(np.int64),
                       self._to_local(ints[here, 2:]), received[here, 6].copy(),
-                      received[here, 7].copy(), sh.exclude)  # fmt: skip
+                      received[here, 7].copy(), sh.exclude, received[here, 8].copy())  # fmt: skip
             ps.tangential, ps.gaps = sh.tangential, sh.gaps
+            if sh.removed is not None:
+                ps.removed = self._removed_here(sh.removed, ints[here, 1])
             passes.append(ps)
         self.passes = passes
         lib, p = self.lib, self._pointer
         for ps in passes:
             reach = np.full(len(ps.segments), widen)
+            removed = ((p(ps.removed[0], "int64_t[]"), p(ps.removed[1], "int64_t[]"))
+                       if ps.removed is not None else (self.ffi.NULL, self.ffi.NULL))
             while True:
                 work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
                 count = lib.contact_sort(
                     len(ps.secondary), p(ps.secondary, "int64_t[]"), len(ps.segments),
                     p(ps.segments, "int64_t[]"), p(reach), p(self.x), int(ps.exclude),
                     p(ps.node_offsets, "int64_t[]"), p(ps.node_segs, "int64_t[]"),
-                    len(ps.candidates), p(ps.offsets, "int64_t[]"),
+                    *removed, len(ps.candidates), p(ps.offsets, "int64_t[]"),
                     p(ps.candidates, "int64_t[]"), p(work, "int64_t[]"),
                 )  # fmt: skip
                 if count <= len(ps.candidates):
@@ -431,6 +462,24 @@ class ContactInterface:
         self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
         self._list_near()
+
+    def _removed_here(self, removed: tuple[np.ndarray, np.ndarray],
+                      places: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """The nodes the segments at ``places`` of the whole pass (sorted) leave out
+        (``removed``: the whole pass's, global numbers) that are this rank's secondary
+        nodes' candidates: its owned ones, as local indices, sorted per segment (CSR)."""
+        offsets, ids = removed
+        counts = offsets[places + 1] - offsets[places]
+        ends = np.cumsum(counts)
+        rows = np.arange(int(ends[-1]) if len(ends) else 0) + np.repeat(offsets[places]
+                                                                         - ends + counts, counts)
+        segment = np.repeat(np.arange(len(places)), counts)
+        ids = ids[rows]
+        mine = self.owners.mine(ids)
+        local = np.searchsorted(self.ids, ids[mine]).astype(np.int64)
+        kept = np.bincount(segment[mine], minlength=len(places))
+        return (np.concatenate([[0], np.cumsum(kept)]).astype(np.int64),
+                np.ascontiguousarray(local))  # fmt: skip
 
     def _list_near(self) -> None:
         """The near lists of the passes (``contact_near``): the candidates whose box is

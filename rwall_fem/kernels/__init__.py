@@ -67,7 +67,7 @@ log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
            "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
-           "friction.h", "wall.c", "contact.c")  # fmt: skip
+           "friction.h", "wall.c", "contact.c", "contact_remove.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -165,14 +165,21 @@ void largest_components(int64_t n, const int64_t *nodes, const double *v, const 
 typedef struct {
   double gap, cap, friction, damping, alpha, dt, reach, gap_max;
   const double *half_thickness;
+  const double *node_size;
   const double *share;
   const int8_t *planes;
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
                      const double *reach, const double *x, int exclude,
-                     const int64_t *node_offsets, const int64_t *node_segs, int64_t capacity,
+                     const int64_t *node_offsets, const int64_t *node_segs,
+                     const int64_t *removed_offsets, const int64_t *removed, int64_t capacity,
                      int64_t *offsets, int64_t *candidates, int64_t *work);
+int64_t contact_remove_lists(int64_t nseg, const int64_t *segs, int64_t nnodes, const double *x,
+                             const int8_t *secondary, const double *seg_gap,
+                             const double *seg_size, const double *node_gap,
+                             const double *node_size, int variable, double gap, double gap_max,
+                             int64_t capacity, int64_t *offsets, int64_t *removed);
 int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                      const int64_t *candidates, const int64_t *segs, int64_t nused,
                      const int64_t *used, double *boxes, const double *x, double limit,
@@ -180,12 +187,13 @@ int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offs
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                     const int64_t *candidates, const int64_t *segs, int64_t nused,
                     const int64_t *used, double *boxes, const double *stiffness0,
-                    const double *depth, const double *x, const double *v,
+                    const double *depth, const double *size, const double *x, const double *v,
                     const double *mass, const contact_params *prm, double *tangential,
                     double *node_gap, double *force, double *stiffness, double out[11]);
 void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                           const int64_t *candidates, const int64_t *segs, int64_t nused,
-                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth, const double *x,
+                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth,
+                          const double *size, const double *x,
                           const contact_params *prm, double *node_gap, double out[3]);
 double contact_step(int64_t n, const double *mass, double *stiffness);
 void contact_gather(int64_t n, const int64_t *rows, const double *X, const double *u,

@@ -8,8 +8,9 @@
  * contact_sort: the candidate segments of each secondary node, by buckets (spatial hashing):
  *   the secondary nodes go into a grid of cubes, each segment is tested against the nodes
  *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
- *   neighbours are left out when `exclude` (self-contact).  The lists come sorted by
- *   segment, whatever the grid.
+ *   neighbours are left out when `exclude` (self-contact), and the nodes each segment's
+ *   list leaves out (`removed`, Radioss Irem_gap 2: contact_remove.c).  The lists come
+ *   sorted by segment, whatever the grid.
  * contact_near: the candidates near enough to their node to be met before the nodes have
  *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
@@ -48,6 +49,8 @@ typedef struct
   double gap_max;  /* m: a pair's variable gap at most this (Radioss Gap_max; inf: none) */
   const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
                                   a constant gap (see pair_gap) */
+  const double *node_size;      /* m per surface node, with half_thickness: %mesh_size x the
+                                  shortest side of its shells (INFINITY: none; see pair_gap) */
   const double *share;          /* per surface node, or NULL (all 1): the share of the whole
                                   node a model cut by symmetry planes holds (see mirror) */
   const int8_t *planes;         /* per surface node, or NULL: bit c set on a symmetry plane
@@ -101,14 +104,33 @@ static int excluded(int64_t s, const int64_t *seg, const int64_t *node_offsets,
   return 0;
 }
 
+/* Whether node s is in the sorted list [from, to). */
+static int listed(int64_t s, const int64_t *from, const int64_t *to)
+{
+  while (from < to)
+  {
+    const int64_t *mid = from + (to - from) / 2;
+    if (*mid == s)
+      return 1;
+    if (*mid < s)
+      from = mid + 1;
+    else
+      to = mid;
+  }
+  return 0;
+}
+
 /* Candidates of the nsec secondary nodes `secondary` among the nseg segments `segs`, each
- * widened by reach[j] (m), at positions x.  Fills offsets (nsec + 1) and up to `capacity`
+ * widened by reach[j] (m), at positions x; segment j leaves out the nodes
+ * removed[removed_offsets[j] .. removed_offsets[j + 1]) (sorted; removed NULL: none).
+ * Fills offsets (nsec + 1) and up to `capacity`
  * candidates (segment indices, sorted per node); `work` holds 2 nsec + 2 capacity + 1
  * int64.  Returns the number of candidates (more than capacity: call again with room). */
 int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t nseg,
                      const int64_t *restrict segs, const double *restrict reach,
                      const double *restrict x, int exclude, const int64_t *restrict node_offsets,
-                     const int64_t *restrict node_segs, int64_t capacity,
+                     const int64_t *restrict node_segs, const int64_t *restrict removed_offsets,
+                     const int64_t *restrict removed, int64_t capacity,
                      int64_t *restrict offsets, int64_t *restrict candidates,
                      int64_t *restrict work)
 {
@@ -228,6 +250,8 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
             for (int k = 0; k < 4; ++k)
               own |= seg[k] == s;
             if (own || (exclude && excluded(s, seg, node_offsets, node_segs, segs)))
+              continue;
+            if (removed && listed(s, removed + removed_offsets[j], removed + removed_offsets[j + 1]))
               continue;
             if (count < capacity)
             {
@@ -405,16 +429,19 @@ static double closest_on_segment(const double p[3], const int64_t *seg, const do
  * distance to it is unsigned and it is pushed out on the side it is on. */
 INLINE int two_sided(double depth) { return depth < 0.0; }
 
-/* The gap (m) of node s against a segment of depth `depth`: the interface's, or with
- * half_thickness (a variable gap, Radioss Igap 1) the node's half thickness plus the
- * segment's (-depth for a shell, 0 for a solid's face), at most gap_max and at least the
- * interface's gap (the floor, Gapmin), as i7cor3.F bounds the pair:
- * max(GAPMIN, min(GAP_S + GAP_M, GAPMAX)). */
-INLINE double pair_gap(const contact_params *prm, int64_t s, double depth)
+/* The gap (m) of node s against a segment of depth `depth` and size share `size`: the
+ * interface's, or with half_thickness (a variable gap, Radioss Igap 3) the node's half
+ * thickness plus the segment's (-depth for a shell, 0 for a solid's face), at most the
+ * node's size share plus the segment's (node_size[s] + size: %mesh_size x their shortest
+ * sides) and gap_max, and at least the interface's gap (the floor, Gapmin), as i7cor3.F
+ * bounds the pair: max(GAPMIN, min(GAP_S + GAP_M, GAP_S_L + GAP_M_L, GAPMAX)). */
+INLINE double pair_gap(const contact_params *prm, int64_t s, double depth, double size)
 {
   if (!prm->half_thickness)
     return prm->gap;
   double pair = prm->half_thickness[s] + (two_sided(depth) ? -depth : 0.0);
+  const double sizes = (prm->node_size ? prm->node_size[s] : INFINITY) + size;
+  pair = pair < sizes ? pair : sizes;
   pair = pair < prm->gap_max ? pair : prm->gap_max;
   return pair > prm->gap ? pair : prm->gap;
 }
@@ -451,6 +478,7 @@ typedef struct
   double d;                     /* signed distance, m (< 0 behind the surface) */
   double normal[3];             /* unit, from the surface toward the node's side */
   double k0, depth;             /* the blended segments' stiffness (N/m) and depth (m) */
+  double size;                  /* and size share (m, see pair_gap) */
 } surface_point;
 
 /* The boxes of the segments `used` (nused of them, indices into segs) at positions x: 6
@@ -555,7 +583,8 @@ int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
 static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               const int64_t *restrict candidates, const int64_t *restrict segs,
                               const double *restrict stiffness0, const double *restrict depth,
-                              const double *restrict x, const double *restrict boxes,
+                              const double *restrict size, const double *restrict x,
+                              const double *restrict boxes,
                               double reach, segment_point *restrict near, surface_point *pt)
 {
   double best = INFINITY;
@@ -578,7 +607,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   const double band = BAND * best;
   double total = 0.0, along = 0.0, q_sum[3] = {0.0, 0.0, 0.0}, n_sum[3] = {0.0, 0.0, 0.0};
   pt->n = 0;
-  pt->k0 = pt->depth = 0.0;
+  pt->k0 = pt->depth = pt->size = 0.0;
   for (int64_t k = from; k < to; ++k)
   {
     const segment_point *sp = near + (k - from);
@@ -598,6 +627,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
     }
     pt->k0 += share * stiffness0[j];
     pt->depth += share * depth[j];
+    pt->size += share * (size ? size[j] : INFINITY);
     total += share;
     for (int m = 0; m < 4; ++m)
     {
@@ -623,6 +653,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
     pt->weight[m] /= weights;
   pt->k0 /= total;
   pt->depth /= total;
+  pt->size /= total;
   pt->d = along >= 0.0 || two_sided(pt->depth) ? best : -best;
   double r[3];
   for (int c = 0; c < 3; ++c)
@@ -698,8 +729,9 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
                           const int64_t *restrict segs, int64_t nused,
                           const int64_t *restrict used, double *restrict boxes,
                           const double *restrict stiffness0,
-                          const double *restrict depth, const double *restrict x,
-                          const contact_params *prm, double *restrict node_gap, double out[3])
+                          const double *restrict depth, const double *restrict size,
+                          const double *restrict x, const contact_params *prm,
+                          double *restrict node_gap, double out[3])
 {
   out[0] = out[1] = out[2] = 0.0;
   int64_t most = 1;
@@ -712,9 +744,9 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
   {
     node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, x, boxes, prm->reach, near, &pt))
+                            segs, stiffness0, depth, size, x, boxes, prm->reach, near, &pt))
       continue;
-    const double g = pair_gap(prm, secondary[i], pt.depth);
+    const double g = pair_gap(prm, secondary[i], pt.depth, pt.size);
     if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
       continue;
     node_gap[i] = pt.d > 0.0 ? INITIAL_GAP * pt.d : 0.0;
@@ -727,8 +759,9 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
 
 /* One pass: the nsec secondary nodes against their candidate segments.  `used` are the
  * nused segments that are someone's candidate (each once), whose boxes (6 values a
- * segment of `boxes`, scratch) are found first.  `stiffness0` and
- * `depth` (m: how deep behind a segment a node is still pushed out) are per segment;
+ * segment of `boxes`, scratch) are found first.  `stiffness0`,
+ * `depth` (m: how deep behind a segment a node is still pushed out) and `size` (m, the
+ * segment's size share of a variable gap, pair_gap; NULL: none) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
  * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
  * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
@@ -738,8 +771,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const int64_t *restrict offsets, const int64_t *restrict candidates,
                     const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
                     double *restrict boxes, const double *restrict stiffness0,
-                    const double *restrict depth, const double *restrict x,
-                    const double *restrict v, const double *restrict mass,
+                    const double *restrict depth, const double *restrict size,
+                    const double *restrict x, const double *restrict v,
+                    const double *restrict mass,
                     const contact_params *prm,
                     double *restrict tangential, double *restrict node_gap,
                     double *restrict force, double *restrict stiffness, double out[11])
@@ -758,13 +792,13 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
     if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
-                            depth, x, boxes, prm->reach, near, &pt))
+                            depth, size, x, boxes, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
       node_gap[i] = INFINITY;
       continue;
     }
-    const double g = grown_gap(node_gap + i, pt.d, pair_gap(prm, s, pt.depth));
+    const double g = grown_gap(node_gap + i, pt.d, pair_gap(prm, s, pt.depth, pt.size));
     const double share = mirror(prm, s, &pt);
     const double k0 = share * pt.k0;
     if (!(g > 0.0 && pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))

@@ -10,13 +10,13 @@ parts meet the main ones one way (``symmetric = false``: TYPE7's nodes against s
 The gap: Igap 0 (1000) is constant, GAPmin or Radioss's default for it, the mean
 thickness of the main shells capped at half the shortest side of the main segments (0.1
 x that side without shells); Igap 1 (2, 3) leaves ``gap`` out: the scene's variable gap,
-half the sum of the thicknesses, each shell's share at most 0.4 x its shortest side
-(Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`), with Igap 2 and 3
+half the sum of the thicknesses, at most 0.4 x the sum of the node's and the segment's
+shortest sides (Igap 3 with its default %mesh_size; :mod:`rwall_fem.contact`), with Igap 2 and 3
 Fscalegap ``gap_scale`` and Gap_max ``gap_max``, with Igap 3 %mesh_size
 ``gap_size_share`` (on shells: a solid's face adds no thickness, and a warning line says
 they are left out). Stfac is ``stiffness_scale``, with Istf 2 to 5 Stmin and Stmax
 ``stiffness_min`` and ``stiffness_max``, Fric ``friction`` (Ifiltr, Xfreq its filter),
-VIS_S ``damping``.
+VIS_S ``damping``, Irem_gap 2 ``exclude_within_gap``.
 """
 
 from __future__ import annotations
@@ -87,6 +87,8 @@ def _common(deck: Deck, inter, main: list[DeckPart], where: str) -> dict:
         table["stiffness_min"] = inter.stiffness_min
     if inter.stiffness_max:
         table["stiffness_max"] = inter.stiffness_max
+    if inter.exclude_within_gap:
+        table["exclude_within_gap"] = True
     if inter.igap == 0:
         table["gap"] = inter.gap_min or _default_gap(deck, main)
         return table

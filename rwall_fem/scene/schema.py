@@ -1308,8 +1308,15 @@ class ContactSpec:
     gap_size_share: float = key(
         Real(low=0.0, high=1.0),
         0.4,
-        doc="Radioss %mesh_size (Igap 3): each shell's share of the variable gap at most "
-        "this fraction of its shortest side (of the shells at a node)",
+        doc="Radioss %mesh_size (Igap 3): a pair's variable gap at most this fraction of the "
+        "sum of the shortest sides of the node's shells and of the segment",
+    )
+    exclude_within_gap: bool = key(
+        Flag(),
+        False,
+        doc="Radioss Irem_gap 2: each segment leaves out of its search the nodes within "
+        "sqrt(2) x their pair gap of it along the mesh, at the start (self-contact of a mesh "
+        "finer than the gap; beyond a node's own segments and their neighbours)",
     )
     stiffness_scale: float = key(
         Real(low=0.0),

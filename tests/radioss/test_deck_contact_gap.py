@@ -71,13 +71,15 @@ SELF = dict(single_surface=True)
         ([ISTF(2), STMIN(10), STMAX(300)],
          ContactSpec(**SELF, gap=1e-3, stiffness_min=1e7, stiffness_max=3e8)),
         ([ISTF(4), STMIN(10)], ContactSpec(**SELF, gap=1e-3, stiffness_min=1e7)),
+        ([IREM(2)], ContactSpec(**SELF, gap=1e-3, exclude_within_gap=True)),
+        ([IGAP(3), IREM(2)], ContactSpec(**SELF, exclude_within_gap=True)),
     ],
-    ids=["igap3", "igap2", "igap3-blank", "istf2-bounds", "istf4-min"],
+    ids=["igap3", "igap2", "igap3-blank", "istf2-bounds", "istf4-min", "irem2", "irem2-igap3"],
 )
 def test_the_deck_gives_the_scene_contact(fields, scene, shared_dir, caplog):
     contact, said = load(shared_dir, caplog, *fields)
     _same(contact, scene)
-    assert not any("left out" in s or "Igap = 2" in s for s in said), said
+    assert not any("left out" in s or "Igap = 2" in s or "Irem_gap" in s for s in said), said
 
 
 def _same(a: ContactSpec, b: ContactSpec) -> None:
@@ -100,9 +102,8 @@ def _same(a: ContactSpec, b: ContactSpec) -> None:
          lambda c: c.gap_size_share == 0.4),
         ([STMAX(300)], "Stmax = 300: left out: Radioss reads it with Istf 2 to 5 only",
          lambda c: c.stiffness_max is None),
-        ([IREM(2)], "Irem_gap = 2: not honoured", lambda c: True),
     ],
-    ids=["fscale-igap1", "gapmax-igap0", "mesh-igap2", "stmax-istf0", "irem-gap"],
+    ids=["fscale-igap1", "gapmax-igap0", "mesh-igap2", "stmax-istf0"],
 )
 def test_fields_radioss_leaves_out_give_one_line(fields, line, check, shared_dir, caplog):
     contact, said = load(shared_dir, caplog, *fields)

@@ -114,3 +114,108 @@ def test_without_the_cap_the_fine_sheet_touches_itself(shared_dir, monkeypatch):
           f"{sim.contacts[0].gap_max:.3e} m")
     assert sim.contacts[0].gap_max == pytest.approx(1.5e-3, rel=1e-9)
     assert inside >= nodes // 2
+
+
+# A constant gap larger than the mesh: Radioss Irem_gap 2 (``exclude_within_gap``). With
+# gap = 1.2 mm (2.4 cells) every node is within the gap of its sheet's coplanar shells two
+# cells away (1 mm), beyond the neighbours it is kept off. Worked by hand: each segment
+# leaves out the nodes within sqrt 2 x 1.2 = 1.70 mm of it along the mesh; a coplanar shell
+# within 1.2 mm of a node in the plane has its nearest node at most (2, 1) cells away, 1.21
+# mm along the mesh (a diagonal and a side): left out, every one. So with the lists no node
+# starts inside the gap or meets its sheet, and the cantilever's run is the run without
+# contact, on any number of ranks (the lists travel with the segments).
+LARGE_GAP = {"self": True, "gap": 1.2e-3}
+
+
+@pytest.mark.parametrize("within", [False, True], ids=["neighbours_only", "exclude_within_gap"])
+def test_a_gap_larger_than_the_mesh_with_the_lists(within, shared_dir):
+    raw = sheet(True, False)
+    raw["contact"] = [LARGE_GAP | ({"exclude_within_gap": True} if within else {})]
+    sim = build_simulation(parse_scene(raw, source="test"), comm, shared_dir)
+    nodes = comm.allreduce(len(sim.state.X))
+    inside = starting_inside(sim)
+    print(f"gap 1.2 mm, exclude_within_gap {within}: {inside} of {nodes} nodes start inside")
+    if not within:
+        assert inside >= nodes // 2
+        return
+    watch = InContact(sim)
+    assert sim.run() == "done"
+    drift = comm.allreduce(float(np.abs(sim.state.v - V0).max(initial=0.0)), op=MPI.MAX)
+    assert inside == 0 and watch.most == 0
+    assert drift <= 1e-12 * np.linalg.norm(V0)
+
+
+def test_a_bending_sheet_with_the_lists_is_the_run_without_contact(shared_dir):
+    raw = sheet(True, True)
+    raw["contact"] = [LARGE_GAP | {"exclude_within_gap": True}]
+    sim = build_simulation(parse_scene(raw, source="test"), comm, shared_dir / "lists")
+    watch = InContact(sim)
+    assert sim.run() == "done"
+    free, _ = run_sheet(shared_dir / "free", contact=False, clamped=True)
+    scale = comm.allreduce(float(np.abs(free.state.u).max(initial=0.0)), op=MPI.MAX)
+    differ = comm.allreduce(float(np.abs(sim.state.u - free.state.u).max(initial=0.0)),
+                            op=MPI.MAX)  # fmt: skip
+    print(f"bending sheet, gap 1.2 mm with the lists: most in contact {watch.most}, "
+          f"against no contact {differ:.2e} m of {scale:.2e} m")
+    assert watch.most == 0 and starting_inside(sim) == 0
+    assert differ <= 1e-12 * scale
+
+
+# A U-fold meeting itself under the lists, on N ranks as on one. A steel strip of 0.5 mm
+# shells in 1 mm cells, 3 mm wide, folded into a U (a bottom leg of 10 mm at z = 0, a wall
+# of 3 mm, a top leg of 10 mm back at z = 3 mm; the bottom leg's free edge held, the top
+# leg's pushed down at 20 m/s), in
+# self-contact with a constant gap of 2.5 mm and exclude_within_gap: the legs meet once
+# they are within 2.5 mm (their nodes far apart along the mesh, round the wall), while each
+# node is left out of its own leg's shells within the gap. The contacts.csv columns on N
+# ranks against one, to 1e-10 of their scale (the normal force's for the forces), the same
+# nodes in contact at the same steps.
+U_GEO = """Point(1) = {0, 0, 0}; Point(2) = {0.01, 0, 0};
+Point(3) = {0.01, 0, 0.003}; Point(4) = {0, 0, 0.003};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4};
+Transfinite Curve{1, 3} = 11; Transfinite Curve{2} = 4;
+a[] = Extrude {0, 0.003, 0} { Line{1}; Layers{3}; Recombine; };
+b[] = Extrude {0, 0.003, 0} { Line{2}; Layers{3}; Recombine; };
+c[] = Extrude {0, 0.003, 0} { Line{3}; Layers{3}; Recombine; };
+Physical Surface("strip") = {a[1], b[1], c[1]};
+Physical Curve("root") = {a[2]};
+Physical Curve("tip") = {c[3]};
+"""
+
+
+@pytest.mark.skipif(comm.size == 1, reason="compares a partitioned run with a serial one")
+def test_a_u_fold_meets_itself_under_the_lists_on_any_ranks(shared_dir, tmp_path):
+    path = shared_dir / "u_fold.geo"
+    if comm.rank == 0:
+        shared_dir.mkdir(parents=True, exist_ok=True)
+        path.write_text(U_GEO)
+    comm.Barrier()
+    raw = {
+        "run": {"end_time": 6e-5},
+        "mesh": {"file": str(path)},
+        "material": dict(STEEL),
+        "element": {"thickness": 5e-4},
+        "boundary": [{"group": "root", "velocity": [0.0, 0.0, 0.0]},
+                     {"group": "tip", "velocity": [0.0, 0.0, -20.0]}],
+        "contact": [{"self": True, "gap": 2.5e-3, "exclude_within_gap": True}],
+        "output": {"plot": False, "frames": 0},
+    }  # fmt: skip
+    parallel = build_simulation(parse_scene(raw, source="test"), comm, shared_dir / "u_fold")
+    assert parallel.run() == "done"
+    serial = build_simulation(parse_scene(raw, source="test"), MPI.COMM_SELF,
+                              tmp_path / f"serial{comm.rank}")  # fmt: skip
+    assert serial.run() == "done"
+    mine, whole = parallel.history.contact(0), serial.history.contact(0)
+    print(f"U-fold: nodes in contact at the end {int(whole[-1, 9])}, most {int(whole[:, 9].max())}"
+          f", starting inside {starting_inside(parallel)}")
+    assert starting_inside(parallel) == 0 and whole[:, 9].max() > 0  # the fold meets
+    assert mine.shape == whole.shape and np.array_equal(mine[:, 9], whole[:, 9])
+    # A self-contact's net force is a cancellation (both legs' nodes are secondary): its
+    # scale is the normal force's (the sum of the pairs' sizes), the impulse's that times
+    # the run's time
+    normal = np.abs(whole[:, 8]).max()
+    scales = {2: normal, 5: normal * raw["run"]["end_time"], 8: normal,
+              10: np.abs(whole[:, 10:13]).max()}  # fmt: skip
+    for columns in (slice(2, 5), slice(5, 8), slice(8, 9), slice(10, 13)):
+        differ = np.abs(mine[:, columns] - whole[:, columns]).max()
+        assert differ <= 1e-10 * scales[columns.start], columns

@@ -206,3 +206,91 @@ def test_the_contact_of_different_shells_starts_at_the_bounded_pair_gap(shared_d
     assert sim.contacts[0].gap_max == pytest.approx(PAIR_GAP, rel=1e-12)
     assert d[k] < PAIR_GAP <= d[k - 1]
     assert d[k - 1] - d[k] <= 1e-2 * PAIR_GAP
+
+
+# Different meshes: Radioss's Igap 3 bounds a pair's gap by the sum of the two sides' size
+# shares, not each side's share by its own (``i7cor3.F``: GAPV = max(GAPMIN, min(GAP_S +
+# GAP_M, GAP_S_L + GAP_M_L, GAPMAX)), ``i7sti3.F``: GAP_M_L = %mesh_size x the segment's
+# shortest side, GAP_S_L the least of it over the node's shells).
+#
+# Two parallel steel plates close at a constant speed w: the lower 2 mm thick in 1 mm
+# quadrilaterals (12 x 12 mm), the upper 0.5 mm thick in 2 mm quadrilaterals (8 x 8 mm over
+# its middle, its nodes a quarter of a lower cell off the lower's). Hand-computed with the
+# default %mesh_size 0.4: thickness shares t/2 = 1 and 0.25 mm (sum 1.25 mm), size shares
+# 0.4 x h = 0.4 and 0.8 mm (sum 1.2 mm), floor min(thinnest t, half the shortest side) =
+# 0.5 mm: the pair's gap max(0.5, min(1.25, 1.2)) = 1.2 mm, both ways (a node of either
+# plate against a segment of the other: the same two sums). Each share capped by its own
+# size would give min(1, 0.4) + min(0.25, 0.8) = 0.65 mm. Within each plate the gap of a
+# node against its own plate's shells is min(2 t/2, 0.8 h) (0.8 and 0.5 mm), below the
+# distance to the nearest shell it is not kept off (h): no contact within a plate. The
+# contact starts at the first step whose positions have d below 1.2 mm: d^n < g <= d^(n-1)
+# (one step of travel, under 1 % of g), both as a single surface (self = true over both
+# plates: Radioss's single-surface TYPE7) and two-sided.
+SIZE_PAIR_GAP = max(5e-4, min(1e-3 + 2.5e-4, 0.4 * (1e-3 + 2e-3)))  # 1.2 mm
+
+SIZE_GEO = """Point(1) = {{0, 0, 0}};
+ax[] = Extrude {{0.012, 0, 0}} {{ Point{{1}}; Layers{{12}}; Recombine; }};
+ay[] = Extrude {{0, 0.012, 0}} {{ Line{{ax[1]}}; Layers{{12}}; Recombine; }};
+Physical Surface("fine") = {{ay[1]}};
+Point(101) = {{0.00225, 0.00225, {d0}}};
+bx[] = Extrude {{0.008, 0, 0}} {{ Point{{101}}; Layers{{4}}; Recombine; }};
+by[] = Extrude {{0, 0.008, 0}} {{ Line{{bx[1]}}; Layers{{4}}; Recombine; }};
+Physical Surface("coarse") = {{by[1]}};
+"""
+
+
+def size_plates(directory, contact: dict, d0: float = 1.6e-3) -> dict:
+    path = directory / "plates.geo"
+    if comm.rank == 0:
+        directory.mkdir(parents=True, exist_ok=True)
+        path.write_text(SIZE_GEO.format(d0=d0))
+    comm.Barrier()
+    return {
+        "run": {"end_time": (d0 - SIZE_PAIR_GAP) / W + 3e-6},
+        "mesh": {"file": str(path)},
+        "material": STEEL,
+        "part": [{"name": "fine", "element": {"thickness": 2e-3},
+                  "initial": {"velocity": [0.0, 0.0, 0.5 * W]}},
+                 {"name": "coarse", "element": {"thickness": 5e-4},
+                  "initial": {"velocity": [0.0, 0.0, -0.5 * W]}}],
+        "contact": [{"damping": 0.0} | contact],
+        "output": {"plot": False, "frames": 0},
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize("contact", [{"self": True}, {"main": ["fine"], "secondary": ["coarse"]}],
+                         ids=["single_surface", "two_sided"])  # fmt: skip
+def test_different_meshes_touch_at_the_sum_of_the_size_shares(contact, shared_dir):
+    directory = shared_dir / ("size_" + "_".join(contact))
+    d0 = 1.6e-3
+    sim = build_simulation(parse_scene(size_plates(directory, contact, d0), source="test"),
+                           comm, directory)  # fmt: skip
+    watch = FirstTouch(sim, d0)
+    assert sim.run() == "done"
+    k, contacts, _ = watch.touch
+    d = watch.separations
+    print(f"{contact}: pair gap {SIZE_PAIR_GAP:.4e} m; first contact at step {k}: d^n "
+          f"{d[k]:.6e} m, d^(n-1) {d[k - 1]:.6e} m, {contacts} nodes")
+    assert d[k] < SIZE_PAIR_GAP <= d[k - 1]
+    assert d[k - 1] - d[k] <= 1e-2 * SIZE_PAIR_GAP
+
+
+@pytest.mark.skipif(comm.size == 1, reason="compares a partitioned run with a serial one")
+def test_the_sum_of_the_size_shares_does_not_depend_on_the_ranks(shared_dir, tmp_path):
+    """The single-surface plates on N ranks against one rank: the contacts.csv columns
+    (force, impulse, normal force, energies) to 1e-10 of their scale, the same nodes in
+    contact at the same steps (the segments' size shares travel with them between ranks)."""
+    d0 = 1.25e-3  # into contact within a few steps
+    raw = size_plates(shared_dir / "size_ranks", {"self": True}, d0)
+    raw["run"]["end_time"] = 6e-6
+    parallel = build_simulation(parse_scene(raw, source="test"), comm, shared_dir / "size_ranks")
+    assert parallel.run() == "done"
+    serial_dir = tmp_path / f"serial{comm.rank}"
+    serial = build_simulation(parse_scene(raw, source="test"), MPI.COMM_SELF, serial_dir)
+    assert serial.run() == "done"
+    mine, whole = parallel.history.contact(0), serial.history.contact(0)
+    assert mine.shape == whole.shape and whole[:, 9].max() > 0
+    assert np.array_equal(mine[:, 9], whole[:, 9])
+    for columns in (slice(2, 5), slice(5, 8), slice(8, 9), slice(10, 13)):
+        scale = np.abs(whole[:, columns]).max()
+        assert np.abs(mine[:, columns] - whole[:, columns]).max() <= 1e-10 * scale, columns

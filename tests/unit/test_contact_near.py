@@ -43,7 +43,8 @@ def pass_forces(interface: ContactInterface, ps: Pass, offsets, candidates) -> n
     lib.contact_forces(len(ps.secondary), p(ps.secondary, "int64_t[]"),
                        p(offsets, "int64_t[]"), p(candidates, "int64_t[]"),
                        p(ps.segments, "int64_t[]"), len(used), p(used, "int64_t[]"),
-                       p(np.zeros((len(ps.segments), 6))), p(ps.stiffness), p(ps.depth), x, v,
+                       p(np.zeros((len(ps.segments), 6))), p(ps.stiffness), p(ps.depth),
+                       p(ps.size), x, v,
                        mass, interface._params, p(tangential), p(gaps), force, stiffness,
                        p(out))  # fmt: skip
     found = np.concatenate([interface.force.ravel(), interface.stiffness, tangential.ravel(),

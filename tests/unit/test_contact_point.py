@@ -41,7 +41,7 @@ def forces(x, segments, node, *, depth=5e-4):
     lib.contact_forces(1, p(secondary, "int64_t[]"), p(offsets, "int64_t[]"),
                        p(candidates, "int64_t[]"), p(segments, "int64_t[]"), len(segments),
                        p(candidates, "int64_t[]"), p(np.zeros((len(segments), 6))), p(k0),
-                       p(depths), p(x), p(v), p(mass), prm, p(tangential), p(gaps), p(force),
+                       p(depths), ffi.NULL, p(x), p(v), p(mass), prm, p(tangential), p(gaps), p(force),
                        p(stiffness), p(out))  # fmt: skip
     return force
 

@@ -5,7 +5,7 @@ older surface-to-surface and node-to-surface contacts) too, saying that TYPE7 do
 they do.
 
 Fields read: grnd_IDs, surf_IDm, Istf, Igap, Idel, Gapmin, Stfac, Fric, Inacti, VISs,
-Ifric, Ifiltr, Xfreq; Fscalegap and Gap_max with Igap 2 and 3, %mesh_size with Igap 3,
+Ifric, Ifiltr, Xfreq, Irem_gap; Fscalegap and Gap_max with Igap 2 and 3, %mesh_size with Igap 3,
 Stmin and Stmax with Istf 2 to 5 (where Radioss reads them: ``hm_read_inter_type07.F``;
 elsewhere Radioss leaves them out, and a warning line says so). Each other field that is
 not at its default gives one warning line saying it is not honoured (``docs/radioss.md``,
@@ -29,7 +29,9 @@ class Interface:
     flag and scale, the gap flag and minimum gap (m, 0: Radioss's default), Coulomb's
     coefficient with its filter (``ifq``, ``xfreq``: as /RWALL's), the normal damping;
     the variable gap's scale, bound (m, 0: none) and size share (Fscalegap, Gap_max,
-    %mesh_size), the bounds of the penalty stiffness (N/m, Stmin, Stmax; 0: none)."""
+    %mesh_size), the bounds of the penalty stiffness (N/m, Stmin, Stmax; 0: none); whether
+    each segment leaves out of its search the nodes within sqrt 2 x the gap of it along the
+    mesh (Irem_gap 2)."""
 
     id: int
     title: str
@@ -49,6 +51,7 @@ class Interface:
     size_share: float = 0.4
     stiffness_min: float = 0.0
     stiffness_max: float = 0.0
+    exclude_within_gap: bool = False
 
 
 def _ignored(deck: Deck, card: Card, line, values: dict) -> None:
@@ -100,10 +103,6 @@ def _type7(deck: Deck, card: Card) -> None:
     stiffness = units.factor("force") / units.length
     bounds = _stiffness_bounds(deck, card, istf, stmin, stmax, stiffness)
     _ignored(deck, card, card.lines[3], {"dtmin": dtmin, "Irem_i2": irem_i2})
-    if irem_gap == 2:
-        deck.warn(card, "Irem_gap = 2: not honoured: a node is kept off its own segments "
-                  "and their neighbours only (self-contact), not off every segment within "
-                  "the gap through the mesh", card.lines[3])  # fmt: skip
     at = 5 if icurv in (1, 2) else 4  # the curvature's node line
     stfac, fric, gapmin, tstart, tstop = card.read(at, "f:Stfac f:Fric f:GAPmin f:Tstart f:Tstop")
     if stfac < 0:
@@ -138,7 +137,7 @@ def _type7(deck: Deck, card: Card) -> None:
         iid, card.title(), nodes, surf, istf, 1 if igap in (1, 2, 3) else 0,
         gapmin * units.length, stfac or 1.0, fric, ifiltr,
         xfreq * (units.factor("rate") if ifiltr == 3 else 1.0), viss or 0.05,
-        card.header.where, **gap, **bounds,
+        card.header.where, **gap, **bounds, exclude_within_gap=irem_gap == 2,
     ))  # fmt: skip
 
 
@@ -161,8 +160,8 @@ def _variable_gap(deck: Deck, card: Card, igap: int, scale: float, bound: float,
 
 
 def _size_share(deck: Deck, card: Card, igap: int, share: float) -> float:
-    """%mesh_size: each shell's share of the variable gap at most this fraction of its
-    shortest side, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
+    """%mesh_size: a pair's variable gap at most this fraction of the sum of the node's and
+    the segment's shortest sides, in (0, 1] (0: Radioss's 0.4); read with Igap 3, left out with a warning
     line with Igap 0 to 2 (as Radioss does; with Igap 1 and 2 0.4 kept, the cap of every
     variable gap)."""
     if not 0.0 <= share <= 1.0:
