@@ -764,7 +764,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const int64_t s = secondary[i];
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
-    if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
+    /* (a node without candidates, most of them, has no closest point: not looked for) */
+    if (offsets[i] == offsets[i + 1] ||
+        !closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
                             depth, x, boxes, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
@@ -857,6 +859,16 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
   free(near);
 }
 
+/* Whether the force f (N) on a node of velocity v (m/s) counts in a sum of f . v: not when
+ * f is 0 (+0 or -0) and v finite, whose terms (+0 or -0) change no sum that starts at +0
+ * (such a sum is never -0: x + (-x) is +0), so that the sums skip most surface nodes, out
+ * of contact, yet come out the same to the bit. */
+INLINE int counts(const double f[3], const double v[3])
+{
+  return f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0 ||
+         !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]));
+}
+
 /* One sweep of the rank's n owned surface nodes (the first local ones) before the passes:
  * the rows `rows` of the state into their x = X + u (m), vs (m/s) and ms (kg), and, unless
  * `packed` is NULL (one rank: nothing to send), packed 7 values a node for the other ranks;
@@ -892,7 +904,7 @@ void contact_read(int64_t n, const int64_t *restrict rows, const double *restric
       }
       p[6] = ms[i];
     }
-    if (kept)
+    if (kept && counts(kept + 3 * i, v + 3 * r))
       for (int c = 0; c < 3; ++c)
         power += kept[3 * i + c] * v[3 * r + c];
     if (sorted)
@@ -937,13 +949,20 @@ void contact_apply(int64_t n, const int64_t *restrict rows, double *restrict for
   for (int64_t i = 0; i < n; ++i)
   {
     const int64_t r = rows[i];
+    double *f = force + 3 * i;
+    if (counts(f, v + 3 * r) || !(mass[r] > 0.0))
+      for (int c = 0; c < 3; ++c)
+      {
+        a[3 * r + c] += f[c] / mass[r];
+        power += f[c] * v[3 * r + c];
+      }
+    else /* no term of the power (see counts), and f / m is f, +0 or -0 */
+      for (int c = 0; c < 3; ++c)
+        a[3 * r + c] += f[c];
     for (int c = 0; c < 3; ++c)
     {
-      const double f = force[3 * i + c];
-      kept[3 * i + c] = f;
-      a[3 * r + c] += f / mass[r];
-      power += f * v[3 * r + c];
-      force[3 * i + c] = 0.0;
+      kept[3 * i + c] = f[c];
+      f[c] = 0.0;
     }
     if (stiffness[i] > 0.0)
     {
