@@ -166,8 +166,8 @@ class ContactInterface:
         # on the secondary side and normal force sum (N), and the contacts of the latest
         # pass.
         self.energy, self.dissipated = 0.0, 0.0
-        self.impulse = np.zeros(3)
-        self.latest = np.zeros(3)
+        self.impulse = [0.0, 0.0, 0.0]  # (lists: a step's few sums without NumPy's calls)
+        self.latest = [0.0, 0.0, 0.0]
         self.normal_force, self.contacts = 0.0, 0
         # The work of the forces on this rank's nodes over the finished steps (J); the
         # latest pass's force on them (N) and f . v^{n-1/2} (W), and dt^{n-1/2} (s).
@@ -497,7 +497,7 @@ class ContactInterface:
         if power is None:
             v = self._pointer(self.state.v)
             power = self.lib.contact_power(self.n, self._rows, self._surface[5], v)
-        self.impulse += dt_v * self.latest
+        self.impulse = [i + dt_v * f for i, f in zip(self.impulse, self.latest, strict=True)]
         self.work += 0.5 * dt_v * (self._first + power)
         self._pending = False
 
@@ -517,11 +517,12 @@ class ContactInterface:
         self._params.dt = s.dt_previous
         lib = self.lib
         energy, tangential, dissipated, normal, contacts = 0.0, 0.0, 0.0, 0.0, 0
-        latest = np.zeros(3)
+        latest = [0.0, 0.0, 0.0]
         for k, (ps, arguments) in enumerate(zip(self.passes, self._passes, strict=True)):
             lib.contact_forces(len(ps.secondary), *arguments)
-            out = ps.out
-            latest += out[:3] if k == 0 else -out[:3]
+            out = ps.out.tolist()
+            sign = 1.0 if k == 0 else -1.0  # the force on the secondary side of the first
+            latest = [f + sign * g for f, g in zip(latest, out[:3], strict=True)]
             contacts += int(out[6])
             energy += out[7]
             tangential += out[8]
@@ -570,8 +571,9 @@ class ContactInterface:
         """The books summed over the ranks (collective): the latest force on the secondary
         side, the normal force, the contacts, the stored energy, the dissipation and the
         impulse so far (with the latest step's)."""
-        latest = self.state.dt_velocity * self.latest if self._pending else np.zeros(3)
-        impulse = self.impulse + latest
+        dt_v = self.state.dt_velocity
+        latest = [dt_v * f if self._pending else 0.0 for f in self.latest]  # its impulse
+        impulse = [i + j for i, j in zip(self.impulse, latest, strict=True)]
         local = np.array([*self.latest, self.normal_force, self.contacts, self.energy,
                           self.dissipated, *impulse])  # fmt: skip
         total = self.comm.allreduce(local) if self.comm.size > 1 else local
