@@ -155,7 +155,6 @@ class ContactInterface:
         self.ids = np.ascontiguousarray(nodes[self.owners.mine(nodes)], dtype=np.int64)
         self.n = len(self.ids)  # the rank's owned surface nodes: the first local nodes
         self.mine = self.ids - self.owners.start  # their rows of the state
-        self.where = np.arange(self.n, dtype=np.int64)  # their local indices
         self._table = np.zeros((self.n, 7))  # x, v, mass of the local nodes (packed, to send)
         self.x, self.v, self.mass = np.zeros((self.n, 3)), np.zeros((self.n, 3)), np.zeros(self.n)
         self._sorted_at = None  # positions of the owned surface nodes at the latest sort
@@ -179,8 +178,8 @@ class ContactInterface:
         # on the secondary side and normal force sum (N), and the contacts of the latest
         # pass.
         self.energy, self.dissipated = 0.0, 0.0
-        self.impulse = np.zeros(3)
-        self.latest = np.zeros(3)
+        self.impulse = [0.0, 0.0, 0.0]  # (lists: a step's few sums without NumPy's calls)
+        self.latest = [0.0, 0.0, 0.0]
         self.normal_force, self.contacts = 0.0, 0
         # The work of the forces on this rank's nodes over the finished steps (J); the
         # latest pass's force on them (N) and f . v^{n-1/2} (W), and dt^{n-1/2} (s).
@@ -191,7 +190,12 @@ class ContactInterface:
         self._previous_dt = 0.0
         p = self._pointer
         self._state = [p(x) for x in (state.X, state.u, state.v, state.mass, state.a)]
-        self._rows = (p(self.mine, "int64_t[]"), p(self.where, "int64_t[]"))
+        self._rows = p(self.mine, "int64_t[]")
+        # What the sweeps before and after the passes find (kernels/contact.c,
+        # contact_read: the power of the latest forces, W, and how far the nodes moved since
+        # the sort and the near lists, m^2; contact_apply: the power, W, and the step, s).
+        self._read_out, self._apply_out = np.zeros(3), np.zeros(2)
+        self._read_pointers = (p(self._read_out), p(self._apply_out))
         self.shares: list[_Share] = []
         self.use(passes, nodes)
         self._local(np.zeros(0, dtype=np.int64))
@@ -327,11 +331,20 @@ class ContactInterface:
             stiffness, p(ps.out),
         )  # fmt: skip
 
-    def _read(self, s) -> None:
-        """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state."""
+    def _read(self, s, books: bool = False) -> np.ndarray:
+        """x^n, v^{n-1/2} and masses of the owned surface nodes, from the state (one sweep,
+        ``contact_read``), and what that sweep finds: the power of the latest pass's forces
+        at these velocities (W; with ``books``), and the largest squared distance (m^2) a
+        node moved since the latest sort and near lists (if any)."""
         X, u, v, mass, _ = self._state
-        packed = self._packed if self.comm.size > 1 else self.ffi.NULL  # the table is sent
-        self.lib.contact_gather(self.n, self._rows[0], X, u, v, mass, packed, *self._surface[:3])
+        null = self.ffi.NULL
+        packed = self._packed if self.comm.size > 1 else null  # the table is sent
+        sorted_at = null if self._sorted_at is None else self._sorted_pointer
+        near_at = null if self._sorted_at is None else self._near_pointer
+        self.lib.contact_read(self.n, self._rows, X, u, v, mass, packed, *self._surface[:3],
+                              self._surface[5] if books else null, sorted_at, near_at,
+                              self._read_pointers[0])  # fmt: skip
+        return self._read_out
 
     def _read_ghosts(self) -> None:
         """x^n, v^{n-1/2} and masses of the ghosts, from their owners."""
@@ -502,58 +515,63 @@ class ContactInterface:
         self._near_pointer = self._pointer(self._near_at)
         self._near_moved = (skin / 3.0) ** 2  # m^2: 1/3 > 1 / (1 + sqrt 3) of the skin
 
-    def _near_stale(self) -> bool:
+    def _near_stale(self, moved: float) -> bool:
         """Whether some local node moved more than a third of the skin since the near lists
-        (this rank's own test: no exchange)."""
-        moved = self.lib.contact_moved(len(self.x), self._surface[0], self._near_pointer)
+        (this rank's own test: no exchange), the owned surface nodes' largest squared move
+        (m^2) being ``moved`` (``_read``)."""
+        if not moved <= self._near_moved:
+            return True
+        g = len(self.x) - self.n  # the ghosts'
+        if not g:
+            return False
+        p = self._pointer
+        moved = self.lib.contact_moved(g, p(self.x[self.n :]), p(self._near_at[self.n :]))
         return not moved <= self._near_moved
 
-    def _moved(self) -> bool:
+    def _moved(self, moved: float) -> bool:
         """Whether some surface node moved more than half the margin since the latest sort
-        (collective)."""
-        moved = self.lib.contact_moved(self.n, self._surface[0], self._sorted_pointer)
+        (collective), this rank's owned surface nodes' largest squared move (m^2) being
+        ``moved`` (``_read``)."""
         if self.comm.size > 1:
             moved = self.comm.allreduce(moved if moved == moved else math.inf, op=MPI.MAX)
             self.sent += 8
         return not moved <= (0.5 * self.margin) ** 2
 
-    def _pending_books(self, dt_v: float, v: np.ndarray) -> tuple[np.ndarray, float]:
-        """The impulse (N s, on the secondary side) and the work on this rank's nodes (J)
-        of the latest pass over its velocity step dt_v (s), v^{n+1/2} being ``v``."""
+    def _book_pending(self, dt_v: float, power: float | None = None) -> None:
+        """Book the latest pass over its velocity step dt_v (s): its impulse (N s, on the
+        secondary side) and its work on this rank's nodes (J), ``power`` (W) being its
+        forces' power at v^{n+1/2} (default: at the state's velocities now)."""
         if not self._pending:
-            return np.zeros(3), 0.0
-        v = self._pointer(v)
-        second = self.lib.contact_power(self.n, self._rows[0], self._surface[5], v)
-        return dt_v * self.latest, 0.5 * dt_v * (self._first + second)
-
-    def _book_pending(self, dt_v: float, v: np.ndarray) -> None:
-        impulse, work = self._pending_books(dt_v, v)
-        self.impulse += impulse
-        self.work += work
+            return
+        if power is None:
+            v = self._pointer(self.state.v)
+            power = self.lib.contact_power(self.n, self._rows, self._surface[5], v)
+        self.impulse = [i + dt_v * f for i, f in zip(self.impulse, self.latest, strict=True)]
+        self.work += 0.5 * dt_v * (self._first + power)
         self._pending = False
 
     def accelerate(self, s) -> None:
         """Add the contact forces of step n to ``s.a``; note the nodal stable step."""
+        power, moved, moved_near = self._read(s, self._pending).tolist()
         if self._pending:  # the previous step's books, now that dt^n and v^{n+1/2} are known
             previous = self._previous_dt
             dt_v = s.dt_previous if previous == 0.0 else 0.5 * (previous + s.dt_previous)
-            self._book_pending(dt_v, s.v)
-        self._read(s)
-        if self._sorted_at is None or self._moved():
+            self._book_pending(dt_v, power)
+        if self._sorted_at is None or self._moved(moved):
             self._sort()
         else:
             self._read_ghosts()
-            if self._near_stale():
+            if self._near_stale(moved_near):
                 self._list_near()
-        self.force[:] = 0.0
         self._params.dt = s.dt_previous
         lib = self.lib
         energy, tangential, dissipated, normal, contacts = 0.0, 0.0, 0.0, 0.0, 0
-        latest = np.zeros(3)
+        latest = [0.0, 0.0, 0.0]
         for k, (ps, arguments) in enumerate(zip(self.passes, self._passes, strict=True)):
             lib.contact_forces(len(ps.secondary), *arguments)
-            out = ps.out
-            latest += out[:3] if k == 0 else -out[:3]
+            out = ps.out.tolist()
+            sign = 1.0 if k == 0 else -1.0  # the force on the secondary side of the first
+            latest = [f + sign * g for f, g in zip(latest, out[:3], strict=True)]
             contacts += int(out[6])
             energy += out[7]
             tangential += out[8]
@@ -565,13 +583,12 @@ class ContactInterface:
             back = self._ghosts.reverse(np.column_stack([self.force[n:], self.stiffness[n:]]))
             np.add.at(self.force, self._ghosts.rows, back[:, :3])
             np.add.at(self.stiffness, self._ghosts.rows, back[:, 3])
-            self.stiffness[n:] = 0.0
-        x, v, mass, force, stiffness = self._surface[:5]
-        self.dt_limit = lib.contact_step(n, mass, stiffness)
+            self.force[n:], self.stiffness[n:] = 0.0, 0.0
+        _, _, mass, force, stiffness, kept = self._surface
         _, _, state_v, state_mass, a = self._state
-        mine, where = self._rows
-        self._first = lib.contact_apply(n, mine, where, force, state_mass, state_v, a,
-                                        self._surface[5])  # fmt: skip
+        lib.contact_apply(n, self._rows, force, stiffness, mass, state_mass, state_v, a, kept,
+                          self._read_pointers[1])  # fmt: skip
+        self._first, self.dt_limit = self._apply_out.tolist()
         self.energy = energy + tangential
         self.dissipated += dissipated
         self.latest, self.normal_force, self.contacts = latest, normal, contacts
@@ -603,7 +620,9 @@ class ContactInterface:
         """The books summed over the ranks (collective): the latest force on the secondary
         side, the normal force, the contacts, the stored energy, the dissipation and the
         impulse so far (with the latest step's)."""
-        impulse = self.impulse + self._pending_books(self.state.dt_velocity, self.state.v)[0]
+        dt_v = self.state.dt_velocity
+        latest = [dt_v * f if self._pending else 0.0 for f in self.latest]  # its impulse
+        impulse = [i + j for i, j in zip(self.impulse, latest, strict=True)]
         local = np.array([*self.latest, self.normal_force, self.contacts, self.energy,
                           self.dissipated, *impulse])  # fmt: skip
         total = self.comm.allreduce(local) if self.comm.size > 1 else local
@@ -658,7 +677,7 @@ class ContactInterface:
         node (0 and inf off the secondary set: their number does not change when erosion
         changes the passes), the books, and the impulse of the latest step (booked now: its
         velocity step is known after the update)."""
-        self._book_pending(self.state.dt_velocity, self.state.v)
+        self._book_pending(self.state.dt_velocity)
         arrays = {}
         for k, sh in enumerate(self.shares):
             rows = np.searchsorted(self.ids, sh.secondary)

@@ -195,14 +195,15 @@ void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t 
                           const int64_t *used, double *boxes, const double *stiffness0, const double *depth,
                           const double *size, const double *x,
                           const contact_params *prm, double *node_gap, double out[3]);
-double contact_step(int64_t n, const double *mass, double *stiffness);
-void contact_gather(int64_t n, const int64_t *rows, const double *X, const double *u,
-                    const double *v, const double *mass, double *packed, double *x,
-                    double *vs, double *ms);
+void contact_read(int64_t n, const int64_t *rows, const double *X, const double *u,
+                  const double *v, const double *mass, double *packed, double *x, double *vs,
+                  double *ms, const double *kept, const double *sorted, const double *listed,
+                  double out[3]);
 void contact_unpack(int64_t n, const int64_t *order, const double *packed, double *x,
                     double *v, double *mass);
-double contact_apply(int64_t n, const int64_t *rows, const int64_t *where, const double *force,
-                     const double *mass, const double *v, double *a, double *kept);
+void contact_apply(int64_t n, const int64_t *rows, double *force, double *stiffness,
+                   const double *ms, const double *mass, const double *v, double *a,
+                   double *kept, double out[2]);
 double contact_power(int64_t n, const int64_t *rows, const double *kept, const double *v);
 """
     + "".join(

@@ -26,7 +26,10 @@
  *   added to `force` (N) and the contact stiffness of each node to `stiffness` (N/m): the
  *   tangent of the springs in contact, k0 for those within reach of a segment but not in
  *   contact (so that the step does not jump as nodes come and go).
- * contact_step: the interface's nodal stable step min sqrt(2 m / k) (s), zeroing k.
+ * contact_read, contact_apply: the sweeps of the rank's owned surface nodes before the
+ *   passes (the state's values in; the books of the previous step's forces; how far the
+ *   nodes moved since the sort and the near lists) and after them (the forces out to the
+ *   accelerations; the nodal stable step min sqrt(2 m / k) (s); force and k zeroed).
  * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
  * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
  * With `share` and `planes`, a model cut by symmetry planes acts as the whole model would
@@ -75,15 +78,19 @@ INLINE void ccross(const double a[3], const double b[3], double r[3])
   r[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+/* The larger of `largest` and the squared distance (m^2) from x0 to x; NaN once some is. */
+INLINE double farther(double largest, const double x[3], const double x0[3])
+{
+  const double dx = x[0] - x0[0], dy = x[1] - x0[1], dz = x[2] - x0[2];
+  const double d = dx * dx + dy * dy + dz * dz;
+  return d > largest || isnan(d) ? d : largest;
+}
+
 double contact_moved(int64_t n, const double *restrict x, const double *restrict x0)
 {
   double largest = 0.0;
   for (int64_t i = 0; i < 3 * n; i += 3)
-  {
-    const double dx = x[i] - x0[i], dy = x[i + 1] - x0[i + 1], dz = x[i + 2] - x0[i + 2];
-    const double d = dx * dx + dy * dy + dz * dz;
-    largest = d > largest || isnan(d) ? d : largest;
-  }
+    largest = farther(largest, x + i, x0 + i);
   return largest;
 }
 
@@ -791,7 +798,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     const int64_t s = secondary[i];
     const double *xs = x + 3 * s;
     double *ft = tangential + 3 * i;
-    if (!closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
+    /* (a node without candidates, most of them, has no closest point: not looked for) */
+    if (offsets[i] == offsets[i + 1] ||
+        !closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
                             depth, size, x, boxes, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
@@ -884,50 +893,62 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
   free(near);
 }
 
-double contact_step(int64_t n, const double *restrict mass, double *restrict stiffness)
+/* Whether the force f (N) on a node of velocity v (m/s) counts in a sum of f . v: not when
+ * f is 0 (+0 or -0) and v finite, whose terms (+0 or -0) change no sum that starts at +0
+ * (such a sum is never -0: x + (-x) is +0), so that the sums skip most surface nodes, out
+ * of contact, yet come out the same to the bit. */
+INLINE int counts(const double f[3], const double v[3])
 {
-  double smallest = INFINITY;
-  for (int64_t i = 0; i < n; ++i)
-  {
-    if (stiffness[i] > 0.0)
-    {
-      const double dt = sqrt(2.0 * mass[i] / stiffness[i]);
-      smallest = dt < smallest ? dt : smallest;
-    }
-    stiffness[i] = 0.0;
-  }
-  return smallest;
+  return f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0 ||
+         !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]));
 }
 
-/* The rows `rows` of the state into the first n surface nodes' x = X + u (m), vs (m/s) and
- * ms (kg), and, unless `packed` is NULL (one rank: nothing to send), packed 7 values a node
- * for the other ranks (one sweep). */
-void contact_gather(int64_t n, const int64_t *restrict rows, const double *restrict X,
-                    const double *restrict u, const double *restrict v,
-                    const double *restrict mass, double *restrict packed, double *restrict x,
-                    double *restrict vs, double *restrict ms)
+/* One sweep of the rank's n owned surface nodes (the first local ones) before the passes:
+ * the rows `rows` of the state into their x = X + u (m), vs (m/s) and ms (kg), and, unless
+ * `packed` is NULL (one rank: nothing to send), packed 7 values a node for the other ranks;
+ * unless NULL, out[0] = sum kept . v (W) of the forces `kept` (n rows, N) at the velocities
+ * read (contact_power's sum, in its order), out[1] the largest squared distance (m^2) a
+ * node moved since `sorted` (its positions at the latest sort), out[2] since `listed` (at
+ * the latest near lists; the first n rows), each as contact_moved finds it (NaN once some
+ * is NaN). */
+void contact_read(int64_t n, const int64_t *restrict rows, const double *restrict X,
+                  const double *restrict u, const double *restrict v,
+                  const double *restrict mass, double *restrict packed, double *restrict x,
+                  double *restrict vs, double *restrict ms, const double *restrict kept,
+                  const double *restrict sorted, const double *restrict listed, double out[3])
 {
+  double power = 0.0, moved = 0.0, moved_listed = 0.0;
   for (int64_t i = 0; i < n; ++i)
   {
     const int64_t r = rows[i];
+    double *xi = x + 3 * i;
     for (int c = 0; c < 3; ++c)
     {
-      x[3 * i + c] = X[3 * r + c] + u[3 * r + c];
+      xi[c] = X[3 * r + c] + u[3 * r + c];
       vs[3 * i + c] = v[3 * r + c];
     }
     ms[i] = mass[r];
-  }
-  if (packed)
-    for (int64_t i = 0; i < n; ++i)
+    if (packed)
     {
       double *p = packed + 7 * i;
       for (int c = 0; c < 3; ++c)
       {
-        p[c] = x[3 * i + c];
+        p[c] = xi[c];
         p[3 + c] = vs[3 * i + c];
       }
       p[6] = ms[i];
     }
+    if (kept && counts(kept + 3 * i, v + 3 * r))
+      for (int c = 0; c < 3; ++c)
+        power += kept[3 * i + c] * v[3 * r + c];
+    if (sorted)
+      moved = farther(moved, xi, sorted + 3 * i);
+    if (listed)
+      moved_listed = farther(moved_listed, xi, listed + 3 * i);
+  }
+  out[0] = power;
+  out[1] = moved;
+  out[2] = moved_listed;
 }
 
 /* Packed rows to the surface nodes `order` (their positions, velocities and masses). */
@@ -947,25 +968,45 @@ void contact_unpack(int64_t n, const int64_t *restrict order, const double *rest
   }
 }
 
-/* Add the surface forces (rows `where`) to the accelerations of the state's rows `rows`,
- * keep them in `kept` (n rows) and return sum f . v (W) over them. */
-double contact_apply(int64_t n, const int64_t *restrict rows, const int64_t *restrict where,
-                     const double *restrict force, const double *restrict mass,
-                     const double *restrict v, double *restrict a, double *restrict kept)
+/* One sweep of the rank's n owned surface nodes (the first local ones) after the passes:
+ * add their forces `force` (N) to the accelerations of the state's rows `rows` (masses
+ * `mass`), keep them in `kept`, and zero `force` and the contact stiffness `stiffness` (N/m)
+ * for the next step.  out[0] = sum f . v (W) at the state's velocities v, out[1] the
+ * interface's nodal stable step min sqrt(2 ms / k) over the nodes with k > 0 (s; inf: none),
+ * ms being the surface nodes' masses (kg). */
+void contact_apply(int64_t n, const int64_t *restrict rows, double *restrict force,
+                   double *restrict stiffness, const double *restrict ms,
+                   const double *restrict mass, const double *restrict v, double *restrict a,
+                   double *restrict kept, double out[2])
 {
-  double power = 0.0;
+  double power = 0.0, smallest = INFINITY;
   for (int64_t i = 0; i < n; ++i)
   {
-    const int64_t r = rows[i], k = where[i];
+    const int64_t r = rows[i];
+    double *f = force + 3 * i;
+    if (counts(f, v + 3 * r) || !(mass[r] > 0.0))
+      for (int c = 0; c < 3; ++c)
+      {
+        a[3 * r + c] += f[c] / mass[r];
+        power += f[c] * v[3 * r + c];
+      }
+    else /* no term of the power (see counts), and f / m is f, +0 or -0 */
+      for (int c = 0; c < 3; ++c)
+        a[3 * r + c] += f[c];
     for (int c = 0; c < 3; ++c)
     {
-      const double f = force[3 * k + c];
-      kept[3 * i + c] = f;
-      a[3 * r + c] += f / mass[r];
-      power += f * v[3 * r + c];
+      kept[3 * i + c] = f[c];
+      f[c] = 0.0;
     }
+    if (stiffness[i] > 0.0)
+    {
+      const double dt = sqrt(2.0 * ms[i] / stiffness[i]);
+      smallest = dt < smallest ? dt : smallest;
+    }
+    stiffness[i] = 0.0;
   }
-  return power;
+  out[0] = power;
+  out[1] = smallest;
 }
 
 /* sum f . v (W) of the kept forces (n rows) at the state's rows `rows`. */

@@ -93,12 +93,11 @@ def test_the_near_lists_give_the_forces_of_all_candidates(shape):
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)
     for fraction in (0.0, 0.5, 1.0):
         state.u[:] = fraction * step * direction  # in place: the interface reads it
-        interface._read(state)
-        assert not interface._near_stale()
+        moved = interface._read(state)[2]  # since the lists
+        assert not interface._near_stale(moved)
         near = pass_forces(interface, ps, ps.near_offsets, ps.near)
         every = pass_forces(interface, ps, ps.offsets, ps.candidates)
         assert np.array_equal(near, every)
     assert near[-5] > 0  # some nodes in contact at the end (out[6])
     state.u[:] = 1.01 * SKIN * MARGIN / 3.0 * direction
-    interface._read(state)
-    assert interface._near_stale()
+    assert interface._near_stale(interface._read(state)[2])
