@@ -74,7 +74,11 @@ CONVERGED = 0.01  # the finest solid within this of the extrapolation: converged
 SAFETY = 1.25  # Roache's safety factor of the grid convergence index (three levels)
 SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
 QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
-SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
+# load -> the solids' [element]: one point, the Flanagan-Belytschko stiffness hourglass
+# control (the rows of docs/study_shells_solids.csv name their element: a kept row of
+# another element is run again)
+SOLID_ELEMENT = {"elastic": {"integration": "reduced", "hourglass": "stiffness"},
+                 "plastic": {"integration": "reduced", "hourglass": "stiffness"}}
 MASS = 1.0  # kg, the whole sphere's
 PEAK_WINDOW = 50e-6  # s, the peak force is the largest mean over this long
 SHARE = {"solid": 4, "shell": 1, "thinning_shell": 1}  # the whole plate over the part run
@@ -135,7 +139,7 @@ def plate_scene(load: str, kind: str, h: float, layers: int = 0,
             {"group": "rim_x", "components": "xyz"},
             {"group": "rim_y", "components": "xyz"},
         ]
-        element, skin = dict(SOLID_ELEMENT), THICKNESS / 2
+        element, skin = dict(SOLID_ELEMENT[load]), THICKNESS / 2
     material = dict(material)
     if kind == "solid":
         material["model"] = SOLID_MODEL.get(material["model"], material["model"])
@@ -163,10 +167,16 @@ def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -
     sim.run()
     cpu = comm.allreduce(time.process_time() - cpu)
     s = sim.history.summary
-    row = {"load": load, "kind": kind, "status": s["status"], "element_size": h, "layers": layers,
+    row = {"load": load, "kind": kind, "element": element_label(raw["element"]),
+           "status": s["status"], "element_size": h, "layers": layers,
            "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
            "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu}  # fmt: skip
     return row | measure(s, sim.history.wall(0), SHARE[kind])
+
+
+def element_label(element: dict) -> str:
+    """An ``[element]`` table as the rows name it: "hourglass=physical integration=reduced"."""
+    return " ".join(f"{k}={v}" for k, v in sorted(element.items()))
 
 
 def measure(summary: dict, rows, share: int = 1) -> dict:
@@ -204,7 +214,7 @@ FIGURES = {"peak_force": ("peak force", 1e-3, "kN"), "contact_time": ("contact t
            "deflection": ("largest deflection", 1e3, "mm")}  # fmt: skip
 # the committed reference: the solid levels' rows (the finest take an hour each on 1 rank)
 REFERENCE = Path(__file__).resolve().parents[2] / "docs" / "study_shells_solids.csv"
-_TEXT = ("load", "kind", "status")
+_TEXT = ("load", "kind", "element", "status")
 _WHOLE = ("layers", "cells", "steps")
 
 
@@ -258,7 +268,8 @@ def report(rows: list[dict], seconds: float, cached: str = "") -> str:
         ref = reference(rows, load)
         material, speed, end = LOADS[load]
         lines += [f"**{load}** ({material['model']} shells, "
-                  f"{SOLID_MODEL.get(material['model'], material['model'])} solids, "
+                  f"{SOLID_MODEL.get(material['model'], material['model'])} solids "
+                  f"({element_label(SOLID_ELEMENT[load])}), "
                   f"{speed:g} m/s, {end * 1e3:g} ms).", ""]  # fmt: skip
         lines += ["| model | h (mm) | layers | cells | steps | loop wall (s) | loop CPU (s) | "
                   + " | ".join(f"{label} ({unit})" for label, _, unit in FIGURES.values())
@@ -369,9 +380,10 @@ def _cached_solids(loads, comm, out: Path, echo) -> tuple[list[dict], str]:
     kept = comm.bcast(kept if comm.rank == 0 else None, root=0)
     rows, notes = [], []
     for load in loads:
+        solid = element_label(SOLID_ELEMENT[load])  # kept rows of another element: run again
         for h, n in SOLID_LEVELS:
             found = [r for r in kept if r["load"] == load and r["element_size"] == h
-                     and r["layers"] == n]  # fmt: skip
+                     and r["layers"] == n and r["element"] == solid]  # fmt: skip
             rows += found[:1] or _run([(load, "solid", h, n)], out, comm, echo)
         h, n = SOLID_LEVELS[0]
         again = _run([(load, "solid", h, n)], out, comm, echo)[0]
