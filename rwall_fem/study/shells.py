@@ -66,10 +66,9 @@ LOADS = {
                  "yield_stress": 300.0e6, "hardening_modulus": 300.0e6}, 20.0, 2.0e-3),
 }  # fmt: skip
 SOLID_MODEL = {"linear_elastic": "saint_venant_kirchhoff"}
-# (in-plane size m, layers through the thickness): halved together (RATIO), so the aspect of
-# the hexahedra stays 5 and three levels give Richardson's extrapolation.
+# (in-plane size m, layers through the thickness): halved together, so the aspect of the
+# hexahedra stays 5 and three levels give Richardson's extrapolation.
 SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.25e-3, 8))
-RATIO = 2.0
 CONVERGED = 0.01  # the finest solid within this of the extrapolation: converged
 SAFETY = 1.25  # Roache's safety factor of the grid convergence index (three levels)
 SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
@@ -218,23 +217,48 @@ _TEXT = ("load", "kind", "element", "status")
 _WHOLE = ("layers", "cells", "steps")
 
 
-def richardson(values, ratio: float = RATIO) -> dict:
-    """Richardson's extrapolation of a figure from three levels, coarse to fine, each
-    ``ratio`` times finer than the one before: the observed order p = ln(d21 / d32) /
-    ln(ratio) (d21 = f2 - f1, d32 = f3 - f2), the extrapolated value f3 + d32 / (ratio^p - 1),
-    its estimated error the grid convergence index of the finest level, SAFETY |d32| /
-    (ratio^p - 1), relative to it (Roache 1994), and the finest level's distance from it.
-    Not converging monotonically at an order of 0.5 at least (the differences change sign,
-    or do not shrink): no extrapolation, the finest level stands, with twice its last
+def _order(d21: float, d32: float, r21: float, r32: float) -> float:
+    """The order p of f(h) = f0 + C h^p whose changes over the size ratios r21 = h1 / h2 and
+    r32 = h2 / h3 are d21 and d32: d21 / d32 = r32^p (r21^p - 1) / (r32^p - 1), which is
+    r^p for equal ratios; nan when the changes differ in sign or p lies outside [-20, 20]."""
+    if d21 * d32 <= 0:
+        return math.nan
+    if r21 == r32:
+        return math.log(d21 / d32) / math.log(r21)
+
+    def excess(p: float) -> float:  # increasing in p; at p = 0 its limit ln r21 / ln r32
+        shrink = (r32**p * (r21**p - 1) / (r32**p - 1) if p != 0.0
+                  else math.log(r21) / math.log(r32))  # fmt: skip
+        return shrink - d21 / d32
+
+    lo, hi = -20.0, 20.0
+    if excess(lo) > 0 or excess(hi) < 0:
+        return math.nan
+    for _ in range(200):  # bisection to round-off
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def richardson(values, sizes=(4.0, 2.0, 1.0)) -> dict:
+    """Richardson's extrapolation of a figure from three levels of cell sizes ``sizes``,
+    coarse to fine (only their ratios matter; the study's levels halve it): the observed
+    order p of f = f0 + C h^p (:func:`_order`; ln(d21 / d32) / ln(r) for a constant ratio r,
+    d21 = f2 - f1, d32 = f3 - f2), the extrapolated value f3 + d32 / (r32^p - 1) (r32 =
+    h2 / h3), its estimated error the grid convergence index of the finest level, SAFETY
+    |d32| / (r32^p - 1), relative to it (Roache 1994), and the finest level's distance from
+    it. Not converging monotonically at an order of 0.5 at least (the differences change
+    sign, or do not shrink): no extrapolation, the finest level stands, with twice its last
     change as its error and the order nan."""
     f1, f2, f3 = (float(v) for v in values)
-    d21, d32 = f2 - f1, f3 - f2
-    order = math.log(d21 / d32) / math.log(ratio) if d21 * d32 > 0 else math.nan
+    h1, h2, h3 = (float(h) for h in sizes)
+    d21, d32, r32 = f2 - f1, f3 - f2, h2 / h3
+    order = _order(d21, d32, h1 / h2, r32)
     if not order >= 0.5:  # nan too
         return {"order": order, "value": f3, "error": 2 * abs(d32 / f3), "finest_error": 0.0,
                 "extrapolated": False}  # fmt: skip
-    value = f3 + d32 / (ratio**order - 1)
-    return {"order": order, "value": value, "error": SAFETY * abs(d32 / value) / (ratio**order - 1),
+    value = f3 + d32 / (r32**order - 1)
+    return {"order": order, "value": value, "error": SAFETY * abs(d32 / value) / (r32**order - 1),
             "finest_error": abs(f3 / value - 1), "extrapolated": True}  # fmt: skip
 
 
@@ -244,7 +268,8 @@ def reference(rows: list[dict], load: str) -> dict:
     (``extrapolated`` False, error nan) with fewer levels."""
     solids = [r for r in rows if r["load"] == load and r["kind"] == "solid"]
     if len(solids) >= 3:
-        return {k: richardson([r[k] for r in solids[-3:]]) for k in FIGURES}
+        sizes = [r["element_size"] for r in solids[-3:]]
+        return {k: richardson([r[k] for r in solids[-3:]], sizes) for k in FIGURES}
     return {k: {"order": math.nan, "value": solids[-1][k], "error": math.nan,
                 "finest_error": math.nan, "extrapolated": False} for k in FIGURES}  # fmt: skip
 
