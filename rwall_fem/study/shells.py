@@ -12,9 +12,8 @@ on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahe
 refined in the plane and through the thickness together (the cells' aspect stays 5):
 elastic, with the Flanagan-Belytschko stiffness hourglass control (coefficient 0.1), 5 mm x
 2 layers, 2.5 mm x 4 and 1.25 mm x 8; elasto-plastic, with the physical (assumed-strain)
-hourglass control (coefficient 0.1), 5 mm x 2, 2.5 mm x 4 and 1.667 mm x 6 (its levels
-converge faster than the stiffness form's; the third 1.5 times finer than the second, the
-finest affordable). The sphere's main node of
+hourglass control (coefficient 0.1), 5 mm x 2, 2.5 mm x 4, 1.667 mm x 6 and 1.25 mm x 8
+(its levels converge faster than the stiffness form's). The sphere's main node of
 the quarter lies on both planes: its x and y velocity are held (``motion.held = "xy"``).
 Free, it drifted sideways as soon as the plastic plate wrapped round it (nodes off the axis
 touching it all push it away from the quarter); held, a quarter of the shells gives the
@@ -22,7 +21,7 @@ whole plate's answers to 1e-12 (``tests/shells/test_shell_symmetry.py``), and th
 solid quarter the whole solid plate's to 3e-5 (the whole plate, meshed by the built-in
 ``plate`` shape, takes a step 1e-3 longer).
 
-The reference of each figure is Richardson's extrapolation of the three solid levels
+The reference of each figure is Richardson's extrapolation of the three finest solid levels
 (`richardson` in `rwall_fem/study/shells.py`): the observed order, the extrapolated
 value and its estimated error (Roache's grid convergence index, safety factor 1.25); the
 reference is converged when
@@ -70,11 +69,10 @@ LOADS = {
 }  # fmt: skip
 SOLID_MODEL = {"linear_elastic": "saint_venant_kirchhoff"}
 # load -> its levels (in-plane size m, layers through the thickness), refined together so
-# that the aspect of the hexahedra stays 5; three levels give Richardson's extrapolation.
-# The elasto-plastic third level is 1.667 mm x 6, not 1.25 x 8 (1.5 times finer than the
-# second, not 2): the finest it could afford (docs/study_notes.md).
+# that the aspect of the hexahedra stays 5; the three finest give Richardson's
+# extrapolation (the elasto-plastic 2.5 mm x 4, 1.667 x 6 and 1.25 x 8: docs/study_notes.md).
 SOLID_LEVELS = {"elastic": ((5.0e-3, 2), (2.5e-3, 4), (1.25e-3, 8)),
-                "plastic": ((5.0e-3, 2), (2.5e-3, 4), (5.0e-3 / 3, 6))}
+                "plastic": ((5.0e-3, 2), (2.5e-3, 4), (5.0e-3 / 3, 6), (1.25e-3, 8))}
 CONVERGED = 0.01  # the finest solid within this of the extrapolation: converged
 SAFETY = 1.25  # Roache's safety factor of the grid convergence index (three levels)
 SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
@@ -272,8 +270,8 @@ def richardson(values, sizes=(4.0, 2.0, 1.0)) -> dict:
 
 def reference(rows: list[dict], load: str) -> dict:
     """The solid reference of ``load``: per figure of :data:`FIGURES` Richardson's
-    extrapolation of the three solid levels (:func:`richardson`), or the finest solid alone
-    (``extrapolated`` False, error nan) with fewer levels."""
+    extrapolation of the three finest solid levels (:func:`richardson`), or the finest solid
+    alone (``extrapolated`` False, error nan) with fewer levels."""
     solids = [r for r in rows if r["load"] == load and r["kind"] == "solid"]
     if len(solids) >= 3:
         sizes = [r["element_size"] for r in solids[-3:]]
