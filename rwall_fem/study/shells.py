@@ -8,10 +8,12 @@ the skin it strikes: the solids' top face, the shells' mid-surface (walls act on
 shells' nodes, with no thickness offset). The shells are the whole plate in 5-point
 Belytschko-Lin-Tsay quadrilaterals with the Belytschko-Wong-Chiang warping correction; the
 solids a quarter of it (the planes x = 0 and y = 0 are planes of symmetry, held by u_x = 0
-on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahedra with
-the Flanagan-Belytschko stiffness hourglass control (coefficient 0.1), refined in the plane
-and through the thickness together, 5 mm x 2 layers, 2.5 mm x 4 and 1.25 mm x 8 (the
-cells' aspect stays 5). The sphere's main node of
+on x = 0 and u_y = 0 on y = 0; the sphere's mass is a quarter), one-point hexahedra,
+refined in the plane and through the thickness together (the cells' aspect stays 5):
+elastic, with the Flanagan-Belytschko stiffness hourglass control (coefficient 0.1), 5 mm x
+2 layers, 2.5 mm x 4 and 1.25 mm x 8; elasto-plastic, with the physical (assumed-strain)
+hourglass control (coefficient 0.1), 5 mm x 2, 2.5 mm x 4, 1.667 mm x 6 and 1.25 mm x 8
+(its levels converge faster than the stiffness form's). The sphere's main node of
 the quarter lies on both planes: its x and y velocity are held (``motion.held = "xy"``).
 Free, it drifted sideways as soon as the plastic plate wrapped round it (nodes off the axis
 touching it all push it away from the quarter); held, a quarter of the shells gives the
@@ -19,7 +21,7 @@ whole plate's answers to 1e-12 (``tests/shells/test_shell_symmetry.py``), and th
 solid quarter the whole solid plate's to 3e-5 (the whole plate, meshed by the built-in
 ``plate`` shape, takes a step 1e-3 longer).
 
-The reference of each figure is Richardson's extrapolation of the three solid levels
+The reference of each figure is Richardson's extrapolation of the three finest solid levels
 (`richardson` in `rwall_fem/study/shells.py`): the observed order, the extrapolated
 value and its estimated error (Roache's grid convergence index, safety factor 1.25); the
 reference is converged when
@@ -66,15 +68,22 @@ LOADS = {
                  "yield_stress": 300.0e6, "hardening_modulus": 300.0e6}, 20.0, 2.0e-3),
 }  # fmt: skip
 SOLID_MODEL = {"linear_elastic": "saint_venant_kirchhoff"}
-# (in-plane size m, layers through the thickness): halved together (RATIO), so the aspect of
-# the hexahedra stays 5 and three levels give Richardson's extrapolation.
-SOLID_LEVELS = ((5.0e-3, 2), (2.5e-3, 4), (1.25e-3, 8))
-RATIO = 2.0
+# load -> its levels (in-plane size m, layers through the thickness), refined together so
+# that the aspect of the hexahedra stays 5; the three finest give Richardson's
+# extrapolation (the elasto-plastic 2.5 mm x 4, 1.667 x 6 and 1.25 x 8: docs/study_notes.md).
+SOLID_LEVELS = {"elastic": ((5.0e-3, 2), (2.5e-3, 4), (1.25e-3, 8)),
+                "plastic": ((5.0e-3, 2), (2.5e-3, 4), (5.0e-3 / 3, 6), (1.25e-3, 8))}
 CONVERGED = 0.01  # the finest solid within this of the extrapolation: converged
 SAFETY = 1.25  # Roache's safety factor of the grid convergence index (three levels)
 SHELL_LEVELS = (5.0e-3, 2.5e-3, 1.25e-3)  # m, quadrilaterals
 QUICK_SOLID, QUICK_SHELL = ((5.0e-3, 2),), (5.0e-3,)
-SOLID_ELEMENT = {"integration": "reduced", "hourglass": "stiffness"}
+# load -> the solids' [element] (the rows of docs/study_shells_solids.csv name theirs: a
+# kept row of another element is run again): one point, the Flanagan-Belytschko stiffness
+# hourglass control for the elastic load (its levels converge to 0.13 %), the physical
+# (assumed-strain) one for the elasto-plastic load, whose levels converge faster than the
+# stiffness form's (docs/study_notes.md)
+SOLID_ELEMENT = {"elastic": {"integration": "reduced", "hourglass": "stiffness"},
+                 "plastic": {"integration": "reduced", "hourglass": "physical"}}
 MASS = 1.0  # kg, the whole sphere's
 PEAK_WINDOW = 50e-6  # s, the peak force is the largest mean over this long
 SHARE = {"solid": 4, "shell": 1, "thinning_shell": 1}  # the whole plate over the part run
@@ -135,7 +144,7 @@ def plate_scene(load: str, kind: str, h: float, layers: int = 0,
             {"group": "rim_x", "components": "xyz"},
             {"group": "rim_y", "components": "xyz"},
         ]
-        element, skin = dict(SOLID_ELEMENT), THICKNESS / 2
+        element, skin = dict(SOLID_ELEMENT[load]), THICKNESS / 2
     material = dict(material)
     if kind == "solid":
         material["model"] = SOLID_MODEL.get(material["model"], material["model"])
@@ -163,10 +172,16 @@ def run_plate(load: str, kind: str, h: float, layers: int, comm, folder: Path) -
     sim.run()
     cpu = comm.allreduce(time.process_time() - cpu)
     s = sim.history.summary
-    row = {"load": load, "kind": kind, "status": s["status"], "element_size": h, "layers": layers,
+    row = {"load": load, "kind": kind, "element": element_label(raw["element"]),
+           "status": s["status"], "element_size": h, "layers": layers,
            "cells": s["cells"], "steps": s["steps"], "dt": s["dt"],
            "wall_seconds": s["wall_seconds"], "cpu_seconds": cpu}  # fmt: skip
     return row | measure(s, sim.history.wall(0), SHARE[kind])
+
+
+def element_label(element: dict) -> str:
+    """An ``[element]`` table as the rows name it: "hourglass=physical integration=reduced"."""
+    return " ".join(f"{k}={v}" for k, v in sorted(element.items()))
 
 
 def measure(summary: dict, rows, share: int = 1) -> dict:
@@ -204,37 +219,63 @@ FIGURES = {"peak_force": ("peak force", 1e-3, "kN"), "contact_time": ("contact t
            "deflection": ("largest deflection", 1e3, "mm")}  # fmt: skip
 # the committed reference: the solid levels' rows (the finest take an hour each on 1 rank)
 REFERENCE = Path(__file__).resolve().parents[2] / "docs" / "study_shells_solids.csv"
-_TEXT = ("load", "kind", "status")
+_TEXT = ("load", "kind", "element", "status")
 _WHOLE = ("layers", "cells", "steps")
 
 
-def richardson(values, ratio: float = RATIO) -> dict:
-    """Richardson's extrapolation of a figure from three levels, coarse to fine, each
-    ``ratio`` times finer than the one before: the observed order p = ln(d21 / d32) /
-    ln(ratio) (d21 = f2 - f1, d32 = f3 - f2), the extrapolated value f3 + d32 / (ratio^p - 1),
-    its estimated error the grid convergence index of the finest level, SAFETY |d32| /
-    (ratio^p - 1), relative to it (Roache 1994), and the finest level's distance from it.
-    Not converging monotonically at an order of 0.5 at least (the differences change sign,
-    or do not shrink): no extrapolation, the finest level stands, with twice its last
+def _order(d21: float, d32: float, r21: float, r32: float) -> float:
+    """The order p of f(h) = f0 + C h^p whose changes over the size ratios r21 = h1 / h2 and
+    r32 = h2 / h3 are d21 and d32: d21 / d32 = r32^p (r21^p - 1) / (r32^p - 1), which is
+    r^p for equal ratios; nan when the changes differ in sign or p lies outside [-20, 20]."""
+    if d21 * d32 <= 0:
+        return math.nan
+    if r21 == r32:
+        return math.log(d21 / d32) / math.log(r21)
+
+    def excess(p: float) -> float:  # increasing in p; at p = 0 its limit ln r21 / ln r32
+        shrink = (r32**p * (r21**p - 1) / (r32**p - 1) if p != 0.0
+                  else math.log(r21) / math.log(r32))  # fmt: skip
+        return shrink - d21 / d32
+
+    lo, hi = -20.0, 20.0
+    if excess(lo) > 0 or excess(hi) < 0:
+        return math.nan
+    for _ in range(200):  # bisection to round-off
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) < 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def richardson(values, sizes=(4.0, 2.0, 1.0)) -> dict:
+    """Richardson's extrapolation of a figure from three levels of cell sizes ``sizes``,
+    coarse to fine (only their ratios matter; the study's levels halve it): the observed
+    order p of f = f0 + C h^p (:func:`_order`; ln(d21 / d32) / ln(r) for a constant ratio r,
+    d21 = f2 - f1, d32 = f3 - f2), the extrapolated value f3 + d32 / (r32^p - 1) (r32 =
+    h2 / h3), its estimated error the grid convergence index of the finest level, SAFETY
+    |d32| / (r32^p - 1), relative to it (Roache 1994), and the finest level's distance from
+    it. Not converging monotonically at an order of 0.5 at least (the differences change
+    sign, or do not shrink): no extrapolation, the finest level stands, with twice its last
     change as its error and the order nan."""
     f1, f2, f3 = (float(v) for v in values)
-    d21, d32 = f2 - f1, f3 - f2
-    order = math.log(d21 / d32) / math.log(ratio) if d21 * d32 > 0 else math.nan
+    h1, h2, h3 = (float(h) for h in sizes)
+    d21, d32, r32 = f2 - f1, f3 - f2, h2 / h3
+    order = _order(d21, d32, h1 / h2, r32)
     if not order >= 0.5:  # nan too
         return {"order": order, "value": f3, "error": 2 * abs(d32 / f3), "finest_error": 0.0,
                 "extrapolated": False}  # fmt: skip
-    value = f3 + d32 / (ratio**order - 1)
-    return {"order": order, "value": value, "error": SAFETY * abs(d32 / value) / (ratio**order - 1),
+    value = f3 + d32 / (r32**order - 1)
+    return {"order": order, "value": value, "error": SAFETY * abs(d32 / value) / (r32**order - 1),
             "finest_error": abs(f3 / value - 1), "extrapolated": True}  # fmt: skip
 
 
 def reference(rows: list[dict], load: str) -> dict:
     """The solid reference of ``load``: per figure of :data:`FIGURES` Richardson's
-    extrapolation of the three solid levels (:func:`richardson`), or the finest solid alone
-    (``extrapolated`` False, error nan) with fewer levels."""
+    extrapolation of the three finest solid levels (:func:`richardson`), or the finest solid
+    alone (``extrapolated`` False, error nan) with fewer levels."""
     solids = [r for r in rows if r["load"] == load and r["kind"] == "solid"]
     if len(solids) >= 3:
-        return {k: richardson([r[k] for r in solids[-3:]]) for k in FIGURES}
+        sizes = [r["element_size"] for r in solids[-3:]]
+        return {k: richardson([r[k] for r in solids[-3:]], sizes) for k in FIGURES}
     return {k: {"order": math.nan, "value": solids[-1][k], "error": math.nan,
                 "finest_error": math.nan, "extrapolated": False} for k in FIGURES}  # fmt: skip
 
@@ -258,7 +299,8 @@ def report(rows: list[dict], seconds: float, cached: str = "") -> str:
         ref = reference(rows, load)
         material, speed, end = LOADS[load]
         lines += [f"**{load}** ({material['model']} shells, "
-                  f"{SOLID_MODEL.get(material['model'], material['model'])} solids, "
+                  f"{SOLID_MODEL.get(material['model'], material['model'])} solids "
+                  f"({element_label(SOLID_ELEMENT[load])}), "
                   f"{speed:g} m/s, {end * 1e3:g} ms).", ""]  # fmt: skip
         lines += ["| model | h (mm) | layers | cells | steps | loop wall (s) | loop CPU (s) | "
                   + " | ".join(f"{label} ({unit})" for label, _, unit in FIGURES.values())
@@ -340,8 +382,9 @@ def _run(plan, out: Path, comm, echo) -> list[dict]:
     return rows
 
 
-def _solid_plan(loads, levels) -> list[tuple]:
-    return [(load, "solid", h, n) for load in loads for h, n in levels]
+def _solid_plan(loads, quick: bool = False) -> list[tuple]:
+    return [(load, "solid", h, n) for load in loads
+            for h, n in (QUICK_SOLID if quick else SOLID_LEVELS[load])]  # fmt: skip
 
 
 def run_solid_reference(out="results/study-shells", *, comm=None, loads=tuple(LOADS),
@@ -353,7 +396,7 @@ def run_solid_reference(out="results/study-shells", *, comm=None, loads=tuple(LO
 
     comm = comm or MPI.COMM_WORLD
     out = Path(out)
-    rows = _run(_solid_plan(loads, SOLID_LEVELS), out, comm, echo)
+    rows = _run(_solid_plan(loads), out, comm, echo)
     if comm.rank == 0:
         write_rows(out / "solids.csv", rows)
         if keep:  # the other loads' rows stay
@@ -369,11 +412,12 @@ def _cached_solids(loads, comm, out: Path, echo) -> tuple[list[dict], str]:
     kept = comm.bcast(kept if comm.rank == 0 else None, root=0)
     rows, notes = [], []
     for load in loads:
-        for h, n in SOLID_LEVELS:
+        solid = element_label(SOLID_ELEMENT[load])  # kept rows of another element: run again
+        for h, n in SOLID_LEVELS[load]:
             found = [r for r in kept if r["load"] == load and r["element_size"] == h
-                     and r["layers"] == n]  # fmt: skip
+                     and r["layers"] == n and r["element"] == solid]  # fmt: skip
             rows += found[:1] or _run([(load, "solid", h, n)], out, comm, echo)
-        h, n = SOLID_LEVELS[0]
+        h, n = SOLID_LEVELS[load][0]
         again = _run([(load, "solid", h, n)], out, comm, echo)[0]
         first = next(r for r in rows if r["load"] == load)
         change = max(abs(again[k] / first[k] - 1) for k in FIGURES)
@@ -395,7 +439,7 @@ def run_shell_study(out="results/study-shells", *, quick: bool = False, comm=Non
     out = Path(out)
     started = time.perf_counter()
     if quick:
-        solids, cached = _run(_solid_plan(loads, QUICK_SOLID), out, comm, echo), ""
+        solids, cached = _run(_solid_plan(loads, quick=True), out, comm, echo), ""
     else:
         solids, cached = _cached_solids(loads, comm, out, echo)
     plan = [(load, "shell", h, 0) for load in loads

@@ -35,12 +35,25 @@ def test_levels_that_oscillate_are_not_extrapolated():
 
 
 def test_the_reference_takes_the_three_finest_solids_of_its_load():
-    rows = [{"load": load, "kind": kind, "peak_force": f, "contact_time": f, "deflection": f}
-            for load, kind, f in [("plastic", "solid", 99.0), ("plastic", "solid", 4.0),
-                                  ("plastic", "solid", 2.5), ("plastic", "shell", 7.0),
-                                  ("plastic", "solid", 1.75), ("elastic", "solid", 5.0)]]
+    levels = [("plastic", "solid", 8e-3, 99.0), ("plastic", "solid", 4e-3, 4.0),
+              ("plastic", "solid", 2e-3, 2.5), ("plastic", "shell", 2e-3, 7.0),
+              ("plastic", "solid", 1e-3, 1.75), ("elastic", "solid", 5e-3, 5.0)]
+    rows = [{"load": load, "kind": kind, "element_size": h, "peak_force": f, "contact_time": f,
+             "deflection": f} for load, kind, h, f in levels]  # fmt: skip
     ref = reference(rows, "plastic")  # 4, 2.5, 1.75: order 1, limit 1
     assert ref["deflection"]["order"] == pytest.approx(1.0)
     assert ref["deflection"]["value"] == pytest.approx(1.0, rel=1e-12)
     single = reference(rows, "elastic")["peak_force"]
     assert (single["value"], single["extrapolated"]) == (5.0, False)
+
+
+@pytest.mark.parametrize("order", [0.8, 2.0, 1.37])
+def test_richardson_with_unequal_ratios_recovers_the_limit_and_the_order(order):
+    # sizes 5, 2.5 and 5/3: ratios 2 then 1.5, as a third level of 1.667 mm x 6 layers
+    f0, c = 17.3, 0.9
+    sizes = (5.0, 2.5, 5.0 / 3.0)
+    ref = richardson([f0 + c * h**order for h in sizes], sizes)
+    assert ref["extrapolated"]
+    assert ref["order"] == pytest.approx(order, rel=1e-10)
+    assert ref["value"] == pytest.approx(f0, rel=1e-12)
+    assert ref["finest_error"] == pytest.approx(abs(c * sizes[2] ** order / f0), rel=1e-9)
