@@ -139,6 +139,12 @@ void central_difference(int64_t n, double dt_v, double dt, const double *mass, c
                         double *v, double *u, const double *f, double out[9],
                         double integral[3], double momentum[3], const int32_t *labels,
                         double *part_sums);
+void shell_central_difference(int64_t n, double dt_v, double dt, const double *mass,
+                              const double *a, double *v, double *u, const double *f,
+                              double out[9], double integral[3], double momentum[3],
+                              const int32_t *labels, double *part_sums, const double *inertia,
+                              const double *turning, const double *alpha,
+                              const double *moments, double *w, double turns[3]);
 double interface_work(int64_t n, const int32_t *nodes, const double *f, const double *v);
 typedef struct {
   int kind;

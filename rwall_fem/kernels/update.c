@@ -17,6 +17,16 @@
  * labels (a part per node, -1 at the interfaces of parts), the same two sums per part
  * over the nodes of that part alone, in part_sums[2 part] and part_sums[2 part + 1].
  *
+ * shell_central_difference: the same pass over a shell body's nodes, each node's rotations
+ * advanced in the same sweep as its translations (rwall_fem/shells/update.py):
+ * w^{n+1/2} = w^{n-1/2} + dt_v alpha^n (angular velocity, global axes, rad/s), booking
+ *   turns[0] = 1/2 sum I w^{n-1/2} . w^{n+1/2}   (the rotations' shadow kinetic energy; I the
+ *              rotational inertia, inertia[2 i + 1] of the (n, 2) masses and inertias,
+ *              times turning[i] when given: 0 at a rigid body's nodes)
+ *   turns[1] = sum M . w^{n-1/2}, turns[2] = sum M . w^{n+1/2}   (M the nodal moments)
+ * The rotations are angular velocities only: the elements take their frame from the
+ * current coordinates, so there is no nodal triad to turn.
+ *
  * interface_work: sum over k of f[k] . v[nodes[k]], the work rate (W) of a part's forces f
  * at the nodes it shares with other parts (rwall_fem/body.py).
  */
@@ -72,6 +82,24 @@ INLINE void advance_node(int64_t i, double dt_v, double dt, const double *restri
   }
 }
 
+/* The pass's sums into out[9] and the momentum integral (see central_difference). */
+INLINE void finish(double dt_v, double kinetic, double first, double second,
+                   const double before[3], const double after[3], double out[9],
+                   double integral[3], double momentum[3])
+{
+  out[0] = 0.5 * kinetic;
+  out[1] = first;
+  out[2] = second;
+  const double half = 0.5 * dt_v;
+  for (int c = 0; c < 3; ++c)
+  {
+    out[3 + c] = before[c];
+    out[6 + c] = after[c];
+    momentum[c] = integral[c] + half * before[c];
+    integral[c] += half * (before[c] + after[c]);
+  }
+}
+
 void central_difference(int64_t n, double dt_v, double dt, const double *restrict mass,
                         const double *restrict a, double *restrict v, double *restrict u,
                         const double *restrict f, double out[9], double integral[3],
@@ -92,17 +120,48 @@ void central_difference(int64_t n, double dt_v, double dt, const double *restric
     for (int64_t i = 0; i < n; ++i)
       advance_node(i, dt_v, dt, mass, a, v, u, NULL, &kinetic, &first, &second, before, after,
                    NULL, NULL);
-  out[0] = 0.5 * kinetic;
-  out[1] = first;
-  out[2] = second;
-  const double half = 0.5 * dt_v;
+  finish(dt_v, kinetic, first, second, before, after, out, integral, momentum);
+}
+
+/* One node's rotations (see shell_central_difference). */
+INLINE void advance_rotation(int64_t i, double dt_v, const double *restrict inertia,
+                             const double *restrict turning, const double *restrict alpha,
+                             const double *restrict moments, double *restrict w,
+                             double turns[3])
+{
+  const double I = turning ? inertia[2 * i + 1] * turning[i] : inertia[2 * i + 1];
   for (int c = 0; c < 3; ++c)
   {
-    out[3 + c] = before[c];
-    out[6 + c] = after[c];
-    momentum[c] = integral[c] + half * before[c];
-    integral[c] += half * (before[c] + after[c]);
+    const int64_t j = 3 * i + c;
+    const double old = w[j], next = old + dt_v * alpha[j];
+    turns[0] += I * old * next;
+    turns[1] += moments[j] * old;
+    turns[2] += moments[j] * next;
+    w[j] = next;
   }
+}
+
+void shell_central_difference(int64_t n, double dt_v, double dt, const double *restrict mass,
+                              const double *restrict a, double *restrict v, double *restrict u,
+                              const double *restrict f, double out[9], double integral[3],
+                              double momentum[3], const int32_t *restrict labels,
+                              double *restrict part_sums, const double *restrict inertia,
+                              const double *restrict turning, const double *restrict alpha,
+                              const double *restrict moments, double *restrict w,
+                              double turns[3])
+{
+  double kinetic = 0.0, first = 0.0, second = 0.0, before[3] = {0.0, 0.0, 0.0},
+         after[3] = {0.0, 0.0, 0.0}, sums[3] = {0.0, 0.0, 0.0};
+  for (int64_t i = 0; i < n; ++i)
+  {
+    advance_node(i, dt_v, dt, mass, a, v, u, f, &kinetic, &first, &second, before, after,
+                 labels, part_sums);
+    advance_rotation(i, dt_v, inertia, turning, alpha, moments, w, sums);
+  }
+  finish(dt_v, kinetic, first, second, before, after, out, integral, momentum);
+  turns[0] = 0.5 * sums[0];
+  turns[1] = sums[1];
+  turns[2] = sums[2];
 }
 
 double interface_work(int64_t n, const int32_t *restrict nodes, const double *restrict f,
