@@ -29,17 +29,15 @@ class ShellUpdate(CentralDifference):
     ``body``, its internal force."""
 
     def __init__(self, state, body):
-        super().__init__(state, body)
         self.body = body
-        # What the translations' pointers point into.
-        self._state_arrays = (state.mass, state.a, state.v, state.u, state.momentum_integral,
-                              getattr(body, "nodal_force", None))  # fmt: skip
         self._turns = np.zeros(3)  # 1/2 sum I w- . w+, sum M . w-, sum M . w+
-        self._bind()
+        super().__init__(state, body)
 
-    def _bind(self) -> None:
-        """Bind the compiled pass to the state's and the body's arrays (the body's
-        ``turning``, 0 at a rigid body's nodes, may come after the update is built)."""
+    def _bind(self, state) -> None:
+        """Bind the compiled pass to the state's arrays (the translations', as the solids')
+        and to the body's (the body's ``turning``, 0 at a rigid body's nodes, may come after
+        the update is built), keeping them."""
+        super()._bind(state)
         ffi, lib = load()
         body = self.body
         w, moments = body.w.owned, body.moments
@@ -62,8 +60,11 @@ class ShellUpdate(CentralDifference):
 
     def __call__(self, state) -> None:
         body = self.body
-        if getattr(body, "turning", None) is not self._bound_turning:
-            self._bind()
+        arrays = self._state_arrays(state)
+        if getattr(body, "turning", None) is not self._bound_turning or not all(
+            x is y for x, y in zip(arrays, self._bound, strict=True)
+        ):
+            self._bind(state)  # another state, or the body's turning given late
         if self._part_sums is not None:
             self._part_sums[:] = 0.0
         self._pass(state.dt_velocity, state.dt, *self._arrays)
