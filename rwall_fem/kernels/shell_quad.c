@@ -278,18 +278,12 @@ typedef struct
 } qeph_material_t;
 
 /* qeph_material_t of a batch from its state rows after shell_update (plastic cells) and the
- * points' plastic strains before it, eps_before; N, M the new resultants.  A cell yields
- * when one of its points flowed, whatever its flow and mean stresses (qeph_yield_factors):
- * those are taken only when some lane of the batch has no point that flowed (else 0). */
+ * points' plastic strains before it, eps_before; N, M the new resultants. */
 INLINE void qeph_material(const element_params *p, const shell_params *s, const batch_t *b,
                           const double *restrict state, int64_t stride, const vec eps_before[],
                           vec t, const vec N[3], const vec M[3], qeph_material_t *out)
 {
   const double share = 1.0 / s->points;
-  ivec moved = {0};
-  for (int pt = 0; pt < s->points; ++pt)
-    moved |= load_slot(state, stride, b, 2 + SHELL_POINT_SLOTS * pt + 3) > eps_before[pt];
-  int read = shell_any(~moved);
   vec mean = VZERO, least = VZERO + 1.0, flow = VZERO;
   for (int pt = 0; pt < s->points; ++pt)
   {
@@ -298,8 +292,7 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     const vec T = p->thermal ? load_slot(state, stride, b, base + 4) : VZERO;
     const vec factor = flow_factor(p, VZERO, T);
     vec slope;
-    if (read)
-      flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
+    flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
     const ivec flowed = e > eps_before[pt];
     if (shell_any(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
       capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
@@ -307,24 +300,13 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     mean += share * tangent;
     least = vmin(least, tangent);
   }
-  if (!read && shell_any(VZERO + (1.0 - least) <= 0.0)) /* flowed, yet E_t / E = 1 */
-  {
-    read = 1;
-    for (int pt = 0; pt < s->points; ++pt)
-    {
-      const int base = 2 + SHELL_POINT_SLOTS * pt;
-      const vec T = p->thermal ? load_slot(state, stride, b, base + 4) : VZERO;
-      vec slope;
-      flow += share * capped_flow_stress(p, eps_before[pt], flow_factor(p, VZERO, T), &slope);
-    }
-  }
   out->mean_tangent = mean;
   out->least_tangent = least;
   out->flow = flow;
   for (int i = 0; i < 3; ++i)
   {
-    out->membrane[i] = read ? N[i] / t : VZERO;
-    out->bending[i] = read ? M[i] / (t * t) : VZERO;
+    out->membrane[i] = N[i] / t;
+    out->bending[i] = M[i] / (t * t);
   }
 }
 
