@@ -10,6 +10,8 @@ partitioned mesh would) with small random velocities, as in a step of a run. The
 the stresses to the yield surface (a steady plastic flow, increments of about 4e-5 per
 step), hexahedra alike; "below yield" is the same law with its yield stress out of reach
 (the elastic checks only); "elastic" the linear elastic law (resultants, no points).
+The QEPH rows are the quadrilateral as a deck's Ishell 24 reads it (formulation "qeph": its
+physical hourglass stiffness with yield and viscosity, its step length), same laws.
 
 Times are each rank's processor time (not wall time: the machine is shared), per element-
 step of that rank's cells; every figure is the median over rounds in which the kernels
@@ -55,8 +57,14 @@ def timed(call):
     return (time.process_time() - start) / CALLS
 
 
+# QEPH (Radioss's Ishell 24, as a deck's /PROP/SHELL reads it): its physical hourglass
+# stiffness with yield and viscosity, its step length
+QEPH = dict(formulation="qeph", hourglass=(0.0, 0.0, 0.0), step_length="qeph",
+            hourglass_yield=True)
+
+
 def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=300e6,
-               cell="quadrilateral"):
+               cell="quadrilateral", technology=None):
     n = int(round(math.sqrt(cells_wanted / (2 if cell == "triangle" else 1))))
     h = 2.5e-3
     s = np.arange(n + 1) * h
@@ -72,7 +80,8 @@ def shell_case(cells_wanted: int, plastic: bool, points: int = 5, yield_stress=3
     else:
         material = SimpleNamespace(model="linear_elastic", plastic=False, young=E, poisson=NU,
                                    density=RHO)  # fmt: skip
-    k = ShellKernel(material, ShellTechnology.choose(cell, points=points), cells, 1e-3)
+    k = ShellKernel(material, ShellTechnology.choose(cell, points=points, **(technology or {})),
+                    cells, 1e-3)
     u = rng.normal(size=X.shape) * 1e-6
     v, w = rng.normal(size=X.shape), rng.normal(size=X.shape) * 100
     f, m = np.zeros_like(X), np.zeros_like(X)
@@ -134,6 +143,10 @@ CASES = (
     ("quadrilateral, J2, 5 points, below yield", lambda n: shell_case(n, True, 5, 1e12)),
     ("triangle, elastic", lambda n: shell_case(n, False, cell="triangle")),
     ("triangle, J2, 5 points", lambda n: shell_case(n, True, cell="triangle")),
+    ("quadrilateral QEPH (Ishell 24), J2, 5 points",
+     lambda n: shell_case(n, True, technology=QEPH)),
+    ("quadrilateral QEPH (Ishell 24), J2, 5 points, below yield",
+     lambda n: shell_case(n, True, 5, 1e12, technology=QEPH)),
     ("hexahedron, one point, J2 (viscous)", hex_case),
 )
 QUAD_J2, HEX_J2 = 1, len(CASES) - 1
