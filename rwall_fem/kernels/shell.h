@@ -183,15 +183,16 @@ INLINE vec near_flow_stress(const element_params *p, const double c[BINOMIAL_TER
 }
 
 /* capped_flow_stress, also giving e^n in *power (power laws; 1 otherwise) and 1 / e in
- * *inverse (1 where e <= 0). */
+ * *inverse (1 where e <= 0, and for the other laws: only near_flow_stress needs it). */
 INLINE vec flow_stress_power(const element_params *p, vec e, vec factor,
                              vec *slope, vec *power_out, vec *inverse)
 {
   const ivec positive = e > 0.0;
-  *inverse = 1.0 / vselect(positive, e, VZERO + 1.0);
+  *inverse = VZERO + 1.0;
   *power_out = VZERO + 1.0;
   if (p->hardening == HARDENING_POWER || p->hardening == JOHNSON_COOK)
   {
+    *inverse = 1.0 / vselect(positive, e, VZERO + 1.0);
     const double B = p->hardening_coefficient, n = p->hardening_exponent;
     const vec safe = vselect(positive, e, VZERO + 1.0);
     const vec power = n == 0.0 ? VZERO + 1.0 : vselect(positive, vexp(n * vlog(safe)), VZERO);
@@ -334,8 +335,9 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
                       + (2.0 / 3.0) * vmax(start, VZERO) * (safe_q * safe_q * safe_q));
     g[a] = vselect(flowing, vmin(vmax(g0, VZERO), hi[a]), VZERO);
   }
-  double binomial[BINOMIAL_TERMS];
-  binomial_coefficients(p->hardening_exponent, binomial);
+  double binomial[BINOMIAL_TERMS]; /* of near_flow_stress: power laws only */
+  if (power_law)
+    binomial_coefficients(p->hardening_exponent, binomial);
   for (int iteration = 0; iteration < 50; ++iteration)
   {
     vec q[SHELL_MAX_POINTS], dq[SHELL_MAX_POINTS], rq[SHELL_MAX_POINTS];
@@ -436,9 +438,11 @@ INLINE void shell_points_update(const element_params *p, const shell_params *s, 
     dissipation[j] = flow[j] * d[j];
     done[j].increment = d[j];
     done[j].rate = rate[j];
-    done[j].triaxiality = vselect(d[j] > 0.0, ((1.0 / 3.0) * (sig[j][0] + sig[j][1]))
-                                                  / vselect(d[j] > 0.0, flow[j], VZERO + 1.0),
-                                  VZERO);
+    /* the failure criteria's (a division per point) */
+    done[j].triaxiality = !p->failure ? VZERO
+                          : vselect(d[j] > 0.0, ((1.0 / 3.0) * (sig[j][0] + sig[j][1]))
+                                                    / vselect(d[j] > 0.0, flow[j], VZERO + 1.0),
+                                    VZERO);
     if (p->thermal)
       T[j] += (p->taylor_quinney / (p->density * p->specific_heat)) * dissipation[j];
   }

@@ -572,12 +572,15 @@ INLINE vec quad_hourglass(const quad_frame_t *g, const shell_params *s,
     q[3] += gamma[I] * wl[I][0];
     q[4] += gamma[I] * wl[I][1];
   }
-  const vec C = (4.0 * density * s->bar_speed) * thickness * vsqrt(g->area);
-  const vec Cm = s->hm * C, Cf = s->hf * C, Cr = (s->hr / 12.0) * C * thickness * thickness;
-  vec Q[5] = {Cm * q[0], Cm * q[1], Cf * q[2], Cr * q[3], Cr * q[4]};
-  vec work = VZERO;
-  for (int k = 0; k < 5; ++k)
-    work += dt * Q[k] * q[k];
+  vec Q[5] = {VZERO, VZERO, VZERO, VZERO, VZERO}, work = VZERO;
+  if (s->hm != 0.0 || s->hf != 0.0 || s->hr != 0.0) /* QEPH's have none (a square root) */
+  {
+    const vec C = (4.0 * density * s->bar_speed) * thickness * vsqrt(g->area);
+    const vec Cm = s->hm * C, Cf = s->hf * C, Cr = (s->hr / 12.0) * C * thickness * thickness;
+    Q[0] = Cm * q[0], Q[1] = Cm * q[1], Q[2] = Cf * q[2], Q[3] = Cr * q[3], Q[4] = Cr * q[4];
+    for (int k = 0; k < 5; ++k)
+      work += dt * Q[k] * q[k];
+  }
   vec fz[4] = {VZERO, VZERO, VZERO, VZERO}, ms[4][2] = {{VZERO, VZERO}, {VZERO, VZERO},
                                                         {VZERO, VZERO}, {VZERO, VZERO}};
   if (s->qeph_physical)
