@@ -284,6 +284,9 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
                           vec t, const vec N[3], const vec M[3], qeph_material_t *out)
 {
   const double share = 1.0 / s->points;
+  /* an uncapped linear law's slope is H at every strain: its E_t / E once */
+  const int linear = p->hardening == HARDENING_LINEAR && !(p->max_flow_stress > 0.0);
+  const double H = p->hardening_modulus, linear_tangent = H / (H + s->young);
   vec mean = VZERO, least = VZERO + 1.0, flow = VZERO;
   for (int pt = 0; pt < s->points; ++pt)
   {
@@ -294,9 +297,14 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     vec slope;
     flow += share * capped_flow_stress(p, eps_before[pt], factor, &slope);
     const ivec flowed = e > eps_before[pt];
-    if (shell_any(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
-      capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
-    const vec tangent = vselect(flowed, slope / (slope + s->young), VZERO + 1.0);
+    vec tangent = VZERO + linear_tangent;
+    if (!linear)
+    {
+      if (shell_any(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
+        capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
+      tangent = slope / (slope + s->young);
+    }
+    tangent = vselect(flowed, tangent, VZERO + 1.0);
     mean += share * tangent;
     least = vmin(least, tangent);
   }
