@@ -211,3 +211,41 @@ def test_qeph_refuses_the_bwc_hourglass_stiffness_and_triangles():
         ShellTechnology.choose("quadrilateral", formulation="qeph", hourglass_stiffness=0.5)
     with pytest.raises(ValueError, match=r"^element\.formulation: 'qeph' is not for triangle"):
         ShellTechnology.choose("triangle", formulation="qeph")
+
+
+@pytest.mark.parametrize("hardening", ["linear", "power"])
+def test_the_plain_qeph_kernel_equals_the_general_one(hardening):
+    """QEPH's cells without options run through shell_quad compiled apart with those settings
+    as constants (shell_quad.c, qeph_plain); the same cells with a flow-stress cap that is
+    never reached (1e30 Pa) run through the general kernel. Over 100 steps of a random
+    motion that makes some points flow and leaves others elastic, the forces, moments,
+    energies, step notes and state are the same bit for bit."""
+    n = 6
+    grid = np.arange(n + 1) * 2.5e-3
+    X = np.array([[x, y, 0.0] for y in grid for x in grid])
+    cells = np.array([[j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1,
+                       (j + 1) * (n + 1) + i] for j in range(n) for i in range(n)], np.int32)
+    material = SimpleNamespace(model="elastic_plastic", plastic=True, young=E, poisson=NU,
+                               density=RHO, hardening=hardening, yield_stress=300e6,
+                               hardening_modulus=1e9, hardening_coefficient=500e6,
+                               hardening_exponent=0.3, strain_rate_coefficient=0.0,
+                               reference_strain_rate=1.0, failure=None, heating=None)
+    technology = ShellTechnology.choose("quadrilateral", formulation="qeph",
+                                        hourglass=(0.0, 0.0, 0.0), step_length="qeph",
+                                        hourglass_yield=True)  # fmt: skip
+    rng = np.random.default_rng(3)
+    v, w = rng.normal(size=X.shape) * 0.3, rng.normal(size=X.shape) * 30
+    results = []
+    for cap in (math.inf, 1e30):
+        k = ShellKernel(material, technology, cells, T, max_flow_stress=cap)
+        u = np.zeros_like(X)
+        out = []
+        for _ in range(100):
+            f, m = np.zeros_like(X), np.zeros_like(X)
+            energy, step = k.run(1e-7, X, u, v, w, f, m)
+            out.append(np.concatenate([f.ravel(), m.ravel(), energy, step]))
+            u += 1e-7 * v
+        results.append((np.array(out), k.history.copy(), k.plastic_strains()))
+    (plain, plain_state, eps), (general, general_state, _) = results
+    assert 0.1 < np.mean(eps > 0) < 0.9  # some points flowed, others did not
+    assert np.array_equal(plain, general) and np.array_equal(plain_state, general_state)
