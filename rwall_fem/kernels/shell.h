@@ -335,7 +335,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
                       + (2.0 / 3.0) * vmax(start, VZERO) * (safe_q * safe_q * safe_q));
     g[a] = vselect(flowing, vmin(vmax(g0, VZERO), hi[a]), VZERO);
   }
-  double binomial[BINOMIAL_TERMS]; /* of near_flow_stress: power laws only */
+  double binomial[BINOMIAL_TERMS] = {0.0}; /* of near_flow_stress: power laws only */
   if (power_law)
     binomial_coefficients(p->hardening_exponent, binomial);
   for (int iteration = 0; iteration < 50; ++iteration)
