@@ -203,6 +203,11 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                         f"fraction of the parts (default {default})"
                     )
         interfaces.append(interface)
+    if interfaces:
+        # The step of a node held by cells and contact springs, node by node.
+        element = (internal or body).track_nodal_stiffness()
+        for interface in interfaces:
+            interface.combine_with(element)
     return interfaces
 
 

@@ -99,6 +99,8 @@ ELEMENT_PARAMS = """typedef struct {
   double step_floor;
   int32_t *below;
   double *below_step;
+  const double *nodal_mass;
+  double *nodal_stiffness;
   int failure;
   double failure_strain;
   double damage_constants[5];
@@ -209,7 +211,7 @@ void contact_unpack(int64_t n, const int64_t *order, const double *packed, doubl
                     double *v, double *mass);
 void contact_apply(int64_t n, const int64_t *rows, double *force, double *stiffness,
                    const double *ms, const double *mass, const double *v, double *a,
-                   double *kept, double out[2]);
+                   double *kept, const double *element, double out[2]);
 double contact_power(int64_t n, const int64_t *rows, const double *kept, const double *v);
 """
     + "".join(

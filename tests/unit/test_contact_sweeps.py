@@ -73,7 +73,7 @@ class Surface:
         p = self.p
         self.lib.contact_apply(5, p(ROWS, "int64_t[]"), p(self.force), p(self.stiffness),
                                p(self.ms), p(self.mass), p(self.v), p(self.a), p(self.kept),
-                               p(out))  # fmt: skip
+                               self.ffi.NULL, p(out))  # fmt: skip
         return out
 
 
