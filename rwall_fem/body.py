@@ -144,15 +144,18 @@ class PartedBody(ErodingBody):
 
     _nodal = None  # the cells' nodal term of the step (track_nodal_stiffness), a la vector
 
-    def track_nodal_stiffness(self) -> np.ndarray:
+    def track_nodal_stiffness(self, surface: np.ndarray) -> np.ndarray:
         """From now on, every pass gives each node the sum over its cells of m_c / dt_e^2
         (N/m; m_c the mass the cell gives it, dt_e the cell's calibrated estimate) in the
         returned array (a row per node: complete on the owned rows, changed in place only),
-        for the nodal stable step of contact (docs/theory.md, contact's "Stable step")."""
+        for the nodal stable step of contact (docs/theory.md, contact's "Stable step"):
+        at least at the nodes ``surface`` (a bool per node row, owned and ghost), whose cells
+        alone add it."""
         if self._nodal is None:
             self._nodal = la.vector(self.V.dofmap.index_map, 1)
             for part, force in zip(self.parts, self.elements, strict=True):
-                force.note_nodal_stiffness(self._nodal.array, float(part.material.density))
+                force.note_nodal_stiffness(self._nodal.array, float(part.material.density),
+                                           surface)  # fmt: skip
         return self._nodal.array
 
     def _begin_nodal_stiffness(self) -> None:

@@ -104,11 +104,12 @@ INLINE void centroid(const vec *restrict x, const vec *restrict u, int npe, int 
  * the smallest so far, and when p->below is given the cells below p->step_floor, with
  * their steps before mass scaling in p->below_step.  NaN (a broken state, caught by the
  * run's guards) is never the smallest.  When p->nodal_stiffness is given, each cell with
- * a finite dt_e adds m_c / dt_e^2 (N/m, m_c = p->nodal_mass of the cell, kg) to each of its
- * nodes: the element part of a node's squared frequency bound, sum_c m_c (2 / dt_e)^2 / 4,
- * that a nodal stable step combines with the contact springs' (docs/theory.md, contact's
- * "Stable step").  Mass scaling multiplies m_c by s^2 and dt_e by s: the term is the
- * same, so the step before scaling serves. */
+ * a finite dt_e and m_c = p->nodal_mass of the cell (kg) not 0 (0: a cell at no contact
+ * surface node) adds m_c / dt_e^2 (N/m) to each of its nodes: the element part of a
+ * node's squared frequency bound, sum_c m_c (2 / dt_e)^2 / 4, that a nodal stable step
+ * combines with the contact springs' (docs/theory.md, contact's "Stable step").  Mass
+ * scaling multiplies m_c by s^2 and dt_e by s: the term is the same, so the step before
+ * scaling serves. */
 INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
                        const int32_t *restrict cells, const vec *restrict x,
                        const vec *restrict u, int npe, double *step)
@@ -116,10 +117,10 @@ INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
   if (p->nodal_stiffness)
     for (int k = 0; k < b->nb; ++k)
     {
-      const double d = dte[k];
-      if (!(d < INFINITY))
+      const double d = dte[k], mc = p->nodal_mass[b->id[k]];
+      if (!(d < INFINITY) || mc == 0.0)
         continue;
-      const double term = p->nodal_mass[b->id[k]] / (d * d);
+      const double term = mc / (d * d);
       const int32_t *cell = cells + b->id[k] * npe;
       for (int I = 0; I < npe; ++I)
         p->nodal_stiffness[cell[I]] += term;
