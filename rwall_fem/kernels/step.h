@@ -115,16 +115,16 @@ INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
                        const vec *restrict u, int npe, double *step)
 {
   if (p->nodal_stiffness)
+  {
+    const vec term = cell_values(p->nodal_mass, b) / (dte * dte); /* dt_e inf: 0 */
     for (int k = 0; k < b->nb; ++k)
-    {
-      const double d = dte[k], mc = p->nodal_mass[b->id[k]];
-      if (!(d < INFINITY) || mc == 0.0)
-        continue;
-      const double term = mc / (d * d);
-      const int32_t *cell = cells + b->id[k] * npe;
-      for (int I = 0; I < npe; ++I)
-        p->nodal_stiffness[cell[I]] += term;
-    }
+      if (term[k] > 0.0) /* not 0 (none to add) nor NaN */
+      {
+        const int32_t *cell = cells + b->id[k] * npe;
+        for (int I = 0; I < npe; ++I)
+          p->nodal_stiffness[cell[I]] += term[k];
+      }
+  }
   const vec scaled = p->step_factor ? dte * cell_values(p->step_factor, b) : dte;
   for (int k = 0; k < b->nb; ++k)
   {
