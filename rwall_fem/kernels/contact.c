@@ -29,7 +29,8 @@
  * contact_read, contact_apply: the sweeps of the rank's owned surface nodes before the
  *   passes (the state's values in; the books of the previous step's forces; how far the
  *   nodes moved since the sort and the near lists) and after them (the forces out to the
- *   accelerations; the nodal stable step min sqrt(2 m / k) (s); force and k zeroed).
+ *   accelerations; the nodal stable step min sqrt(m / (e + k / 2)) (s), e the cells'
+ *   term; force and k zeroed).
  * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
  * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
  * With `share` and `planes`, a model cut by symmetry planes acts as the whole model would
