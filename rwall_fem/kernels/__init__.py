@@ -164,6 +164,9 @@ double wall_work(int64_t k, const int64_t *nodes, const double *impulse, const d
                  const double velocity[3], double *scratch);
 void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
                 const double *tangential, double dt_v, double *a, double out[9]);
+void wall_coupling(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,
+                   const double *vs, const double *target, const double *tangential,
+                   double out[12]);
 double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const double *u,
                       const wall_shape *s, const double offset[3], double *clearance);
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,

@@ -10,6 +10,8 @@
  *   nodes for a wall velocity.
  * wall_apply: add the impulses to a^n and sum what the wall books (impulses, works).
  * wall_work: the sum of impulse . (v - V) over listed nodes (the second half of a work).
+ * wall_coupling: the sums over the listed nodes of a main-node wall's equations (the
+ *   mass each node lends the wall and the momentum it brings).
  * wall_clearance: how far each secondary node is from being treated (selects the near set).
  * largest_components: the largest |v_i| and |a_i| of the secondary nodes (how far the
  *   near set may be trusted).
@@ -320,6 +322,50 @@ double wall_work(int64_t k, const int64_t *restrict nodes, const double *restric
       scratch[3 * i + c] = impulse[3 * i + c] * (v[3 * row + c] - velocity[c]);
   }
   return numpy_sum(3 * k, scratch);
+}
+
+/* The sums over the k listed nodes (masses m, kg; normals n; v* vs, m/s; target normal
+ * velocities, m/s) of the equations of a main-node wall's velocity (walls/constraint.py,
+ * _coupled_velocity): out[0..8] = sum m_i P_i (rows of 3), out[9..11] = sum m_i P_i v*_i
+ * - sum m_i b_i n_i [- sum of the extra impulses], P_i the identity for a tied node and
+ * n_i n_i^T for another.  Without `slip` every node is tied when `tied` is not 0; with it,
+ * the nodes that do not slip are tied and the slipping ones bring their `tangential`
+ * impulses (N s) as extra.  Sums in the order of NumPy's einsum and axis-0 sums: node after
+ * node, the three products of a row of P_i v*_i summed before they join the total. */
+void wall_coupling(int64_t k, int tied, const uint8_t *restrict slip, const double *restrict m,
+                   const double *restrict n, const double *restrict vs,
+                   const double *restrict target, const double *restrict tangential,
+                   double out[12])
+{
+  double M[9] = {0.0}, R[3] = {0.0}, S[3] = {0.0}, E[3] = {0.0};
+  for (int64_t i = 0; i < k; ++i)
+  {
+    const double *ni = n + 3 * i, *vi = vs + 3 * i;
+    const int held = slip ? !slip[i] : tied;
+    double P[9];
+    for (int j = 0; j < 3; ++j)
+      for (int c = 0; c < 3; ++c)
+        P[3 * j + c] = held ? (j == c ? 1.0 : 0.0) : ni[j] * ni[c];
+    const double mb = m[i] * target[i];
+    for (int j = 0; j < 3; ++j)
+    {
+      double accum = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        const double mp = m[i] * P[3 * j + c];
+        M[3 * j + c] += mp;
+        accum += mp * vi[c];
+      }
+      R[j] = accum + R[j];
+      S[j] += mb * ni[j];
+      if (slip)
+        E[j] += slip[i] ? tangential[3 * i + j] : 0.0;
+    }
+  }
+  for (int c = 0; c < 9; ++c)
+    out[c] = M[c];
+  for (int j = 0; j < 3; ++j)
+    out[9 + j] = slip ? (R[j] - S[j]) - E[j] : R[j] - S[j];
 }
 
 /* Add the impulses (normal, plus tangential unless NULL; N s) of the k listed nodes to

@@ -290,14 +290,11 @@ class RigidWall:
         free = self.slide == "free"
         if motion.dynamic:
             predicted = wall_velocity
-            tied = np.full(k, self.slide == "tied")
-            wall_velocity = self._coupled_velocity(predicted, passes, k, tied)
+            wall_velocity = self._coupled_velocity(predicted, passes, k)
         passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
         if motion.dynamic and self.slide == "friction":
             # Second pass: sticking nodes move with the wall, slipping ones push it.
-            slip = passes.slip[:k]
-            extra = np.where(slip[:, None], passes.tangential[:k], 0.0)
-            wall_velocity = self._coupled_velocity(predicted, passes, k, ~slip, extra)
+            wall_velocity = self._coupled_velocity(predicted, passes, k, slip=True)
             passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
         normal = passes.normal[:k]
         tangential = None if free else passes.tangential[:k]
@@ -399,24 +396,27 @@ class RigidWall:
         self._near = np.flatnonzero(clearance <= slack)
         self._near_nodes = self.nodes[self._near]
 
-    def _coupled_velocity(self, predicted, passes, k, tied, extra=None) -> np.ndarray:
+    def _coupled_velocity(self, predicted, passes, k, slip=False) -> np.ndarray:
         """Velocity (m/s) of a main-node wall over the step when it moves with the mass of
         the k nodes in contact (``passes``): normal motion shared by all, tangential by the
-        ``tied`` ones; ``extra`` impulses (N s) are given to the nodes on top."""
-        m, n = passes.mass[:k, None], passes.normals[:k]
-        vs, target = passes.predicted[:k], passes.target[:k]
-        # The normals' outer products only where some node is not tied (np.where's values).
-        outer = 0.0 if tied.all() else np.einsum("ij,ik->ijk", n, n)
-        P = np.where(tied[:, None, None], _EYE, outer)
-        matrix = np.einsum("i,ijk->jk", m[:, 0], P)
-        rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
-        if extra is not None:
-            rhs -= extra.sum(axis=0)
-        total = self._summed(np.concatenate([matrix.ravel(), rhs]))
+        tied ones (all if the wall is ``tied``; with ``slip``, those of ``passes.slip``
+        that do not slip, the slipping ones giving their tangential impulses on top)."""
+        total = self._summed(passes.coupling(k, self.slide == "tied", slip)).tolist()
         mass, held = self.motion.mass, self.motion.held
-        matrix, rhs = mass * _EYE + total[:9].reshape(3, 3), mass * predicted + total[9:]
-        matrix[held], rhs[held] = _EYE[held], predicted[held]  # held components
-        return np.linalg.solve(matrix, rhs)
+        matrix = [mass * (1.0 if i % 4 == 0 else 0.0) + total[i] for i in range(9)]
+        rhs = [mass * p + r for p, r in zip(predicted.tolist(), total[9:])]
+        for j in held.tolist():  # held components: V_j = V*_j
+            matrix[3 * j : 3 * j + 3] = _EYE[j].tolist()
+            rhs[j] = float(predicted[j])
+        diagonal = matrix[0::4]
+        if (
+            not any(matrix[i] for i in (1, 2, 3, 5, 6, 7))
+            and all(math.isfinite(d) and d != 0.0 for d in diagonal)
+            and all(math.isfinite(r) for r in rhs)
+        ):
+            # A diagonal system (all nodes tied): LAPACK's solve divides, to the bit.
+            return np.array([r / d for r, d in zip(rhs, diagonal)])
+        return np.linalg.solve(np.array(matrix).reshape(3, 3), np.array(rhs))
 
     def _summed(self, values: np.ndarray) -> np.ndarray:
         """``values`` summed over the ranks (on one rank, themselves: no exchange)."""

@@ -4,7 +4,8 @@
 arrays the passes fill, sized for the wall's near set: :meth:`~ContactPasses.find` lists
 the nodes in contact at a step, :meth:`~ContactPasses.impulses` gives their impulses for
 a wall velocity, :meth:`~ContactPasses.apply` adds them to the accelerations, and
-:meth:`~ContactPasses.work` sums the work of impulses; :meth:`~ContactPasses.clearance` and
+:meth:`~ContactPasses.work` sums the work of impulses, :meth:`~ContactPasses.coupling` the
+equations of a main-node wall's velocity; :meth:`~ContactPasses.clearance` and
 :meth:`~ContactPasses.largest` select and keep the near set. The arithmetic is NumPy's,
 operation for operation (``kernels/wall.c``), so that the results are those of the NumPy
 code that ``walls/constraint.py`` had before.
@@ -67,6 +68,8 @@ class ContactPasses:
         # offset, next offset and velocity of the wall (m, m, m/s), then the sums of apply
         self._vectors = np.zeros(3 * 3 + 9)
         self._vectors_pointer = _pointer(self.ffi, self._vectors)
+        self._coupling = np.zeros(12)  # the sums of coupling
+        self._coupling_pointer = _pointer(self.ffi, self._coupling)
         self._clearance = np.zeros(0)
         self._reserve(0)
 
@@ -154,6 +157,20 @@ class ContactPasses:
         sums = self._vectors_pointer + 9
         self.lib.wall_apply(k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, sums)
         return self._vectors[9:].reshape(3, 3)
+
+    def coupling(self, k: int, tied: bool, slip: bool = False) -> np.ndarray:
+        """The sums over the k nodes in contact of the equations of a main-node wall's
+        velocity V, (M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i) - extra: the
+        9 values of sum m_i P_i (rows of 3), then the 3 of the right side's sum, kg and
+        N s (a view the next call overwrites). P_i is the identity for a tied node (all
+        are when ``tied``), n_i n_i^T for another; with ``slip``, the nodes of :attr:`slip`
+        slip (the others are tied) and bring their :attr:`tangential` impulses as extra."""
+        q, null = self._pointers, self.ffi.NULL
+        self.lib.wall_coupling(
+            k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
+            q["target"], q["tangential"] if slip else null, self._coupling_pointer,
+        )  # fmt: skip
+        return self._coupling
 
     def work(self, impulse: np.ndarray, velocity, nodes: np.ndarray | None = None) -> float:
         """sum impulse . (v - ``velocity``) (N m/s) over the rows of ``impulse`` (k, 3):

@@ -199,3 +199,70 @@ def test_the_bound_on_travel_is_the_largest_component():
     s.a[nodes[5], 2] = -np.inf
     speed, acceleration = passes.largest(nodes)
     assert speed == np.nanmax(np.abs(s.v[nodes])) and acceleration == np.inf
+
+
+def numpy_coupled_velocity(mass, held, predicted, m, n, vs, target, tied, extra=None):
+    """``RigidWall._coupled_velocity`` of the NumPy code (m as a column): the main node's
+    velocity solving (M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i) - extra."""
+    eye = np.eye(3)
+    outer = 0.0 if tied.all() else np.einsum("ij,ik->ijk", n, n)
+    P = np.where(tied[:, None, None], eye, outer)
+    matrix = np.einsum("i,ijk->jk", m[:, 0], P)
+    rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
+    if extra is not None:
+        rhs -= extra.sum(axis=0)
+    sums = np.concatenate([matrix.ravel(), rhs])
+    matrix, rhs = mass * eye + matrix, mass * predicted + rhs
+    matrix[held], rhs[held] = eye[held], predicted[held]
+    return sums, np.linalg.solve(matrix, rhs)
+
+
+@pytest.mark.parametrize("slide", ["free", "tied", "friction"])
+@pytest.mark.parametrize("held", ["", "xy"])
+def test_main_node_coupling_is_numpys(slide, held):
+    """The compiled sums of the main node's equations and the velocity solved from them
+    (a division when all nodes are tied: LAPACK's solve of a diagonal system) are the
+    NumPy code's to the bit."""
+    from mpi4py import MPI
+
+    from rwall_fem.walls import RigidWall
+    from rwall_fem.walls.motion import MainNodeMotion
+
+    shape = SHAPES["sphere"]()
+    s = State(shape, n=3000)  # many contacts: sums over more than one einsum buffer
+    near = np.arange(len(s.mass), dtype=np.int64)
+    dt_v, dt, offset, wall_next, velocity = step_of()
+    motion = MainNodeMotion(0.02, velocity, held=held)
+    wall = RigidWall(shape, near, "w", slide=slide, friction=0.2, motion=motion,
+                     comm=MPI.COMM_SELF)  # fmt: skip
+    passes = ContactPasses(shape, s)
+    k = passes.find(near, dt_v, dt, offset, wall_next, velocity)
+    assert k > 500
+    m, n = passes.mass[:k, None].copy(), passes.normals[:k].copy()
+    vs, target = passes.predicted[:k].copy(), passes.target[:k].copy()
+    tied = np.full(k, slide == "tied")
+    sums, expected = numpy_coupled_velocity(0.02, motion.held, velocity, m, n, vs, target, tied)
+    np.testing.assert_array_equal(passes.coupling(k, slide == "tied"), sums)
+    np.testing.assert_array_equal(wall._coupled_velocity(velocity, passes, k), expected)
+    if slide != "friction":
+        return
+    passes.impulses(k, slide, 0.2, 1.0, expected)
+    slip = passes.slip[:k].copy()
+    assert 0 < slip.sum() < k
+    extra = np.where(slip[:, None], passes.tangential[:k], 0.0)
+    sums, expected = numpy_coupled_velocity(0.02, motion.held, velocity, m, n, vs, target,
+                                            ~slip, extra)  # fmt: skip
+    np.testing.assert_array_equal(passes.coupling(k, False, slip=True), sums)
+    np.testing.assert_array_equal(wall._coupled_velocity(velocity, passes, k, slip=True),
+                                  expected)  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_diagonal_solve_is_a_division(seed):
+    """LAPACK's solve of a diagonal system divides (the main node's velocity when every
+    node is tied takes that path without the solver)."""
+    rng = np.random.default_rng(seed)
+    d = rng.uniform(0.1, 10.0, (2000, 3)) * 10.0 ** rng.uniform(-3, 3, (2000, 3))
+    r = rng.standard_normal((2000, 3)) * 10.0 ** rng.uniform(-3, 3, (2000, 3))
+    solved = np.array([np.linalg.solve(np.diag(di), ri) for di, ri in zip(d, r)])
+    np.testing.assert_array_equal(solved, r / d)
