@@ -1,12 +1,12 @@
 """Compiled element kernels: C compiled at first use through cffi and cached.
 
 The C sources beside this file (one per element family, with the formulas in
-their header comments; ``update.c``, ``wall.c`` and ``contact.c`` for the per-node passes
-of a step, the update, the rigid walls and the contact interfaces, which share the
-friction law of ``friction.h``) are compiled into one extension module the first time a
-process needs them, the way FFCx compiles forms (the shells' kernels into a second one,
-an :class:`Extension` of :mod:`rwall_fem.shells.elements`, by the same :func:`load`), and
-cached per user under
+their header comments; ``update.c``, ``wall.c``, ``boundary.c`` and ``contact.c`` for the
+per-node passes of a step, the update, the rigid walls, the velocity boundaries and the
+contact interfaces, the walls and interfaces sharing the friction law of ``friction.h``)
+are compiled into one extension module the first time a process needs them, the way
+FFCx compiles forms (the shells' kernels into a second one, an :class:`Extension` of
+:mod:`rwall_fem.shells.elements`, by the same :func:`load`), and cached per user under
 ``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
 ``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
 compiler flags, the Python and cffi versions and the processor's instruction
@@ -67,7 +67,7 @@ log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
            "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
-           "friction.h", "wall.c", "contact.c", "contact_remove.c")  # fmt: skip
+           "friction.h", "wall.c", "contact.c", "contact_remove.c", "boundary.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -164,6 +164,11 @@ double wall_work(int64_t k, const int64_t *nodes, const double *impulse, const d
                  const double velocity[3], double *scratch);
 void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
                 const double *tangential, double dt_v, double *a, double out[9]);
+void boundary_velocity(int64_t n, int64_t axes, const int32_t *nodes, const int64_t *flat,
+                       const double *target, double dt_v, const double *mass, const double *v,
+                       double *a, double *reaction, double *power, double *sums);
+void boundary_power(int64_t m, const int64_t *flat, const double *reaction, const double *v,
+                    double *power);
 void wall_coupling(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,
                    const double *vs, const double *target, const double *tangential,
                    double out[12]);
