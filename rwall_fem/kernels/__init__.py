@@ -160,8 +160,11 @@ void wall_impulses(int64_t k, int slide, double friction, double alpha, const do
                    const double *n, const double *vs, const double velocity[3],
                    const double *target, const double *kept, double *normal,
                    double *tangential, uint8_t *slip);
-double wall_work(int64_t k, const int64_t *nodes, const double *impulse, const double *v,
-                 const double velocity[3], double *scratch);
+void wall_work(int64_t k, const int64_t *nodes, const double *normal, const double *tangential,
+               const double *v, const double velocity[3], double *scratch, double out[2]);
+int wall_velocity(const double total[12], double mass, const double predicted[3],
+                  const uint8_t held[3], double matrix[9], double rhs[3], double out[3]);
+void largest_range(int64_t n, const double *v, const double *a, double out[2]);
 void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
                 const double *tangential, double dt_v, double *a, double out[9]);
 void boundary_velocity(int64_t n, int64_t axes, const int32_t *nodes, const int64_t *flat,

@@ -9,12 +9,13 @@
  *   friction filter of friction.h, the law the contact interfaces share) of the listed
  *   nodes for a wall velocity.
  * wall_apply: add the impulses to a^n and sum what the wall books (impulses, works).
- * wall_work: the sum of impulse . (v - V) over listed nodes (the second half of a work).
+ * wall_work: the sums of impulse . (v - V) over listed nodes (the halves of the works).
  * wall_coupling: the sums over the listed nodes of a main-node wall's equations (the
- *   mass each node lends the wall and the momentum it brings).
+ *   mass each node lends the wall and the momentum it brings); wall_velocity: those
+ *   equations assembled, and solved when they are diagonal.
  * wall_clearance: how far each secondary node is from being treated (selects the near set).
  * largest_components: the largest |v_i| and |a_i| of the secondary nodes (how far the
- *   near set may be trusted).
+ *   near set may be trusted); largest_range: the same for a range of nodes.
  *
  * The arithmetic is that of the NumPy code these replace, operation for operation and in
  * the same order, so that results stay the same to the bit: dot products of 3 components
@@ -311,17 +312,27 @@ void wall_impulses(int64_t k, int slide, double friction, double alpha,
 
 /* sum over the k listed nodes of impulse . (v - velocity) (N m/s), v rows of 3 at the
  * node indices `nodes` (when not NULL; else the rows of v themselves), as NumPy's
- * (impulse * (v[nodes] - velocity)).sum(); `scratch` holds 3 k values. */
-double wall_work(int64_t k, const int64_t *restrict nodes, const double *restrict impulse,
-                 const double *restrict v, const double velocity[3], double *restrict scratch)
+ * (impulse * (v[nodes] - velocity)).sum(): out[0] for `normal`, out[1] for `tangential`
+ * (0 when NULL); `scratch` holds 3 k values. */
+void wall_work(int64_t k, const int64_t *restrict nodes, const double *restrict normal,
+               const double *restrict tangential, const double *restrict v,
+               const double velocity[3], double *restrict scratch, double out[2])
 {
-  for (int64_t i = 0; i < k; ++i)
+  const double *impulses[2] = {normal, tangential};
+  for (int j = 0; j < 2; ++j)
   {
-    const int64_t row = nodes ? nodes[i] : i;
-    for (int c = 0; c < 3; ++c)
-      scratch[3 * i + c] = impulse[3 * i + c] * (v[3 * row + c] - velocity[c]);
+    const double *impulse = impulses[j];
+    out[j] = 0.0;
+    if (!impulse)
+      continue;
+    for (int64_t i = 0; i < k; ++i)
+    {
+      const int64_t row = nodes ? nodes[i] : i;
+      for (int c = 0; c < 3; ++c)
+        scratch[3 * i + c] = impulse[3 * i + c] * (v[3 * row + c] - velocity[c]);
+    }
+    out[j] = numpy_sum(3 * k, scratch);
   }
-  return numpy_sum(3 * k, scratch);
 }
 
 /* The sums over the k listed nodes (masses m, kg; normals n; v* vs, m/s; target normal
@@ -366,6 +377,66 @@ void wall_coupling(int64_t k, int tied, const uint8_t *restrict slip, const doub
     out[c] = M[c];
   for (int j = 0; j < 3; ++j)
     out[9 + j] = slip ? (R[j] - S[j]) - E[j] : R[j] - S[j];
+}
+
+/* The equations of a main-node wall's velocity V (kg, N s) from the sums `total` of
+ * wall_coupling (over all ranks): matrix = mass I + total[0..8], rhs = mass V* + total[9..11],
+ * the rows of the `held` components (held[j] not 0) replaced by V_j = V*_j.  When the
+ * matrix is diagonal (all nodes tied), finite and without zero on its diagonal, V =
+ * rhs / diagonal (what LAPACK's solve gives such a system, to the bit) and returns 1;
+ * else returns 0 (the caller solves). */
+int wall_velocity(const double total[12], double mass, const double predicted[3],
+                  const uint8_t held[3], double matrix[9], double rhs[3], double out[3])
+{
+  int diagonal = 1;
+  for (int j = 0; j < 3; ++j)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const double eye = j == c ? 1.0 : 0.0;
+      matrix[3 * j + c] = held[j] ? eye : mass * eye + total[3 * j + c];
+      if (j != c && matrix[3 * j + c] != 0.0)
+        diagonal = 0;
+    }
+    rhs[j] = held[j] ? predicted[j] : mass * predicted[j] + total[9 + j];
+    const double d = matrix[4 * j];
+    if (!isfinite(d) || d == 0.0 || !isfinite(rhs[j]))
+      diagonal = 0;
+  }
+  if (!diagonal)
+    return 0;
+  for (int j = 0; j < 3; ++j)
+    out[j] = rhs[j] / matrix[4 * j];
+  return 1;
+}
+
+/* The largest absolute values of the n values of v and of a (contiguous: the rows of a
+ * range of nodes), NaN values left out, in out[0] and out[1]: largest_components on
+ * nodes that follow one another, in independent lanes. */
+void largest_range(int64_t n, const double *restrict v, const double *restrict a,
+                   double out[2])
+{
+  double mv[8] = {0.0}, ma[8] = {0.0};
+  int64_t i = 0;
+  for (; i + 8 <= n; i += 8)
+    for (int j = 0; j < 8; ++j)
+    {
+      const double x = fabs(v[i + j]), y = fabs(a[i + j]);
+      mv[j] = x > mv[j] ? x : mv[j];
+      ma[j] = y > ma[j] ? y : ma[j];
+    }
+  for (int j = 0; i < n; ++i, ++j)
+  {
+    const double x = fabs(v[i]), y = fabs(a[i]);
+    mv[j] = x > mv[j] ? x : mv[j];
+    ma[j] = y > ma[j] ? y : ma[j];
+  }
+  out[0] = out[1] = 0.0;
+  for (int j = 0; j < 8; ++j)
+  {
+    out[0] = mv[j] > out[0] ? mv[j] : out[0];
+    out[1] = ma[j] > out[1] ? ma[j] : out[1];
+  }
 }
 
 /* Add the impulses (normal, plus tangential unless NULL; N s) of the k listed nodes to

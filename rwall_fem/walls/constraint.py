@@ -68,8 +68,6 @@ _HORIZON = 16
 # sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
 # covers rounding (a float sum u + dt v moves u by at most twice the increment).
 _TRAVEL = 2.0 * math.sqrt(3.0)
-_EYE = np.eye(3)  # the identity of the main node's equations (read only)
-_EYE.flags.writeable = False
 
 
 def filter_alpha(friction_filter: tuple[str, float] | None, dt: float) -> float:
@@ -126,6 +124,13 @@ class RigidWall:
         self.motion = motion if motion is not None else FixedMotion()
         self.comm = comm
         self.nodes = np.asarray(nodes, dtype=np.int64)
+        # The secondary nodes as a range (first, end) when they follow one another: the bound
+        # on their travel is then a contiguous pass.
+        n = len(self.nodes)
+        follow = n and self.nodes[-1] - self.nodes[0] == n - 1 and np.all(np.diff(self.nodes) == 1)
+        self._span = (int(self.nodes[0]), int(self.nodes[-1]) + 1) if follow else None
+        self._held = np.zeros(3, dtype=np.uint8)  # the main node's held components, a mask
+        self._held[getattr(self.motion, "held", [])] = 1
         self.finite = shape.kind == "parallelogram"
         self.normal_impulse = np.zeros(3)
         self.tangential_impulse = np.zeros(3)
@@ -249,10 +254,12 @@ class RigidWall:
         masses change, and at the start of every step."""
         if self._latest is not None:
             nodes, normal, tangential, final = self._latest
-            passes = self._passes_for(state)
-            self.normal_work += 0.5 * passes.work(normal, final, nodes)
+            normal_work, friction_work = self._passes_for(state).work(
+                normal, tangential, final, nodes
+            )
+            self.normal_work += 0.5 * normal_work
             if tangential is not None:
-                self.friction_work += 0.5 * passes.work(tangential, final, nodes)
+                self.friction_work += 0.5 * friction_work
             self._latest = None
         self.driving_work += self._pending_driving
         self.normal_work += self._pending_body
@@ -306,12 +313,14 @@ class RigidWall:
         if motion.dynamic:
             # The main node takes exactly what the nodes received (momentum to round-off).
             final = predicted - self._summed(impulse_sum) / motion.mass
-            final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
+            if len(motion.held):
+                final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
         before = motion.velocity
         motion.advance(final, dt)
-        self.normal_work += 0.5 * passes.work(normal, before)
+        normal_work, friction_work = passes.work(normal, tangential, before)
+        self.normal_work += 0.5 * normal_work
         if tangential is not None:
-            self.friction_work += 0.5 * passes.work(tangential, before)
+            self.friction_work += 0.5 * friction_work
             self.tangential_impulse -= tangential_sum
         self._latest = (self.touching, normal, tangential, final)
         if motion.prescribed:
@@ -371,7 +380,7 @@ class RigidWall:
         exact translation.
         """
         dt = state.dt
-        speed, acceleration = passes.largest(self.nodes)  # bound |v^{n-1/2}| components, m/s
+        speed, acceleration = passes.largest(self.nodes, self._span)  # bound |v^{n-1/2}| components, m/s
         self._travel += state.dt_previous * speed  # of x^n from where the set was selected
         ahead = speed + state.dt_velocity * acceleration  # bounds those of v*, m/s
         wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster
@@ -401,22 +410,8 @@ class RigidWall:
         the k nodes in contact (``passes``): normal motion shared by all, tangential by the
         tied ones (all if the wall is ``tied``; with ``slip``, those of ``passes.slip``
         that do not slip, the slipping ones giving their tangential impulses on top)."""
-        total = self._summed(passes.coupling(k, self.slide == "tied", slip)).tolist()
-        mass, held = self.motion.mass, self.motion.held
-        matrix = [mass * (1.0 if i % 4 == 0 else 0.0) + total[i] for i in range(9)]
-        rhs = [mass * p + r for p, r in zip(predicted.tolist(), total[9:])]
-        for j in held.tolist():  # held components: V_j = V*_j
-            matrix[3 * j : 3 * j + 3] = _EYE[j].tolist()
-            rhs[j] = float(predicted[j])
-        diagonal = matrix[0::4]
-        if (
-            not any(matrix[i] for i in (1, 2, 3, 5, 6, 7))
-            and all(math.isfinite(d) and d != 0.0 for d in diagonal)
-            and all(math.isfinite(r) for r in rhs)
-        ):
-            # A diagonal system (all nodes tied): LAPACK's solve divides, to the bit.
-            return np.array([r / d for r, d in zip(rhs, diagonal)])
-        return np.linalg.solve(np.array(matrix).reshape(3, 3), np.array(rhs))
+        total = self._summed(passes.coupling(k, self.slide == "tied", slip))
+        return passes.velocity(total, self.motion.mass, predicted, self._held)
 
     def _summed(self, values: np.ndarray) -> np.ndarray:
         """``values`` summed over the ranks (on one rank, themselves: no exchange)."""

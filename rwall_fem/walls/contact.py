@@ -68,8 +68,10 @@ class ContactPasses:
         # offset, next offset and velocity of the wall (m, m, m/s), then the sums of apply
         self._vectors = np.zeros(3 * 3 + 9)
         self._vectors_pointer = _pointer(self.ffi, self._vectors)
-        self._coupling = np.zeros(12)  # the sums of coupling
+        # the sums of coupling; then the main node's matrix, right side and velocity; works
+        self._coupling = np.zeros(12 + 9 + 3 + 3 + 2)
         self._coupling_pointer = _pointer(self.ffi, self._coupling)
+        self._coupling_sums = self._coupling[:12]
         self._clearance = np.zeros(0)
         self._reserve(0)
 
@@ -110,12 +112,19 @@ class ContactPasses:
         )  # fmt: skip
         return self._clearance, largest
 
-    def largest(self, nodes: np.ndarray) -> tuple[float, float]:
+    def largest(self, nodes: np.ndarray, span: tuple[int, int] | None = None) -> tuple[float, float]:
         """The largest absolute component of the velocities (m/s) and of the accelerations
-        (m/s^2) of ``nodes`` (node indices, int64; NaN if one is NaN), in one pass."""
+        (m/s^2) of ``nodes`` (node indices, int64; NaN values left out), in one pass; with
+        ``span`` (first, end), ``nodes`` are the range first, ..., end - 1 (a contiguous
+        pass)."""
         sums = self._vectors_pointer + 9
-        rows = _pointer(self.ffi, nodes, "int64_t[]")
-        self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
+        if span is not None:
+            first, end = span
+            self.lib.largest_range(3 * (end - first), self._v + 3 * first, self._a + 3 * first,
+                                   sums)  # fmt: skip
+        else:
+            rows = _pointer(self.ffi, nodes, "int64_t[]")
+            self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
         speed, acceleration = self._vectors[9:11].tolist()
         return speed, acceleration
 
@@ -170,19 +179,38 @@ class ContactPasses:
             k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
             q["target"], q["tangential"] if slip else null, self._coupling_pointer,
         )  # fmt: skip
-        return self._coupling
+        return self._coupling_sums
 
-    def work(self, impulse: np.ndarray, velocity, nodes: np.ndarray | None = None) -> float:
-        """sum impulse . (v - ``velocity``) (N m/s) over the rows of ``impulse`` (k, 3):
-        with ``nodes``, v is the nodes' current velocity, else :attr:`previous`."""
-        k = len(impulse)
+    def velocity(self, total: np.ndarray, mass: float, predicted: np.ndarray, held) -> np.ndarray:
+        """The main node's velocity (m/s) over the step from the sums ``total`` of
+        :meth:`coupling` over the ranks: (M I + total) V = M V* + total's right side, V_j =
+        V*_j for the components ``held`` (a uint8 mask of 3; kg, m/s). A diagonal system
+        (all nodes tied) is divided (what LAPACK's solve does to it, to the bit), another
+        solved by NumPy."""
+        c, q, ffi = self._coupling, self._coupling_pointer, self.ffi
+        if total is not self._coupling_sums:
+            c[:12] = total
+        p, held = ffi.from_buffer("double[]", predicted), ffi.from_buffer("uint8_t[]", held)
+        if self.lib.wall_velocity(q, mass, p, held, q + 12, q + 21, q + 24):
+            return c[24:27].copy()
+        return np.linalg.solve(c[12:21].reshape(3, 3), c[21:24])
+
+    def work(self, normal, tangential, velocity, nodes=None) -> tuple[float, float]:
+        """sum impulse . (v - ``velocity``) (N m/s) over the rows of the impulses ``normal``
+        and ``tangential`` (k, 3; or None: 0), in one pass: with ``nodes``, v is the nodes'
+        current velocity, else :attr:`previous`."""
+        k = len(normal)
         self._reserve(k)
         self._vectors[6:9] = velocity
         if nodes is None:
             rows, v = self.ffi.NULL, self._pointers["previous"]
         else:
             rows, v = _pointer(self.ffi, nodes, "int64_t[]"), self._v
-        return self.lib.wall_work(
-            k, rows, _pointer(self.ffi, impulse), v, self._vectors_pointer + 6,
-            self._pointers["_scratch"],
+        t = self.ffi.NULL if tangential is None else _pointer(self.ffi, tangential)
+        out = self._coupling_pointer + 27
+        self.lib.wall_work(
+            k, rows, _pointer(self.ffi, normal), t, v, self._vectors_pointer + 6,
+            self._pointers["_scratch"], out,
         )  # fmt: skip
+        normal_work, tangential_work = self._coupling[27:29].tolist()
+        return normal_work, tangential_work

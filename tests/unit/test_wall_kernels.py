@@ -159,9 +159,14 @@ def test_impulses_applied_and_booked_as_numpy_does(slide):
         np.testing.assert_array_equal(sums[1], tangential.sum(axis=0))
 
     before, final = np.array([0.5, 0.1, -0.2]), np.array([0.4, 0.2, -0.1])
-    assert passes.work(normal, before) == (normal * (passes.previous[:k] - before)).sum()
+    works = passes.work(normal, tangential, before)
+    assert works[0] == (normal * (passes.previous[:k] - before)).sum()
     nodes = passes.nodes[:k].copy()
-    assert passes.work(normal, final, nodes) == (normal * (s.v[nodes] - final)).sum()
+    assert passes.work(normal, None, final, nodes) == ((normal * (s.v[nodes] - final)).sum(), 0)
+    if tangential is not None:
+        assert works[1] == (tangential * (passes.previous[:k] - before)).sum()
+        works = passes.work(normal, tangential, final, nodes)
+        assert works[1] == (tangential * (s.v[nodes] - final)).sum()
 
 
 @pytest.mark.parametrize("n", [0, 1, 2, 7, 8, 9, 15, 16, 17, 100, 127, 128, 129, 255, 256, 1000,
@@ -195,10 +200,16 @@ def test_the_bound_on_travel_is_the_largest_component():
     nodes = np.sort(RNG.choice(len(s.mass), 101, replace=False)).astype(np.int64)
     passes = ContactPasses(shape, s)
     assert passes.largest(nodes) == (np.abs(s.v[nodes]).max(), np.abs(s.a[nodes]).max())
+    span = np.arange(37, 37 + 203)  # a range of nodes: the contiguous pass
+    assert passes.largest(span, (37, 240)) == (np.abs(s.v[span]).max(), np.abs(s.a[span]).max())
     s.v[nodes[3], 1] = np.nan  # left out: such a node fails its test
     s.a[nodes[5], 2] = -np.inf
+    s.v[100, 2], s.a[200, 0] = np.nan, -np.inf
     speed, acceleration = passes.largest(nodes)
     assert speed == np.nanmax(np.abs(s.v[nodes])) and acceleration == np.inf
+    assert passes.largest(span, (37, 240)) == (np.nanmax(np.abs(s.v[span])), np.inf)
+    s.a[200, 0] = 0.0
+    assert passes.largest(span, (37, 240))[1] == np.abs(s.a[span]).max()
 
 
 def numpy_coupled_velocity(mass, held, predicted, m, n, vs, target, tied, extra=None):
