@@ -21,6 +21,10 @@ from rwall_fem.walls.motion import PrescribedMotion
 
 __all__ = ["VelocityBoundary"]
 
+# The most values the compiled pass sums as NumPy does (one block of NumPy's buffer; more,
+# and NumPy sums them, as its versions differ there).
+_SUMMED = 8192
+
 
 class VelocityBoundary:
     """Prescribed velocity of some components of the nodes ``nodes`` (local indices, a set:
@@ -46,6 +50,7 @@ class VelocityBoundary:
         self._reactions = np.zeros(self._flat.shape)
         self._power = np.zeros(self._flat.shape)
         self._sums = np.zeros(len(self.axes))
+        self._works = np.zeros(2)  # the powers summed, the latest step's and this one's
         self._target = np.zeros(len(self.axes))
         self._constant = len(self.prescribed.times) == 1
         if self._constant:
@@ -74,6 +79,7 @@ class VelocityBoundary:
                 "flat": p("int64_t[]", self._flat), "target": p("double[]", self._target),
                 "reactions": p("double[]", self._reactions),
                 "power": p("double[]", self._power), "sums": p("double[]", self._sums),
+                "works": p("double[]", self._works),
             }  # fmt: skip
             self._bound = (state, ffi, lib, pointers)
         return self._bound[1:]
@@ -95,13 +101,20 @@ class VelocityBoundary:
         dt^{n+1/2}/2), the velocity update's step being dt^n (``state.dt_velocity``)."""
         if not self._constant:
             self._target[:] = self.prescribed.predict(state.t, state.dt)[self.axes]
-        self.settle(state)
+        summed = self._reactions.size <= _SUMMED
+        settle = summed and self._reaction is self._reactions  # in the same pass
+        if not settle:
+            self.settle(state)
         ffi, lib, q = self._pointers(state)
         lib.boundary_velocity(
             len(self.nodes), len(self.axes), q["nodes"], q["flat"], q["target"],
             state.dt_velocity, q["mass"], q["v"], q["a"], q["reactions"], q["power"], q["sums"],
+            settle, q["works"],
         )  # fmt: skip
-        self.work += 0.5 * float(np.sum(self._power))
+        latest, now = self._works.tolist()
+        if settle:
+            self.work += 0.5 * latest
+        self.work += 0.5 * (now if summed else float(np.sum(self._power)))
         self._reaction = self._reactions
         # NumPy's sum over the nodes of one component is pairwise, of 2 or 3 in node order.
         sums = self._sums if len(self.axes) > 1 else self._reactions.sum(axis=0)

@@ -169,7 +169,8 @@ void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *
                 const double *tangential, double dt_v, double *a, double out[9]);
 void boundary_velocity(int64_t n, int64_t axes, const int32_t *nodes, const int64_t *flat,
                        const double *target, double dt_v, const double *mass, const double *v,
-                       double *a, double *reaction, double *power, double *sums);
+                       double *a, double *reaction, double *power, double *sums, int settle,
+                       double works[2]);
 void boundary_power(int64_t m, const int64_t *flat, const double *reaction, const double *v,
                     double *power);
 void wall_coupling(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,

@@ -7,23 +7,41 @@
  * boundary_power: the reaction's power against the velocities the nodes have now.
  *
  * The arithmetic is that of the NumPy code these replace, operation for operation, so that
- * results stay the same to the bit; the powers are summed by NumPy (boundary.py). The
- * prescribed places are distinct (a node set). */
+ * results stay the same to the bit; the powers are summed as NumPy sums them (numpy_sum of
+ * wall.c; boundary.py sums more than one block of NumPy's buffer itself). The prescribed
+ * places are distinct (a node set). */
 #include <stdint.h>
 
 #pragma GCC optimize("fp-contract=off")
+
+double numpy_sum(int64_t n, const double *a);
+
+/* power = reaction * v at the m places `flat` (N m/s). */
+void boundary_power(int64_t m, const int64_t *restrict flat, const double *restrict reaction,
+                    const double *restrict v, double *restrict power)
+{
+  for (int64_t i = 0; i < m; ++i)
+    power[i] = reaction[i] * v[flat[i]];
+}
 
 /* For the n nodes `nodes` (rows of mass) with their `axes` prescribed components at the
  * places `flat` (n x axes indices into the flattened (nodes, 3) arrays v and a) prescribed
  * `target` (axes values, m/s): reaction and power (n x axes, N s and N m/s), sums (axes
  * values, N s, the reactions summed node after node: NumPy's order for 2 or 3 components,
- * not for 1); a^n of those places set. */
+ * not for 1); a^n of those places set.  works[1] = the power summed; with `settle`, first
+ * works[0] = the power of the latest step's reaction (in `reaction`) at v now, summed. */
 void boundary_velocity(int64_t n, int64_t axes, const int32_t *restrict nodes,
                        const int64_t *restrict flat, const double *restrict target, double dt_v,
                        const double *restrict mass, const double *restrict v,
                        double *restrict a, double *restrict reaction, double *restrict power,
-                       double *restrict sums)
+                       double *restrict sums, int settle, double works[2])
 {
+  works[0] = 0.0;
+  if (settle)
+  {
+    boundary_power(n * axes, flat, reaction, v, power);
+    works[0] = numpy_sum(n * axes, power);
+  }
   for (int64_t c = 0; c < axes; ++c)
     sums[c] = 0.0;
   for (int64_t i = 0; i < n; ++i)
@@ -40,12 +58,5 @@ void boundary_velocity(int64_t n, int64_t axes, const int32_t *restrict nodes,
       sums[c] += r;
     }
   }
-}
-
-/* power = reaction * v at the m places `flat` (N m/s). */
-void boundary_power(int64_t m, const int64_t *restrict flat, const double *restrict reaction,
-                    const double *restrict v, double *restrict power)
-{
-  for (int64_t i = 0; i < m; ++i)
-    power[i] = reaction[i] * v[flat[i]];
+  works[1] = numpy_sum(n * axes, power);
 }

@@ -46,10 +46,11 @@ class NumpyBoundary:
 
 @pytest.mark.parametrize("components", ["xyz", "z", "xz"])
 @pytest.mark.parametrize("velocity", [[0.0, 0.0, 0.0], [[0.0, 1.0, -2.0, 3.0], [1e-6, -4.0, 5.0, 0.5]]])
-def test_boundary_pass_is_numpys(components, velocity):
-    state, reference = State(), State()
+@pytest.mark.parametrize("count", [130, 3000])  # sums in C; more than NumPy's buffer (xyz)
+def test_boundary_pass_is_numpys(components, velocity, count):
+    state, reference = State(4000), State(4000)
     reference.v, reference.a = state.v.copy(), state.a.copy()
-    nodes = np.sort(RNG.choice(len(state.mass), 130, replace=False))
+    nodes = np.sort(RNG.choice(len(state.mass), count, replace=False))
     reference.mass = state.mass
     compiled = VelocityBoundary("compiled", nodes, velocity, components)
     numpy = NumpyBoundary(nodes, velocity, components)
@@ -66,6 +67,8 @@ def test_boundary_pass_is_numpys(components, velocity):
             s.v[::7] *= 0.5
             s.a[:] = np.arange(s.a.size).reshape(s.a.shape) * 1e3
             s.t += s.dt
+        if step == 1:  # as after a resume: the latest reaction is the checkpoint's
+            compiled.restore_state({k: v.copy() for k, v in compiled.checkpoint_state().items()})
     compiled.settle(state)
     numpy.constrain(reference)  # books the latest half the same way
     assert compiled.work != 0.0
