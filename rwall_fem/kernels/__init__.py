@@ -166,7 +166,12 @@ int wall_velocity(const double total[12], double mass, const double predicted[3]
                   const uint8_t held[3], double matrix[9], double rhs[3], double out[3]);
 void largest_range(int64_t n, const double *v, const double *a, double out[2]);
 void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
-                const double *tangential, double dt_v, double *a, double out[9]);
+                const double *tangential, double dt_v, double *a, double out[9],
+                const double *previous, const double before[3], double *scratch,
+                double works[2]);
+int wall_coupled(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,
+                 const double *vs, const double *target, const double *tangential, double mass,
+                 const double predicted[3], const uint8_t held[3], double out[27]);
 void boundary_velocity(int64_t n, int64_t axes, const int32_t *nodes, const int64_t *flat,
                        const double *target, double dt_v, const double *mass, const double *v,
                        double *a, double *reaction, double *power, double *sums, int settle,

@@ -410,6 +410,18 @@ int wall_velocity(const double total[12], double mass, const double predicted[3]
   return 1;
 }
 
+/* wall_coupling and wall_velocity in one call (one rank: the sums are the totals): out[0..11]
+ * the sums, out[12..20] the matrix, out[21..23] the right side, out[24..26] V if solved;
+ * returns whether it was. */
+int wall_coupled(int64_t k, int tied, const uint8_t *restrict slip, const double *restrict m,
+                 const double *restrict n, const double *restrict vs,
+                 const double *restrict target, const double *restrict tangential, double mass,
+                 const double predicted[3], const uint8_t held[3], double out[27])
+{
+  wall_coupling(k, tied, slip, m, n, vs, target, tangential, out);
+  return wall_velocity(out, mass, predicted, held, out + 12, out + 21, out + 24);
+}
+
 /* The largest absolute values of the n values of v and of a (contiguous: the rows of a
  * range of nodes), NaN values left out, in out[0] and out[1]: largest_components on
  * nodes that follow one another, in independent lanes. */
@@ -441,10 +453,13 @@ void largest_range(int64_t n, const double *restrict v, const double *restrict a
 
 /* Add the impulses (normal, plus tangential unless NULL; N s) of the k listed nodes to
  * their accelerations a^n as impulse / (m dt_v), and sum over the nodes (in order):
- * out[0..2] the normal impulses, out[3..5] the tangential ones, out[6..8] both (N s). */
+ * out[0..2] the normal impulses, out[3..5] the tangential ones, out[6..8] both (N s); then
+ * the works' halves at v^{n-1/2} (`previous`, rows of 3) relative to the wall's velocity
+ * `before` (wall_work: works[0] normal, works[1] tangential; scratch of 3 k values). */
 void wall_apply(int64_t k, const int64_t *restrict nodes, const double *restrict m,
                 const double *restrict normal, const double *restrict tangential, double dt_v,
-                double *restrict a, double out[9])
+                double *restrict a, double out[9], const double *restrict previous,
+                const double before[3], double *restrict scratch, double works[2])
 {
   for (int c = 0; c < 9; ++c)
     out[c] = 0.0;
@@ -461,6 +476,7 @@ void wall_apply(int64_t k, const int64_t *restrict nodes, const double *restrict
       out[6 + c] += impulse;
     }
   }
+  wall_work(k, NULL, normal, tangential, previous, before, scratch, works);
 }
 
 /* The largest velocity and acceleration components |v_i| and |a_i| of the n nodes `nodes`

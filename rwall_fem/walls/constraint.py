@@ -307,7 +307,9 @@ class RigidWall:
         tangential = None if free else passes.tangential[:k]
         if self._previous_tangential is not None:
             self._previous_tangential[self._filtered_rows] = tangential
-        normal_sum, tangential_sum, impulse_sum = passes.apply(k, not free, dt_v)
+        before = motion.velocity
+        sums, (normal_work, friction_work) = passes.apply(k, not free, dt_v, before)
+        normal_sum, tangential_sum, impulse_sum = sums
 
         final = wall_velocity
         if motion.dynamic:
@@ -315,9 +317,7 @@ class RigidWall:
             final = predicted - self._summed(impulse_sum) / motion.mass
             if len(motion.held):
                 final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
-        before = motion.velocity
         motion.advance(final, dt)
-        normal_work, friction_work = passes.work(normal, tangential, before)
         self.normal_work += 0.5 * normal_work
         if tangential is not None:
             self.friction_work += 0.5 * friction_work
@@ -410,8 +410,11 @@ class RigidWall:
         the k nodes in contact (``passes``): normal motion shared by all, tangential by the
         tied ones (all if the wall is ``tied``; with ``slip``, those of ``passes.slip``
         that do not slip, the slipping ones giving their tangential impulses on top)."""
-        total = self._summed(passes.coupling(k, self.slide == "tied", slip))
-        return passes.velocity(total, self.motion.mass, predicted, self._held)
+        tied, mass = self.slide == "tied", self.motion.mass
+        if self.comm.size == 1:
+            return passes.coupled_velocity(k, tied, slip, mass, predicted, self._held)
+        total = self.comm.allreduce(passes.coupling(k, tied, slip))
+        return passes.velocity(total, mass, predicted, self._held)
 
     def _summed(self, values: np.ndarray) -> np.ndarray:
         """``values`` summed over the ranks (on one rank, themselves: no exchange)."""

@@ -156,16 +156,21 @@ class ContactPasses:
             q["slip"],
         )  # fmt: skip
 
-    def apply(self, k: int, tangential: bool, dt_v: float) -> np.ndarray:
+    def apply(self, k: int, tangential: bool, dt_v: float, before) -> tuple:
         """Add the impulses of the k nodes in contact (the normal ones, and the tangential
         if ``tangential``) to their accelerations, impulse / (m dt_v); returns the sums
         over them of the normal, tangential and whole impulses (N s; rows of a (3, 3)
-        view)."""
-        q = self._pointers
+        view) and the sums of impulse . (v^{n-1/2} - ``before``) (N m/s; normal and
+        tangential, 0 without: the works' first halves at the wall's velocity before)."""
+        q, w = self._pointers, self._vectors_pointer
         t = q["tangential"] if tangential else self.ffi.NULL
-        sums = self._vectors_pointer + 9
-        self.lib.wall_apply(k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, sums)
-        return self._vectors[9:].reshape(3, 3)
+        self._vectors[6:9] = before
+        self.lib.wall_apply(
+            k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, w + 9, q["previous"],
+            w + 6, q["_scratch"], self._coupling_pointer + 27,
+        )  # fmt: skip
+        normal_work, tangential_work = self._coupling[27:29].tolist()
+        return self._vectors[9:].reshape(3, 3), (normal_work, tangential_work)
 
     def coupling(self, k: int, tied: bool, slip: bool = False) -> np.ndarray:
         """The sums over the k nodes in contact of the equations of a main-node wall's
@@ -181,6 +186,18 @@ class ContactPasses:
         )  # fmt: skip
         return self._coupling_sums
 
+    def coupled_velocity(self, k: int, tied: bool, slip: bool, mass: float, predicted, held):
+        """:meth:`coupling` then :meth:`velocity` in one call, on one rank (its sums are the
+        totals)."""
+        q, c, null = self._pointers, self._coupling_pointer, self.ffi.NULL
+        p, held = self.ffi.from_buffer("double[]", predicted), self.ffi.from_buffer("uint8_t[]", held)
+        if self.lib.wall_coupled(
+            k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
+            q["target"], q["tangential"] if slip else null, mass, p, held, c,
+        ):  # fmt: skip
+            return self._coupling[24:27].copy()
+        return np.linalg.solve(self._coupling[12:21].reshape(3, 3), self._coupling[21:24])
+
     def velocity(self, total: np.ndarray, mass: float, predicted: np.ndarray, held) -> np.ndarray:
         """The main node's velocity (m/s) over the step from the sums ``total`` of
         :meth:`coupling` over the ranks: (M I + total) V = M V* + total's right side, V_j =
@@ -195,22 +212,17 @@ class ContactPasses:
             return c[24:27].copy()
         return np.linalg.solve(c[12:21].reshape(3, 3), c[21:24])
 
-    def work(self, normal, tangential, velocity, nodes=None) -> tuple[float, float]:
+    def work(self, normal, tangential, velocity, nodes) -> tuple[float, float]:
         """sum impulse . (v - ``velocity``) (N m/s) over the rows of the impulses ``normal``
-        and ``tangential`` (k, 3; or None: 0), in one pass: with ``nodes``, v is the nodes'
-        current velocity, else :attr:`previous`."""
+        and ``tangential`` (k, 3; or None: 0), v the current velocity of the ``nodes``
+        (node indices, int64), in one pass."""
         k = len(normal)
         self._reserve(k)
         self._vectors[6:9] = velocity
-        if nodes is None:
-            rows, v = self.ffi.NULL, self._pointers["previous"]
-        else:
-            rows, v = _pointer(self.ffi, nodes, "int64_t[]"), self._v
         t = self.ffi.NULL if tangential is None else _pointer(self.ffi, tangential)
-        out = self._coupling_pointer + 27
         self.lib.wall_work(
-            k, rows, _pointer(self.ffi, normal), t, v, self._vectors_pointer + 6,
-            self._pointers["_scratch"], out,
+            k, _pointer(self.ffi, nodes, "int64_t[]"), _pointer(self.ffi, normal), t, self._v,
+            self._vectors_pointer + 6, self._pointers["_scratch"], self._coupling_pointer + 27,
         )  # fmt: skip
         normal_work, tangential_work = self._coupling[27:29].tolist()
         return normal_work, tangential_work

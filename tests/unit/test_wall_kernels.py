@@ -149,7 +149,8 @@ def test_impulses_applied_and_booked_as_numpy_does(slide):
         assert 0 < slip.sum() < k  # some slip, some stick
 
     a = s.a.copy()
-    sums = passes.apply(k, tangential is not None, dt_v)
+    before, final = np.array([0.5, 0.1, -0.2]), np.array([0.4, 0.2, -0.1])
+    sums, works = passes.apply(k, tangential is not None, dt_v, before)
     impulse = normal if tangential is None else normal + tangential
     a[passes.nodes[:k]] += impulse / (m * dt_v)
     np.testing.assert_array_equal(s.a, a)
@@ -158,8 +159,6 @@ def test_impulses_applied_and_booked_as_numpy_does(slide):
     if tangential is not None:
         np.testing.assert_array_equal(sums[1], tangential.sum(axis=0))
 
-    before, final = np.array([0.5, 0.1, -0.2]), np.array([0.4, 0.2, -0.1])
-    works = passes.work(normal, tangential, before)
     assert works[0] == (normal * (passes.previous[:k] - before)).sum()
     nodes = passes.nodes[:k].copy()
     assert passes.work(normal, None, final, nodes) == ((normal * (s.v[nodes] - final)).sum(), 0)
@@ -255,6 +254,8 @@ def test_main_node_coupling_is_numpys(slide, held):
     sums, expected = numpy_coupled_velocity(0.02, motion.held, velocity, m, n, vs, target, tied)
     np.testing.assert_array_equal(passes.coupling(k, slide == "tied"), sums)
     np.testing.assert_array_equal(wall._coupled_velocity(velocity, passes, k), expected)
+    totals = passes.coupling(k, slide == "tied").copy()  # as summed over the ranks
+    np.testing.assert_array_equal(passes.velocity(totals, 0.02, velocity, wall._held), expected)
     if slide != "friction":
         return
     passes.impulses(k, slide, 0.2, 1.0, expected)
