@@ -47,8 +47,8 @@ secondary nodes, the wall's exact translation) and selects the set again, from a
 secondary nodes, before that bound passes the budget. No node the wall would treat
 is ever left out, so the results are those of testing every secondary node; each
 rank decides on its own nodes, without communication. The passes over the nodes (the
-test, the impulses, the bound, the selection) are compiled
-(:mod:`rwall_fem.walls.contact`).
+test, the impulses, the main node's equations, the works, the bound, the selection) are
+compiled (:mod:`rwall_fem.walls.contact`).
 """
 
 from __future__ import annotations
