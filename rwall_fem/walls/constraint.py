@@ -380,7 +380,8 @@ class RigidWall:
         exact translation.
         """
         dt = state.dt
-        speed, acceleration = passes.largest(self.nodes, self._span)  # bound |v^{n-1/2}| components, m/s
+        # bounds on the |v^{n-1/2}| (m/s) and |a^n| (m/s^2) components
+        speed, acceleration = passes.largest(self.nodes, self._span)
         self._travel += state.dt_previous * speed  # of x^n from where the set was selected
         ahead = speed + state.dt_velocity * acceleration  # bounds those of v*, m/s
         wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster

@@ -112,7 +112,7 @@ class ContactPasses:
         )  # fmt: skip
         return self._clearance, largest
 
-    def largest(self, nodes: np.ndarray, span: tuple[int, int] | None = None) -> tuple[float, float]:
+    def largest(self, nodes: np.ndarray, span: tuple[int, int] | None = None) -> tuple:
         """The largest absolute component of the velocities (m/s) and of the accelerations
         (m/s^2) of ``nodes`` (node indices, int64; NaN values left out), in one pass; with
         ``span`` (first, end), ``nodes`` are the range first, ..., end - 1 (a contiguous
@@ -190,7 +190,8 @@ class ContactPasses:
         """:meth:`coupling` then :meth:`velocity` in one call, on one rank (its sums are the
         totals)."""
         q, c, null = self._pointers, self._coupling_pointer, self.ffi.NULL
-        p, held = self.ffi.from_buffer("double[]", predicted), self.ffi.from_buffer("uint8_t[]", held)
+        p = self.ffi.from_buffer("double[]", predicted)
+        held = self.ffi.from_buffer("uint8_t[]", held)
         if self.lib.wall_coupled(
             k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
             q["target"], q["tangential"] if slip else null, mass, p, held, c,

@@ -45,7 +45,9 @@ class NumpyBoundary:
 
 
 @pytest.mark.parametrize("components", ["xyz", "z", "xz"])
-@pytest.mark.parametrize("velocity", [[0.0, 0.0, 0.0], [[0.0, 1.0, -2.0, 3.0], [1e-6, -4.0, 5.0, 0.5]]])
+@pytest.mark.parametrize(
+    "velocity", [[0.0, 0.0, 0.0], [[0.0, 1.0, -2.0, 3.0], [1e-6, -4.0, 5.0, 0.5]]]
+)
 @pytest.mark.parametrize("count", [130, 3000])  # sums in C; more than NumPy's buffer (xyz)
 def test_boundary_pass_is_numpys(components, velocity, count):
     state, reference = State(4000), State(4000)
