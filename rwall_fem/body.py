@@ -142,6 +142,32 @@ class PartedBody(ErodingBody):
     (what the kernels noted of the stable steps) and ``explicit`` (the scene gave its
     parts)."""
 
+    _nodal = None  # the cells' nodal term of the step (track_nodal_stiffness), a la vector
+
+    def track_nodal_stiffness(self, surface: np.ndarray) -> np.ndarray:
+        """From now on, every pass gives each node the sum over its cells of m_c / dt_e^2
+        (N/m; m_c the mass the cell gives it, dt_e the cell's calibrated estimate) in the
+        returned array (a row per node: complete on the owned rows, changed in place only),
+        for the nodal stable step of contact (docs/theory.md, contact's "Stable step"):
+        at least at the nodes ``surface`` (a bool per node row, owned and ghost), whose cells
+        alone add it."""
+        if self._nodal is None:
+            self._nodal = la.vector(self.V.dofmap.index_map, 1)
+            for part, force in zip(self.parts, self.elements, strict=True):
+                force.note_nodal_stiffness(self._nodal.array, float(part.material.density),
+                                           surface)  # fmt: skip
+        return self._nodal.array
+
+    def _begin_nodal_stiffness(self) -> None:
+        """Zero the nodal term before the parts' passes."""
+        if self._nodal is not None:
+            self._nodal.array.fill(0.0)
+
+    def _end_nodal_stiffness(self) -> None:
+        """The ghosts' shares of the nodal term to their owners, after the passes."""
+        if self._nodal is not None and self.V.mesh.comm.size > 1:
+            _compat.scatter_reverse_add(self._nodal)
+
     def _combine_steps(self) -> None:
         """:attr:`step` from the parts' notes: the smallest estimate, its cell (an index
         among the owned cells) and place, the inverted cells."""
@@ -322,6 +348,7 @@ class Body(PartedBody):
         if self.books_work:
             self._second_halves_at_interfaces()
         self.f.array.fill(0.0)
+        self._begin_nodal_stiffness()
         shared = self._shared if self.books_work else None
         for k, force in enumerate(self.elements):
             if shared is not None:  # what this part adds at the interfaces
@@ -334,6 +361,7 @@ class Body(PartedBody):
         if shared is not None:
             self._interface_first = np.array([work() for work in self._interface_works])
         self.f.scatter_reverse_add()
+        self._end_nodal_stiffness()
         if not self._alone:
             self._combine_steps()
         self._acceleration = acceleration_pass(self._acceleration, self.f.array,

@@ -197,6 +197,23 @@ class InternalForce:
         p.below = ffi.cast("int32_t *", self.below.ctypes.data)
         p.below_step = ffi.cast("double *", self.below_step.ctypes.data)
 
+    def note_nodal_stiffness(
+        self, nodal: np.ndarray, density: float, surface: np.ndarray
+    ) -> None:
+        """From now on, estimate every step and add the m_c / dt_e^2 (N/m) of each cell with
+        a node in ``surface`` (a bool per node row) into ``nodal`` (a row per node, owned
+        and ghost; zeroed by the caller before a pass), m_c = ``density`` (kg/m^3) x its
+        volume at rest / its nodes, the mass it gives each node (kg; exact for triangles,
+        quadrilaterals and tetrahedra, the mean share for hexahedra): the element part of
+        the nodal stable step of contact at the surface nodes."""
+        self.estimate_every_step = True
+        share = density * self.volume0 / self.cells.shape[1]
+        self._nodal_mass = np.where(surface[self.cells].any(axis=1), share, 0.0)
+        self._nodal = nodal  # what the kernels' pointer points into
+        p, ffi = self.params, self.ffi
+        p.nodal_mass = ffi.cast("double *", self._nodal_mass.ctypes.data)
+        p.nodal_stiffness = ffi.cast("double *", nodal.ctypes.data)
+
     def erode_below(self, floor: float) -> None:
         """From now on, erode the cells whose step estimate falls below ``floor`` (s), and
         inverted ones (``run.dt_min_action = "erode"``; the estimates are made every step)."""

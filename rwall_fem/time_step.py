@@ -131,11 +131,9 @@ class _StepSize:
             self._local[:] = (step[0], -step[5], -step[10], -step[11], contact)
             self.comm.Allreduce(self._local, self._total, op=MPI.MIN)
             smallest, inverted, listed, eroded, contact = self._total.tolist()
-        if self.contacts:
-            # A node held by cells and contact springs: 1/dt^2 adds up (conservatively,
-            # with the smallest cell's step).
-            if math.isfinite(contact):
-                smallest = 1.0 / math.sqrt(1.0 / smallest**2 + 1.0 / contact**2)
+        # The contact nodes' own steps, cells and springs combined node by node
+        # (ContactInterface.combine_with), beside the cells'.
+        smallest = min(smallest, contact)
         self._reductions += 1
         self.limit = smallest
         if inverted:

@@ -73,7 +73,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
     owned = solid.V.dofmap.index_map.local_to_global(np.arange(solid.owned, dtype=np.int32))
     surfaces: dict[str, Surface] = {}
     eroding: dict[str, ErodingSurface] = {}  # the parts whose cells may erode
-    interfaces = []
+    interfaces, all_nodes = [], []  # and the surface nodes of each (global numbers)
     held = _held_at_rest(scene, solid)
     # The faces of each solid part left out, on symmetry planes (shells: the sides on
     # them), and the axes of their planes
@@ -203,6 +203,16 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                         f"fraction of the parts (default {default})"
                     )
         interfaces.append(interface)
+        all_nodes.append(nodes)
+    if interfaces:
+        # The step of a node held by cells and contact springs, node by node: the cells'
+        # term, from the cells at some surface node (every node of an eroding part's).
+        imap = solid.V.dofmap.index_map
+        rows = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32)
+        surface = np.isin(imap.local_to_global(rows), np.concatenate(all_nodes))
+        element = (internal or body).track_nodal_stiffness(surface)
+        for interface in interfaces:
+            interface.combine_with(element)
     return interfaces
 
 

@@ -168,6 +168,8 @@ class ContactInterface:
         self.node_size = None  # m per owned surface node (vary_gap)
         self.mirrored = None  # the owned surface nodes' shares and planes (mirror)
         self.dt_limit = math.inf  # the nodal stable step of the latest pass on this rank, s
+        self._element = self.ffi.NULL  # the cells' nodal term of the step (combine_with)
+        self._element_array = None
         self.sorts = 0
         self.sent = 0  # bytes this rank sent for the search (sorts); the ghosts count theirs
         self._ghosts = Ghosts(self.owners, np.zeros(0, dtype=np.int64), self.ids)
@@ -587,13 +589,22 @@ class ContactInterface:
         _, _, mass, force, stiffness, kept = self._surface
         _, _, state_v, state_mass, a = self._state
         lib.contact_apply(n, self._rows, force, stiffness, mass, state_mass, state_v, a, kept,
-                          self._read_pointers[1])  # fmt: skip
+                          self._element, self._read_pointers[1])  # fmt: skip
         self._first, self.dt_limit = self._apply_out.tolist()
         self.energy = energy + tangential
         self.dissipated += dissipated
         self.latest, self.normal_force, self.contacts = latest, normal, contacts
         self._pending = True
         self._previous_dt = s.dt_previous
+
+    def combine_with(self, element: np.ndarray) -> None:
+        """Make :attr:`dt_limit` the nodal step of the cells and springs together,
+        min sqrt(m / (e + k / 2)) over the nodes with contact stiffness k (N/m), ``element``
+        (N/m, a row per node of the state, complete on the owned rows; the body's
+        :meth:`~rwall_fem.body.PartedBody.track_nodal_stiffness`, changed in place only)
+        giving each node's e = sum_c m_c / dt_e^2 of its cells."""
+        self._element_array = element
+        self._element = self._pointer(element)
 
     def nodal_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What the latest pass added to the accelerations: the state rows of this rank's

@@ -1,12 +1,12 @@
 """Compiled element kernels: C compiled at first use through cffi and cached.
 
 The C sources beside this file (one per element family, with the formulas in
-their header comments; ``update.c``, ``wall.c`` and ``contact.c`` for the per-node passes
-of a step, the update, the rigid walls and the contact interfaces, which share the
-friction law of ``friction.h``) are compiled into one extension module the first time a
-process needs them, the way FFCx compiles forms (the shells' kernels into a second one,
-an :class:`Extension` of :mod:`rwall_fem.shells.elements`, by the same :func:`load`), and
-cached per user under
+their header comments; ``update.c``, ``wall.c``, ``boundary.c`` and ``contact.c`` for the
+per-node passes of a step, the update, the rigid walls, the velocity boundaries and the
+contact interfaces, the walls and interfaces sharing the friction law of ``friction.h``)
+are compiled into one extension module the first time a process needs them, the way
+FFCx compiles forms (the shells' kernels into a second one, an :class:`Extension` of
+:mod:`rwall_fem.shells.elements`, by the same :func:`load`), and cached per user under
 ``$XDG_CACHE_HOME/rwall_fem/kernels`` (``~/.cache`` by default; the variable
 ``RWALL_FEM_CACHE`` overrides the folder). The cache key covers the sources, the
 compiler flags, the Python and cffi versions and the processor's instruction
@@ -67,7 +67,7 @@ log = logging.getLogger("rwall_fem")
 
 SOURCES = ("batch.h", "materials.h", "plasticity.h", "step.h", "failure.h", "tetrahedron.c",
            "hexahedron.c", "hexahedron_reduced.c", "material_point.c", "update.c",
-           "friction.h", "wall.c", "contact.c", "contact_remove.c")  # fmt: skip
+           "friction.h", "wall.c", "contact.c", "contact_remove.c", "boundary.c")  # fmt: skip
 # Hidden symbols: no other library's function of the same name (glibc has an ``advance``)
 # can take the place of a kernel.
 FLAG_SETS = (
@@ -99,6 +99,8 @@ ELEMENT_PARAMS = """typedef struct {
   double step_floor;
   int32_t *below;
   double *below_step;
+  const double *nodal_mass;
+  double *nodal_stiffness;
   int failure;
   double failure_strain;
   double damage_constants[5];
@@ -160,10 +162,27 @@ void wall_impulses(int64_t k, int slide, double friction, double alpha, const do
                    const double *n, const double *vs, const double velocity[3],
                    const double *target, const double *kept, double *normal,
                    double *tangential, uint8_t *slip);
-double wall_work(int64_t k, const int64_t *nodes, const double *impulse, const double *v,
-                 const double velocity[3], double *scratch);
+void wall_work(int64_t k, const int64_t *nodes, const double *normal, const double *tangential,
+               const double *v, const double velocity[3], double *scratch, double out[2]);
+int wall_velocity(const double total[12], double mass, const double predicted[3],
+                  const uint8_t held[3], double matrix[9], double rhs[3], double out[3]);
+void largest_range(int64_t n, const double *v, const double *a, double out[2]);
 void wall_apply(int64_t k, const int64_t *nodes, const double *m, const double *normal,
-                const double *tangential, double dt_v, double *a, double out[9]);
+                const double *tangential, double dt_v, double *a, double out[9],
+                const double *previous, const double before[3], double *scratch,
+                double works[2]);
+int wall_coupled(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,
+                 const double *vs, const double *target, const double *tangential, double mass,
+                 const double predicted[3], const uint8_t held[3], double out[27]);
+void boundary_velocity(int64_t n, int64_t axes, const int32_t *nodes, const int64_t *flat,
+                       const double *target, double dt_v, const double *mass, const double *v,
+                       double *a, double *reaction, double *power, double *sums, int settle,
+                       double works[2]);
+void boundary_power(int64_t m, const int64_t *flat, const double *reaction, const double *v,
+                    double *power);
+void wall_coupling(int64_t k, int tied, const uint8_t *slip, const double *m, const double *n,
+                   const double *vs, const double *target, const double *tangential,
+                   double out[12]);
 double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const double *u,
                       const wall_shape *s, const double offset[3], double *clearance);
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
@@ -209,7 +228,7 @@ void contact_unpack(int64_t n, const int64_t *order, const double *packed, doubl
                     double *v, double *mass);
 void contact_apply(int64_t n, const int64_t *rows, double *force, double *stiffness,
                    const double *ms, const double *mass, const double *v, double *a,
-                   double *kept, double out[2]);
+                   double *kept, const double *element, double out[2]);
 double contact_power(int64_t n, const int64_t *rows, const double *kept, const double *v);
 """
     + "".join(

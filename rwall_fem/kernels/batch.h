@@ -63,6 +63,8 @@ typedef struct
   double step_floor;            /* s: the cells whose step is below it are listed in below */
   int32_t *below;               /* NULL, or room for every cell's index */
   double *below_step;           /* and for its step before mass scaling, s */
+  const double *nodal_mass;     /* NULL, or per cell the mass each of its nodes has of it, kg */
+  double *nodal_stiffness;      /* and per node: adds m_c / dt_e^2 of each cell (N/m; step.h) */
   /* failure and erosion (failure.h) */
   int failure;                  /* FAILURE_NONE, FAILURE_PLASTIC_STRAIN or FAILURE_JOHNSON_COOK */
   double failure_strain;        /* eps_f of FAILURE_PLASTIC_STRAIN */

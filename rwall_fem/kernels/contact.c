@@ -29,7 +29,8 @@
  * contact_read, contact_apply: the sweeps of the rank's owned surface nodes before the
  *   passes (the state's values in; the books of the previous step's forces; how far the
  *   nodes moved since the sort and the near lists) and after them (the forces out to the
- *   accelerations; the nodal stable step min sqrt(2 m / k) (s); force and k zeroed).
+ *   accelerations; the nodal stable step min sqrt(m / (e + k / 2)) (s), e the cells'
+ *   term; force and k zeroed).
  * A segment of negative depth -t/2 is a shell's mid-surface with both sides active (the
  * distance to it unsigned); with `half_thickness` the gap is variable, per pair (pair_gap).
  * With `share` and `planes`, a model cut by symmetry planes acts as the whole model would
@@ -971,13 +972,14 @@ void contact_unpack(int64_t n, const int64_t *restrict order, const double *rest
 /* One sweep of the rank's n owned surface nodes (the first local ones) after the passes:
  * add their forces `force` (N) to the accelerations of the state's rows `rows` (masses
  * `mass`), keep them in `kept`, and zero `force` and the contact stiffness `stiffness` (N/m)
- * for the next step.  out[0] = sum f . v (W) at the state's velocities v, out[1] the
- * interface's nodal stable step min sqrt(2 ms / k) over the nodes with k > 0 (s; inf: none),
- * ms being the surface nodes' masses (kg). */
+ * for the next step.  out[0] = sum f . v (W) at the state's velocities v, out[1] the nodal
+ * stable step over the nodes with k > 0 (s; inf: none), ms being the surface nodes' masses
+ * (kg): sqrt(ms / (e + k / 2)), e = element[row] (N/m, the cells' sum m_c / dt_e^2 at the
+ * node, step.h's note_steps; 0 when `element` is NULL: sqrt(2 ms / k), the springs alone). */
 void contact_apply(int64_t n, const int64_t *restrict rows, double *restrict force,
                    double *restrict stiffness, const double *restrict ms,
                    const double *restrict mass, const double *restrict v, double *restrict a,
-                   double *restrict kept, double out[2])
+                   double *restrict kept, const double *restrict element, double out[2])
 {
   double power = 0.0, smallest = INFINITY;
   for (int64_t i = 0; i < n; ++i)
@@ -1000,7 +1002,8 @@ void contact_apply(int64_t n, const int64_t *restrict rows, double *restrict for
     }
     if (stiffness[i] > 0.0)
     {
-      const double dt = sqrt(2.0 * ms[i] / stiffness[i]);
+      const double e = element ? element[r] : 0.0;
+      const double dt = sqrt(ms[i] / (e + 0.5 * stiffness[i]));
       smallest = dt < smallest ? dt : smallest;
     }
     stiffness[i] = 0.0;

@@ -179,7 +179,7 @@ INLINE void add_batch(const element_params *p, const int32_t *restrict cells, in
   scatter_add(cells, npe, b, fe, f);
   note_inverted(inverted & ~failed, b, x, u, npe, step);
   if (p->estimate)
-    note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), b, x, u, npe, step);
+    note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), b, cells, x, u, npe, step);
 }
 
 #endif

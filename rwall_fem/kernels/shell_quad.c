@@ -832,7 +832,7 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
     scatter_add(cells, 4, &b, fe + 12, m);
     note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
     if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 4, step);
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
   }
   energy[0] += stored_total;
   energy[1] += hourglass_total;

@@ -222,7 +222,7 @@ INLINE void shell_tria(int plastic, int64_t num_cells, const int32_t *restrict c
     scatter_add(cells, 3, &b, fe + 9, m);
     note_inverted(inverted & ~failed, &b, x, NULL, 3, step);
     if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, x, NULL, 3, step);
+      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 3, step);
   }
   energy[0] += stored_total;
   energy[2] += plastic_total;

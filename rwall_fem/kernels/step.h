@@ -100,12 +100,31 @@ INLINE void centroid(const vec *restrict x, const vec *restrict u, int npe, int 
   }
 }
 
-/* Note the steps dt_e (s) of the batch's cells, at x (+ u): the smallest so far, and when
- * p->below is given the cells below p->step_floor, with their steps before mass scaling in
- * p->below_step.  NaN (a broken state, caught by the run's guards) is never the smallest. */
+/* Note the steps dt_e (s) of the batch's cells (node rows `cells`, npe a cell), at x (+ u):
+ * the smallest so far, and when p->below is given the cells below p->step_floor, with
+ * their steps before mass scaling in p->below_step.  NaN (a broken state, caught by the
+ * run's guards) is never the smallest.  When p->nodal_stiffness is given, each cell with
+ * a finite dt_e and m_c = p->nodal_mass of the cell (kg) not 0 (0: a cell at no contact
+ * surface node) adds m_c / dt_e^2 (N/m) to each of its nodes: the element part of a
+ * node's squared frequency bound, sum_c m_c (2 / dt_e)^2 / 4, that a nodal stable step
+ * combines with the contact springs' (docs/theory.md, contact's "Stable step").  Mass
+ * scaling multiplies m_c by s^2 and dt_e by s: the term is the same, so the step before
+ * scaling serves. */
 INLINE void note_steps(const element_params *p, vec dte, const batch_t *b,
-                       const vec *restrict x, const vec *restrict u, int npe, double *step)
+                       const int32_t *restrict cells, const vec *restrict x,
+                       const vec *restrict u, int npe, double *step)
 {
+  if (p->nodal_stiffness)
+  {
+    const vec term = cell_values(p->nodal_mass, b) / (dte * dte); /* dt_e inf: 0 */
+    for (int k = 0; k < b->nb; ++k)
+      if (term[k] > 0.0) /* not 0 (none to add) nor NaN */
+      {
+        const int32_t *cell = cells + b->id[k] * npe;
+        for (int I = 0; I < npe; ++I)
+          p->nodal_stiffness[cell[I]] += term[k];
+      }
+  }
   const vec scaled = p->step_factor ? dte * cell_values(p->step_factor, b) : dte;
   for (int k = 0; k < b->nb; ++k)
   {

@@ -9,10 +9,13 @@
  *   friction filter of friction.h, the law the contact interfaces share) of the listed
  *   nodes for a wall velocity.
  * wall_apply: add the impulses to a^n and sum what the wall books (impulses, works).
- * wall_work: the sum of impulse . (v - V) over listed nodes (the second half of a work).
+ * wall_work: the sums of impulse . (v - V) over listed nodes (the halves of the works).
+ * wall_coupling: the sums over the listed nodes of a main-node wall's equations (the
+ *   mass each node lends the wall and the momentum it brings); wall_velocity: those
+ *   equations assembled, and solved when they are diagonal.
  * wall_clearance: how far each secondary node is from being treated (selects the near set).
  * largest_components: the largest |v_i| and |a_i| of the secondary nodes (how far the
- *   near set may be trusted).
+ *   near set may be trusted); largest_range: the same for a range of nodes.
  *
  * The arithmetic is that of the NumPy code these replace, operation for operation and in
  * the same order, so that results stay the same to the bit: dot products of 3 components
@@ -309,25 +312,154 @@ void wall_impulses(int64_t k, int slide, double friction, double alpha,
 
 /* sum over the k listed nodes of impulse . (v - velocity) (N m/s), v rows of 3 at the
  * node indices `nodes` (when not NULL; else the rows of v themselves), as NumPy's
- * (impulse * (v[nodes] - velocity)).sum(); `scratch` holds 3 k values. */
-double wall_work(int64_t k, const int64_t *restrict nodes, const double *restrict impulse,
-                 const double *restrict v, const double velocity[3], double *restrict scratch)
+ * (impulse * (v[nodes] - velocity)).sum(): out[0] for `normal`, out[1] for `tangential`
+ * (0 when NULL); `scratch` holds 3 k values. */
+void wall_work(int64_t k, const int64_t *restrict nodes, const double *restrict normal,
+               const double *restrict tangential, const double *restrict v,
+               const double velocity[3], double *restrict scratch, double out[2])
 {
+  const double *impulses[2] = {normal, tangential};
+  for (int j = 0; j < 2; ++j)
+  {
+    const double *impulse = impulses[j];
+    out[j] = 0.0;
+    if (!impulse)
+      continue;
+    for (int64_t i = 0; i < k; ++i)
+    {
+      const int64_t row = nodes ? nodes[i] : i;
+      for (int c = 0; c < 3; ++c)
+        scratch[3 * i + c] = impulse[3 * i + c] * (v[3 * row + c] - velocity[c]);
+    }
+    out[j] = numpy_sum(3 * k, scratch);
+  }
+}
+
+/* The sums over the k listed nodes (masses m, kg; normals n; v* vs, m/s; target normal
+ * velocities, m/s) of the equations of a main-node wall's velocity (walls/constraint.py,
+ * _coupled_velocity): out[0..8] = sum m_i P_i (rows of 3), out[9..11] = sum m_i P_i v*_i
+ * - sum m_i b_i n_i [- sum of the extra impulses], P_i the identity for a tied node and
+ * n_i n_i^T for another.  Without `slip` every node is tied when `tied` is not 0; with it,
+ * the nodes that do not slip are tied and the slipping ones bring their `tangential`
+ * impulses (N s) as extra.  Sums in the order of NumPy's einsum and axis-0 sums: node after
+ * node, the three products of a row of P_i v*_i summed before they join the total. */
+void wall_coupling(int64_t k, int tied, const uint8_t *restrict slip, const double *restrict m,
+                   const double *restrict n, const double *restrict vs,
+                   const double *restrict target, const double *restrict tangential,
+                   double out[12])
+{
+  double M[9] = {0.0}, R[3] = {0.0}, S[3] = {0.0}, E[3] = {0.0};
   for (int64_t i = 0; i < k; ++i)
   {
-    const int64_t row = nodes ? nodes[i] : i;
-    for (int c = 0; c < 3; ++c)
-      scratch[3 * i + c] = impulse[3 * i + c] * (v[3 * row + c] - velocity[c]);
+    const double *ni = n + 3 * i, *vi = vs + 3 * i;
+    const int held = slip ? !slip[i] : tied;
+    double P[9];
+    for (int j = 0; j < 3; ++j)
+      for (int c = 0; c < 3; ++c)
+        P[3 * j + c] = held ? (j == c ? 1.0 : 0.0) : ni[j] * ni[c];
+    const double mb = m[i] * target[i];
+    for (int j = 0; j < 3; ++j)
+    {
+      double accum = 0.0;
+      for (int c = 0; c < 3; ++c)
+      {
+        const double mp = m[i] * P[3 * j + c];
+        M[3 * j + c] += mp;
+        accum += mp * vi[c];
+      }
+      R[j] = accum + R[j];
+      S[j] += mb * ni[j];
+      if (slip)
+        E[j] += slip[i] ? tangential[3 * i + j] : 0.0;
+    }
   }
-  return numpy_sum(3 * k, scratch);
+  for (int c = 0; c < 9; ++c)
+    out[c] = M[c];
+  for (int j = 0; j < 3; ++j)
+    out[9 + j] = slip ? (R[j] - S[j]) - E[j] : R[j] - S[j];
+}
+
+/* The equations of a main-node wall's velocity V (kg, N s) from the sums `total` of
+ * wall_coupling (over all ranks): matrix = mass I + total[0..8], rhs = mass V* + total[9..11],
+ * the rows of the `held` components (held[j] not 0) replaced by V_j = V*_j.  When the
+ * matrix is diagonal (all nodes tied), finite and without zero on its diagonal, V =
+ * rhs / diagonal (what LAPACK's solve gives such a system, to the bit) and returns 1;
+ * else returns 0 (the caller solves). */
+int wall_velocity(const double total[12], double mass, const double predicted[3],
+                  const uint8_t held[3], double matrix[9], double rhs[3], double out[3])
+{
+  int diagonal = 1;
+  for (int j = 0; j < 3; ++j)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const double eye = j == c ? 1.0 : 0.0;
+      matrix[3 * j + c] = held[j] ? eye : mass * eye + total[3 * j + c];
+      if (j != c && matrix[3 * j + c] != 0.0)
+        diagonal = 0;
+    }
+    rhs[j] = held[j] ? predicted[j] : mass * predicted[j] + total[9 + j];
+    const double d = matrix[4 * j];
+    if (!isfinite(d) || d == 0.0 || !isfinite(rhs[j]))
+      diagonal = 0;
+  }
+  if (!diagonal)
+    return 0;
+  for (int j = 0; j < 3; ++j)
+    out[j] = rhs[j] / matrix[4 * j];
+  return 1;
+}
+
+/* wall_coupling and wall_velocity in one call (one rank: the sums are the totals): out[0..11]
+ * the sums, out[12..20] the matrix, out[21..23] the right side, out[24..26] V if solved;
+ * returns whether it was. */
+int wall_coupled(int64_t k, int tied, const uint8_t *restrict slip, const double *restrict m,
+                 const double *restrict n, const double *restrict vs,
+                 const double *restrict target, const double *restrict tangential, double mass,
+                 const double predicted[3], const uint8_t held[3], double out[27])
+{
+  wall_coupling(k, tied, slip, m, n, vs, target, tangential, out);
+  return wall_velocity(out, mass, predicted, held, out + 12, out + 21, out + 24);
+}
+
+/* The largest absolute values of the n values of v and of a (contiguous: the rows of a
+ * range of nodes), NaN values left out, in out[0] and out[1]: largest_components on
+ * nodes that follow one another, in independent lanes. */
+void largest_range(int64_t n, const double *restrict v, const double *restrict a,
+                   double out[2])
+{
+  double mv[8] = {0.0}, ma[8] = {0.0};
+  int64_t i = 0;
+  for (; i + 8 <= n; i += 8)
+    for (int j = 0; j < 8; ++j)
+    {
+      const double x = fabs(v[i + j]), y = fabs(a[i + j]);
+      mv[j] = x > mv[j] ? x : mv[j];
+      ma[j] = y > ma[j] ? y : ma[j];
+    }
+  for (int j = 0; i < n; ++i, ++j)
+  {
+    const double x = fabs(v[i]), y = fabs(a[i]);
+    mv[j] = x > mv[j] ? x : mv[j];
+    ma[j] = y > ma[j] ? y : ma[j];
+  }
+  out[0] = out[1] = 0.0;
+  for (int j = 0; j < 8; ++j)
+  {
+    out[0] = mv[j] > out[0] ? mv[j] : out[0];
+    out[1] = ma[j] > out[1] ? ma[j] : out[1];
+  }
 }
 
 /* Add the impulses (normal, plus tangential unless NULL; N s) of the k listed nodes to
  * their accelerations a^n as impulse / (m dt_v), and sum over the nodes (in order):
- * out[0..2] the normal impulses, out[3..5] the tangential ones, out[6..8] both (N s). */
+ * out[0..2] the normal impulses, out[3..5] the tangential ones, out[6..8] both (N s); then
+ * the works' halves at v^{n-1/2} (`previous`, rows of 3) relative to the wall's velocity
+ * `before` (wall_work: works[0] normal, works[1] tangential; scratch of 3 k values). */
 void wall_apply(int64_t k, const int64_t *restrict nodes, const double *restrict m,
                 const double *restrict normal, const double *restrict tangential, double dt_v,
-                double *restrict a, double out[9])
+                double *restrict a, double out[9], const double *restrict previous,
+                const double before[3], double *restrict scratch, double works[2])
 {
   for (int c = 0; c < 9; ++c)
     out[c] = 0.0;
@@ -344,6 +476,7 @@ void wall_apply(int64_t k, const int64_t *restrict nodes, const double *restrict
       out[6 + c] += impulse;
     }
   }
+  wall_work(k, NULL, normal, tangential, previous, before, scratch, works);
 }
 
 /* The largest velocity and acceleration components |v_i| and |a_i| of the n nodes `nodes`

@@ -162,10 +162,12 @@ class ShellBody(PartedBody):
             field.scatter_forward()
         self.f.array.fill(0.0)
         self.m.array.fill(0.0)
+        self._begin_nodal_stiffness()
         for force in self.elements:
             force.compute(state)
         self.f.scatter_reverse_add()
         self.m.scatter_reverse_add()
+        self._end_nodal_stiffness()
         if not self._alone:
             self._combine_steps()
         translations, rotations = self._acceleration or (None, None)

@@ -47,8 +47,8 @@ secondary nodes, the wall's exact translation) and selects the set again, from a
 secondary nodes, before that bound passes the budget. No node the wall would treat
 is ever left out, so the results are those of testing every secondary node; each
 rank decides on its own nodes, without communication. The passes over the nodes (the
-test, the impulses, the bound, the selection) are compiled
-(:mod:`rwall_fem.walls.contact`).
+test, the impulses, the main node's equations, the works, the bound, the selection) are
+compiled (:mod:`rwall_fem.walls.contact`).
 """
 
 from __future__ import annotations
@@ -68,8 +68,6 @@ _HORIZON = 16
 # sqrt(3) turns the largest velocity component into a bound on a node's speed; the factor 2
 # covers rounding (a float sum u + dt v moves u by at most twice the increment).
 _TRAVEL = 2.0 * math.sqrt(3.0)
-_EYE = np.eye(3)  # the identity of the main node's equations (read only)
-_EYE.flags.writeable = False
 
 
 def filter_alpha(friction_filter: tuple[str, float] | None, dt: float) -> float:
@@ -126,6 +124,13 @@ class RigidWall:
         self.motion = motion if motion is not None else FixedMotion()
         self.comm = comm
         self.nodes = np.asarray(nodes, dtype=np.int64)
+        # The secondary nodes as a range (first, end) when they follow one another: the bound
+        # on their travel is then a contiguous pass.
+        n = len(self.nodes)
+        follow = n and self.nodes[-1] - self.nodes[0] == n - 1 and np.all(np.diff(self.nodes) == 1)
+        self._span = (int(self.nodes[0]), int(self.nodes[-1]) + 1) if follow else None
+        self._held = np.zeros(3, dtype=np.uint8)  # the main node's held components, a mask
+        self._held[getattr(self.motion, "held", [])] = 1
         self.finite = shape.kind == "parallelogram"
         self.normal_impulse = np.zeros(3)
         self.tangential_impulse = np.zeros(3)
@@ -249,10 +254,12 @@ class RigidWall:
         masses change, and at the start of every step."""
         if self._latest is not None:
             nodes, normal, tangential, final = self._latest
-            passes = self._passes_for(state)
-            self.normal_work += 0.5 * passes.work(normal, final, nodes)
+            normal_work, friction_work = self._passes_for(state).work(
+                normal, tangential, final, nodes
+            )
+            self.normal_work += 0.5 * normal_work
             if tangential is not None:
-                self.friction_work += 0.5 * passes.work(tangential, final, nodes)
+                self.friction_work += 0.5 * friction_work
             self._latest = None
         self.driving_work += self._pending_driving
         self.normal_work += self._pending_body
@@ -290,31 +297,30 @@ class RigidWall:
         free = self.slide == "free"
         if motion.dynamic:
             predicted = wall_velocity
-            tied = np.full(k, self.slide == "tied")
-            wall_velocity = self._coupled_velocity(predicted, passes, k, tied)
+            wall_velocity = self._coupled_velocity(predicted, passes, k)
         passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
         if motion.dynamic and self.slide == "friction":
             # Second pass: sticking nodes move with the wall, slipping ones push it.
-            slip = passes.slip[:k]
-            extra = np.where(slip[:, None], passes.tangential[:k], 0.0)
-            wall_velocity = self._coupled_velocity(predicted, passes, k, ~slip, extra)
+            wall_velocity = self._coupled_velocity(predicted, passes, k, slip=True)
             passes.impulses(k, self.slide, self.friction, self.filter_alpha, wall_velocity, kept)
         normal = passes.normal[:k]
         tangential = None if free else passes.tangential[:k]
         if self._previous_tangential is not None:
             self._previous_tangential[self._filtered_rows] = tangential
-        normal_sum, tangential_sum, impulse_sum = passes.apply(k, not free, dt_v)
+        before = motion.velocity
+        sums, (normal_work, friction_work) = passes.apply(k, not free, dt_v, before)
+        normal_sum, tangential_sum, impulse_sum = sums
 
         final = wall_velocity
         if motion.dynamic:
             # The main node takes exactly what the nodes received (momentum to round-off).
             final = predicted - self._summed(impulse_sum) / motion.mass
-            final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
-        before = motion.velocity
+            if len(motion.held):
+                final[motion.held] = predicted[motion.held]  # the symmetry planes' reaction
         motion.advance(final, dt)
-        self.normal_work += 0.5 * passes.work(normal, before)
+        self.normal_work += 0.5 * normal_work
         if tangential is not None:
-            self.friction_work += 0.5 * passes.work(tangential, before)
+            self.friction_work += 0.5 * friction_work
             self.tangential_impulse -= tangential_sum
         self._latest = (self.touching, normal, tangential, final)
         if motion.prescribed:
@@ -374,7 +380,8 @@ class RigidWall:
         exact translation.
         """
         dt = state.dt
-        speed, acceleration = passes.largest(self.nodes)  # bound |v^{n-1/2}| components, m/s
+        # bounds on the |v^{n-1/2}| (m/s) and |a^n| (m/s^2) components
+        speed, acceleration = passes.largest(self.nodes, self._span)
         self._travel += state.dt_previous * speed  # of x^n from where the set was selected
         ahead = speed + state.dt_velocity * acceleration  # bounds those of v*, m/s
         wall_travel = math.dist(wall_next.tolist(), self._anchor)  # lists: 6x faster
@@ -399,24 +406,16 @@ class RigidWall:
         self._near = np.flatnonzero(clearance <= slack)
         self._near_nodes = self.nodes[self._near]
 
-    def _coupled_velocity(self, predicted, passes, k, tied, extra=None) -> np.ndarray:
+    def _coupled_velocity(self, predicted, passes, k, slip=False) -> np.ndarray:
         """Velocity (m/s) of a main-node wall over the step when it moves with the mass of
         the k nodes in contact (``passes``): normal motion shared by all, tangential by the
-        ``tied`` ones; ``extra`` impulses (N s) are given to the nodes on top."""
-        m, n = passes.mass[:k, None], passes.normals[:k]
-        vs, target = passes.predicted[:k], passes.target[:k]
-        # The normals' outer products only where some node is not tied (np.where's values).
-        outer = 0.0 if tied.all() else np.einsum("ij,ik->ijk", n, n)
-        P = np.where(tied[:, None, None], _EYE, outer)
-        matrix = np.einsum("i,ijk->jk", m[:, 0], P)
-        rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
-        if extra is not None:
-            rhs -= extra.sum(axis=0)
-        total = self._summed(np.concatenate([matrix.ravel(), rhs]))
-        mass, held = self.motion.mass, self.motion.held
-        matrix, rhs = mass * _EYE + total[:9].reshape(3, 3), mass * predicted + total[9:]
-        matrix[held], rhs[held] = _EYE[held], predicted[held]  # held components
-        return np.linalg.solve(matrix, rhs)
+        tied ones (all if the wall is ``tied``; with ``slip``, those of ``passes.slip``
+        that do not slip, the slipping ones giving their tangential impulses on top)."""
+        tied, mass = self.slide == "tied", self.motion.mass
+        if self.comm.size == 1:
+            return passes.coupled_velocity(k, tied, slip, mass, predicted, self._held)
+        total = self.comm.allreduce(passes.coupling(k, tied, slip))
+        return passes.velocity(total, mass, predicted, self._held)
 
     def _summed(self, values: np.ndarray) -> np.ndarray:
         """``values`` summed over the ranks (on one rank, themselves: no exchange)."""

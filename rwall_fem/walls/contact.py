@@ -4,7 +4,8 @@
 arrays the passes fill, sized for the wall's near set: :meth:`~ContactPasses.find` lists
 the nodes in contact at a step, :meth:`~ContactPasses.impulses` gives their impulses for
 a wall velocity, :meth:`~ContactPasses.apply` adds them to the accelerations, and
-:meth:`~ContactPasses.work` sums the work of impulses; :meth:`~ContactPasses.clearance` and
+:meth:`~ContactPasses.work` sums the work of impulses, :meth:`~ContactPasses.coupling` the
+equations of a main-node wall's velocity; :meth:`~ContactPasses.clearance` and
 :meth:`~ContactPasses.largest` select and keep the near set. The arithmetic is NumPy's,
 operation for operation (``kernels/wall.c``), so that the results are those of the NumPy
 code that ``walls/constraint.py`` had before.
@@ -67,6 +68,10 @@ class ContactPasses:
         # offset, next offset and velocity of the wall (m, m, m/s), then the sums of apply
         self._vectors = np.zeros(3 * 3 + 9)
         self._vectors_pointer = _pointer(self.ffi, self._vectors)
+        # the sums of coupling; then the main node's matrix, right side and velocity; works
+        self._coupling = np.zeros(12 + 9 + 3 + 3 + 2)
+        self._coupling_pointer = _pointer(self.ffi, self._coupling)
+        self._coupling_sums = self._coupling[:12]
         self._clearance = np.zeros(0)
         self._reserve(0)
 
@@ -107,12 +112,19 @@ class ContactPasses:
         )  # fmt: skip
         return self._clearance, largest
 
-    def largest(self, nodes: np.ndarray) -> tuple[float, float]:
+    def largest(self, nodes: np.ndarray, span: tuple[int, int] | None = None) -> tuple:
         """The largest absolute component of the velocities (m/s) and of the accelerations
-        (m/s^2) of ``nodes`` (node indices, int64; NaN if one is NaN), in one pass."""
+        (m/s^2) of ``nodes`` (node indices, int64; NaN values left out), in one pass; with
+        ``span`` (first, end), ``nodes`` are the range first, ..., end - 1 (a contiguous
+        pass)."""
         sums = self._vectors_pointer + 9
-        rows = _pointer(self.ffi, nodes, "int64_t[]")
-        self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
+        if span is not None:
+            first, end = span
+            self.lib.largest_range(3 * (end - first), self._v + 3 * first, self._a + 3 * first,
+                                   sums)  # fmt: skip
+        else:
+            rows = _pointer(self.ffi, nodes, "int64_t[]")
+            self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
         speed, acceleration = self._vectors[9:11].tolist()
         return speed, acceleration
 
@@ -144,28 +156,74 @@ class ContactPasses:
             q["slip"],
         )  # fmt: skip
 
-    def apply(self, k: int, tangential: bool, dt_v: float) -> np.ndarray:
+    def apply(self, k: int, tangential: bool, dt_v: float, before) -> tuple:
         """Add the impulses of the k nodes in contact (the normal ones, and the tangential
         if ``tangential``) to their accelerations, impulse / (m dt_v); returns the sums
         over them of the normal, tangential and whole impulses (N s; rows of a (3, 3)
-        view)."""
-        q = self._pointers
+        view) and the sums of impulse . (v^{n-1/2} - ``before``) (N m/s; normal and
+        tangential, 0 without: the works' first halves at the wall's velocity before)."""
+        q, w = self._pointers, self._vectors_pointer
         t = q["tangential"] if tangential else self.ffi.NULL
-        sums = self._vectors_pointer + 9
-        self.lib.wall_apply(k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, sums)
-        return self._vectors[9:].reshape(3, 3)
+        self._vectors[6:9] = before
+        self.lib.wall_apply(
+            k, q["nodes"], q["mass"], q["normal"], t, dt_v, self._a, w + 9, q["previous"],
+            w + 6, q["_scratch"], self._coupling_pointer + 27,
+        )  # fmt: skip
+        normal_work, tangential_work = self._coupling[27:29].tolist()
+        return self._vectors[9:].reshape(3, 3), (normal_work, tangential_work)
 
-    def work(self, impulse: np.ndarray, velocity, nodes: np.ndarray | None = None) -> float:
-        """sum impulse . (v - ``velocity``) (N m/s) over the rows of ``impulse`` (k, 3):
-        with ``nodes``, v is the nodes' current velocity, else :attr:`previous`."""
-        k = len(impulse)
+    def coupling(self, k: int, tied: bool, slip: bool = False) -> np.ndarray:
+        """The sums over the k nodes in contact of the equations of a main-node wall's
+        velocity V, (M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i) - extra: the
+        9 values of sum m_i P_i (rows of 3), then the 3 of the right side's sum, kg and
+        N s (a view the next call overwrites). P_i is the identity for a tied node (all
+        are when ``tied``), n_i n_i^T for another; with ``slip``, the nodes of :attr:`slip`
+        slip (the others are tied) and bring their :attr:`tangential` impulses as extra."""
+        q, null = self._pointers, self.ffi.NULL
+        self.lib.wall_coupling(
+            k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
+            q["target"], q["tangential"] if slip else null, self._coupling_pointer,
+        )  # fmt: skip
+        return self._coupling_sums
+
+    def coupled_velocity(self, k: int, tied: bool, slip: bool, mass: float, predicted, held):
+        """:meth:`coupling` then :meth:`velocity` in one call, on one rank (its sums are the
+        totals)."""
+        q, c, null = self._pointers, self._coupling_pointer, self.ffi.NULL
+        p = self.ffi.from_buffer("double[]", predicted)
+        held = self.ffi.from_buffer("uint8_t[]", held)
+        if self.lib.wall_coupled(
+            k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
+            q["target"], q["tangential"] if slip else null, mass, p, held, c,
+        ):  # fmt: skip
+            return self._coupling[24:27].copy()
+        return np.linalg.solve(self._coupling[12:21].reshape(3, 3), self._coupling[21:24])
+
+    def velocity(self, total: np.ndarray, mass: float, predicted: np.ndarray, held) -> np.ndarray:
+        """The main node's velocity (m/s) over the step from the sums ``total`` of
+        :meth:`coupling` over the ranks: (M I + total) V = M V* + total's right side, V_j =
+        V*_j for the components ``held`` (a uint8 mask of 3; kg, m/s). A diagonal system
+        (all nodes tied) is divided (what LAPACK's solve does to it, to the bit), another
+        solved by NumPy."""
+        c, q, ffi = self._coupling, self._coupling_pointer, self.ffi
+        if total is not self._coupling_sums:
+            c[:12] = total
+        p, held = ffi.from_buffer("double[]", predicted), ffi.from_buffer("uint8_t[]", held)
+        if self.lib.wall_velocity(q, mass, p, held, q + 12, q + 21, q + 24):
+            return c[24:27].copy()
+        return np.linalg.solve(c[12:21].reshape(3, 3), c[21:24])
+
+    def work(self, normal, tangential, velocity, nodes) -> tuple[float, float]:
+        """sum impulse . (v - ``velocity``) (N m/s) over the rows of the impulses ``normal``
+        and ``tangential`` (k, 3; or None: 0), v the current velocity of the ``nodes``
+        (node indices, int64), in one pass."""
+        k = len(normal)
         self._reserve(k)
         self._vectors[6:9] = velocity
-        if nodes is None:
-            rows, v = self.ffi.NULL, self._pointers["previous"]
-        else:
-            rows, v = _pointer(self.ffi, nodes, "int64_t[]"), self._v
-        return self.lib.wall_work(
-            k, rows, _pointer(self.ffi, impulse), v, self._vectors_pointer + 6,
-            self._pointers["_scratch"],
+        t = self.ffi.NULL if tangential is None else _pointer(self.ffi, tangential)
+        self.lib.wall_work(
+            k, _pointer(self.ffi, nodes, "int64_t[]"), _pointer(self.ffi, normal), t, self._v,
+            self._vectors_pointer + 6, self._pointers["_scratch"], self._coupling_pointer + 27,
         )  # fmt: skip
+        normal_work, tangential_work = self._coupling[27:29].tolist()
+        return normal_work, tangential_work

@@ -5,7 +5,9 @@ References: the penalty law of docs/theory.md ("Contact between parts"), f = -k0
 ln(1 - p / g) at the penetration p = g - d (d the node's height over the segment), its
 tangent k0 / (1 - p / g) and energy E = k0 g^2 ((1 - x) ln(1 - x) + x), x = p / g; the
 work of the contact force on a node moving at a constant velocity is -dE (the power the
-sweeps give, summed over the steps, against the closed form); the nodal step sqrt(2 m / k).
+sweeps give, summed over the steps, against the closed form); the nodal step sqrt(2 m / k)
+of the springs alone, sqrt(m / (e + k / 2)) with the cells' term e (docs/theory.md, contact's
+"Stable step").
 """
 
 import math
@@ -67,13 +69,13 @@ class Surface:
                                 p(self.force), p(self.stiffness), p(self.pass_out))  # fmt: skip
         return self.pass_out
 
-    def apply(self):
-        """contact_apply: [power, nodal step]."""
+    def apply(self, element=None):
+        """contact_apply: [power, nodal step]; ``element`` the cells' term per state row."""
         out = np.zeros(2)
         p = self.p
         self.lib.contact_apply(5, p(ROWS, "int64_t[]"), p(self.force), p(self.stiffness),
                                p(self.ms), p(self.mass), p(self.v), p(self.a), p(self.kept),
-                               p(out))  # fmt: skip
+                               p(element), p(out))  # fmt: skip
         return out
 
 
@@ -154,3 +156,28 @@ def test_the_sweeps_skip_no_term_that_counts():
     s.apply()
     assert not np.signbit(s.a[ROWS[2], 0]) and np.signbit(s.a[ROWS[2], 2])
     assert s.a[ROWS[2], 1] == 1.0
+
+
+def test_the_nodal_step_joins_the_cells_and_the_springs_node_by_node():
+    """With the cells' term e per state row (N/m), the step is min sqrt(m / (e + k / 2))
+    over the nodes with k > 0, by hand: the falling node's spring k at 0.5 gap (tangent
+    2 k0) and the corners' w k = k / 4 each; e large on the falling node, so that a corner,
+    of a million times its mass, with e small, cannot set it; no k, no term."""
+    s = Surface()
+    s.X[ROWS[4], 2] = 0.5 * GAP
+    s.read()
+    s.forces()
+    k = s.stiffness.copy()
+    assert k[4] == pytest.approx(2.0 * K0, rel=1e-12)
+    np.testing.assert_allclose(k[:4], 0.25 * k[4], rtol=1e-12)
+    element = np.zeros(6)
+    element[ROWS] = [1.0, 2.0, 3.0, 4.0, 3e9]
+    element[4] = 1e30  # a state row off the surface: never read
+    step = s.apply(element)[1]
+    m = s.mass[ROWS]
+    hand = min(math.sqrt(m[i] / (element[ROWS[i]] + 0.5 * k[i])) for i in range(5))
+    assert hand == math.sqrt(1e-3 / (3e9 + K0))
+    assert step == pytest.approx(hand, rel=1e-14)
+    s.forces()
+    assert s.apply(np.zeros(6))[1] == pytest.approx(math.sqrt(2 * 1e-3 / k[4]), rel=1e-14)
+    assert s.apply(element)[1] == math.inf  # no spring: no nodal step

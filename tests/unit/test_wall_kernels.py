@@ -149,7 +149,8 @@ def test_impulses_applied_and_booked_as_numpy_does(slide):
         assert 0 < slip.sum() < k  # some slip, some stick
 
     a = s.a.copy()
-    sums = passes.apply(k, tangential is not None, dt_v)
+    before, final = np.array([0.5, 0.1, -0.2]), np.array([0.4, 0.2, -0.1])
+    sums, works = passes.apply(k, tangential is not None, dt_v, before)
     impulse = normal if tangential is None else normal + tangential
     a[passes.nodes[:k]] += impulse / (m * dt_v)
     np.testing.assert_array_equal(s.a, a)
@@ -158,10 +159,13 @@ def test_impulses_applied_and_booked_as_numpy_does(slide):
     if tangential is not None:
         np.testing.assert_array_equal(sums[1], tangential.sum(axis=0))
 
-    before, final = np.array([0.5, 0.1, -0.2]), np.array([0.4, 0.2, -0.1])
-    assert passes.work(normal, before) == (normal * (passes.previous[:k] - before)).sum()
+    assert works[0] == (normal * (passes.previous[:k] - before)).sum()
     nodes = passes.nodes[:k].copy()
-    assert passes.work(normal, final, nodes) == (normal * (s.v[nodes] - final)).sum()
+    assert passes.work(normal, None, final, nodes) == ((normal * (s.v[nodes] - final)).sum(), 0)
+    if tangential is not None:
+        assert works[1] == (tangential * (passes.previous[:k] - before)).sum()
+        works = passes.work(normal, tangential, final, nodes)
+        assert works[1] == (tangential * (s.v[nodes] - final)).sum()
 
 
 @pytest.mark.parametrize("n", [0, 1, 2, 7, 8, 9, 15, 16, 17, 100, 127, 128, 129, 255, 256, 1000,
@@ -195,7 +199,82 @@ def test_the_bound_on_travel_is_the_largest_component():
     nodes = np.sort(RNG.choice(len(s.mass), 101, replace=False)).astype(np.int64)
     passes = ContactPasses(shape, s)
     assert passes.largest(nodes) == (np.abs(s.v[nodes]).max(), np.abs(s.a[nodes]).max())
+    span = np.arange(37, 37 + 203)  # a range of nodes: the contiguous pass
+    assert passes.largest(span, (37, 240)) == (np.abs(s.v[span]).max(), np.abs(s.a[span]).max())
     s.v[nodes[3], 1] = np.nan  # left out: such a node fails its test
     s.a[nodes[5], 2] = -np.inf
+    s.v[100, 2], s.a[200, 0] = np.nan, -np.inf
     speed, acceleration = passes.largest(nodes)
     assert speed == np.nanmax(np.abs(s.v[nodes])) and acceleration == np.inf
+    assert passes.largest(span, (37, 240)) == (np.nanmax(np.abs(s.v[span])), np.inf)
+    s.a[200, 0] = 0.0
+    assert passes.largest(span, (37, 240))[1] == np.abs(s.a[span]).max()
+
+
+def numpy_coupled_velocity(mass, held, predicted, m, n, vs, target, tied, extra=None):
+    """``RigidWall._coupled_velocity`` of the NumPy code (m as a column): the main node's
+    velocity solving (M + sum m_i P_i) V = M V* + sum m_i (P_i v*_i - n_i b_i) - extra."""
+    eye = np.eye(3)
+    outer = 0.0 if tied.all() else np.einsum("ij,ik->ijk", n, n)
+    P = np.where(tied[:, None, None], eye, outer)
+    matrix = np.einsum("i,ijk->jk", m[:, 0], P)
+    rhs = np.einsum("i,ijk,ik->j", m[:, 0], P, vs) - np.sum(m * target[:, None] * n, axis=0)
+    if extra is not None:
+        rhs -= extra.sum(axis=0)
+    sums = np.concatenate([matrix.ravel(), rhs])
+    matrix, rhs = mass * eye + matrix, mass * predicted + rhs
+    matrix[held], rhs[held] = eye[held], predicted[held]
+    return sums, np.linalg.solve(matrix, rhs)
+
+
+@pytest.mark.parametrize("slide", ["free", "tied", "friction"])
+@pytest.mark.parametrize("held", ["", "xy"])
+def test_main_node_coupling_is_numpys(slide, held):
+    """The compiled sums of the main node's equations and the velocity solved from them
+    (a division when all nodes are tied: LAPACK's solve of a diagonal system) are the
+    NumPy code's to the bit."""
+    from mpi4py import MPI
+
+    from rwall_fem.walls import RigidWall
+    from rwall_fem.walls.motion import MainNodeMotion
+
+    shape = SHAPES["sphere"]()
+    s = State(shape, n=3000)  # many contacts: sums over more than one einsum buffer
+    near = np.arange(len(s.mass), dtype=np.int64)
+    dt_v, dt, offset, wall_next, velocity = step_of()
+    motion = MainNodeMotion(0.02, velocity, held=held)
+    wall = RigidWall(shape, near, "w", slide=slide, friction=0.2, motion=motion,
+                     comm=MPI.COMM_SELF)  # fmt: skip
+    passes = ContactPasses(shape, s)
+    k = passes.find(near, dt_v, dt, offset, wall_next, velocity)
+    assert k > 500
+    m, n = passes.mass[:k, None].copy(), passes.normals[:k].copy()
+    vs, target = passes.predicted[:k].copy(), passes.target[:k].copy()
+    tied = np.full(k, slide == "tied")
+    sums, expected = numpy_coupled_velocity(0.02, motion.held, velocity, m, n, vs, target, tied)
+    np.testing.assert_array_equal(passes.coupling(k, slide == "tied"), sums)
+    np.testing.assert_array_equal(wall._coupled_velocity(velocity, passes, k), expected)
+    totals = passes.coupling(k, slide == "tied").copy()  # as summed over the ranks
+    np.testing.assert_array_equal(passes.velocity(totals, 0.02, velocity, wall._held), expected)
+    if slide != "friction":
+        return
+    passes.impulses(k, slide, 0.2, 1.0, expected)
+    slip = passes.slip[:k].copy()
+    assert 0 < slip.sum() < k
+    extra = np.where(slip[:, None], passes.tangential[:k], 0.0)
+    sums, expected = numpy_coupled_velocity(0.02, motion.held, velocity, m, n, vs, target,
+                                            ~slip, extra)  # fmt: skip
+    np.testing.assert_array_equal(passes.coupling(k, False, slip=True), sums)
+    np.testing.assert_array_equal(wall._coupled_velocity(velocity, passes, k, slip=True),
+                                  expected)  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_diagonal_solve_is_a_division(seed):
+    """LAPACK's solve of a diagonal system divides (the main node's velocity when every
+    node is tied takes that path without the solver)."""
+    rng = np.random.default_rng(seed)
+    d = rng.uniform(0.1, 10.0, (2000, 3)) * 10.0 ** rng.uniform(-3, 3, (2000, 3))
+    r = rng.standard_normal((2000, 3)) * 10.0 ** rng.uniform(-3, 3, (2000, 3))
+    solved = np.array([np.linalg.solve(np.diag(di), ri) for di, ri in zip(d, r)])
+    np.testing.assert_array_equal(solved, r / d)

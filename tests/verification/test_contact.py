@@ -204,7 +204,8 @@ def test_two_bars_of_tetrahedra_meet_as_on_a_rigid_wall(shared_dir):
     1/N + 1 %, rebound 2/N + 1 %), the contact counted while the normal force exceeds
     1 % of the plateau's (a last node ringing in and out of the gap with 0.6 % of it
     after the faces parted lengthened the count by 5 steps); what the springs keep after
-    separation below 2 % of the energy (the on-off error of the penalty, 1.3 % here); the
+    separation below 5 % of the energy (the on-off error of the penalty, growing with the
+    step: 4.4 % here at the nodal step, 1.3 % at the former global rule's 0.82 of it); the
     books close."""
     geo = f"""SetFactory("OpenCASCADE");
 Box(1) = {{0, 0, 0, {A_SIDE}, {A_SIDE}, {L}}};
@@ -229,7 +230,7 @@ Mesh.CharacteristicLengthMax = 0.002;
     rebound = -part_momentum(sim, "left")[2] / mass
     assert abs(rebound - SPEED) <= (2 / layers + 0.01) * SPEED
     summary = sim.history.summary
-    assert abs(cc["contact_energy"][-1]) <= 0.02 * summary["energy"]["initial"]
+    assert abs(cc["contact_energy"][-1]) <= 0.05 * summary["energy"]["initial"]
     assert summary["energy"]["max_balance_error"] <= 1e-12
 
 
