@@ -28,6 +28,11 @@ from rwall_fem.kernels import FAILURE, load
 
 __all__ = ["HARDENING", "InternalForce", "acceleration_pass", "set_failure", "set_flow_stress"]
 
+# What a pass notes of the cells (kernels/step.h), before it: the smallest estimate and its
+# cell and place, then the inverted cells, the first's place, the listed and eroded cells.
+_ESTIMATE_CLEARED = np.array([np.inf, -1.0, 0.0, 0.0, 0.0])
+_NOTES_CLEARED = np.array([0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+
 # The flow-stress laws of the kernels (kernels/plasticity.h).
 HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
 
@@ -135,9 +140,9 @@ class InternalForce:
         self._energy[0] = 0.0
         estimate = self.estimate_every_step or not self._estimated
         self.params.estimate = estimate
-        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        self.step[5:] = _NOTES_CLEARED
         if estimate:
-            self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
+            self.step[:5] = _ESTIMATE_CLEARED
             self._estimated = True
         self._kernel()
         if self.step[11]:
