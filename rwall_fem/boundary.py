@@ -42,6 +42,8 @@ class VelocityBoundary:
         self.axes = np.array(["xyz".index(c) for c in components])
         # The prescribed values' places in a C-contiguous (nodes, 3) array, (nodes, axes)
         self._flat = 3 * self.nodes.astype(np.int64)[:, None] + self.axes[None, :]
+        # The impulse's components that the sums add to: all of them in order, or some.
+        self._components = slice(None) if self.axes.tolist() == [0, 1, 2] else self.axes
         self.impulse = np.zeros(3)  # reaction on this rank's nodes so far, N s
         self.work = 0.0  # work of the reaction up to step n, J (mid-step booking)
         self._reaction = None  # the latest step's reaction (N s), for its v^{n+1/2} half
@@ -118,4 +120,4 @@ class VelocityBoundary:
         self._reaction = self._reactions
         # NumPy's sum over the nodes of one component is pairwise, of 2 or 3 in node order.
         sums = self._sums if len(self.axes) > 1 else self._reactions.sum(axis=0)
-        self.impulse[self.axes] += sums
+        self.impulse[self._components] += sums

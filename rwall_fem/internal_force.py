@@ -20,12 +20,18 @@ arrays alone.
 from __future__ import annotations
 
 import functools
+import operator
 
 import numpy as np
 
 from rwall_fem.kernels import FAILURE, load
 
 __all__ = ["HARDENING", "InternalForce", "acceleration_pass", "set_failure", "set_flow_stress"]
+
+# What a pass notes of the cells (kernels/step.h), before it: the smallest estimate and its
+# cell and place, then the inverted cells, the first's place, the listed and eroded cells.
+_ESTIMATE_CLEARED = np.array([np.inf, -1.0, 0.0, 0.0, 0.0])
+_NOTES_CLEARED = np.array([0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
 
 # The flow-stress laws of the kernels (kernels/plasticity.h).
 HARDENING = {"linear": 0, "power": 1, "table": 2, "johnson_cook": 3}
@@ -77,20 +83,27 @@ def set_failure(p, failure, slot: int) -> None:
         p.damage_reference_rate = failure.reference_strain_rate
 
 
-def acceleration_pass(bound, f: np.ndarray, inv_mass: np.ndarray, a: np.ndarray):
+def acceleration_pass(bound, f: np.ndarray, inv_mass: np.ndarray, a: np.ndarray,
+                      rotations: tuple | None = None):  # fmt: skip
     """The compiled pass a = -f inv_mass over the rows of ``inv_mass``
     (``internal_acceleration``: f and a (n, 3), N and m/s^2, or moments (N m) and angular
     accelerations (rad/s^2); inv_mass 1/kg or 1/(kg m^2)) on these very arrays: ``bound``
     (an earlier result, or None) when it is theirs, else the pass bound anew. It keeps the
     arrays its pointers point into, and is bound again when it is handed other ones
     (another state, or a state's array replaced) instead of writing into the old ones,
-    freed or not."""
-    arrays = (f, inv_mass, a)
-    if bound is not None and all(x is y for x, y in zip(bound.keep, arrays, strict=True)):
+    freed or not. With ``rotations`` (moments, 1/inertias, free or None, alpha) a shell
+    body's alpha = -M / I times free is set in the same sweep (``shell_acceleration``)."""
+    arrays = (f, inv_mass, a) if rotations is None else (f, inv_mass, a, *rotations)
+    if bound is not None and len(bound.keep) == len(arrays) and not any(
+        map(operator.is_not, bound.keep, arrays)
+    ):
         return bound
+    if rotations is not None and len(rotations[1]) != len(inv_mass):
+        raise ValueError("a shell body's rotations need an inertia per node of the state")
     ffi, lib = load()
-    call = functools.partial(lib.internal_acceleration, len(inv_mass),
-                             *(ffi.cast("double *", x.ctypes.data) for x in arrays))  # fmt: skip
+    kernel = lib.internal_acceleration if rotations is None else lib.shell_acceleration
+    pointers = (ffi.NULL if x is None else ffi.cast("double *", x.ctypes.data) for x in arrays)
+    call = functools.partial(kernel, len(inv_mass), *pointers)
     call.keep = arrays  # what the pointers point into
     return call
 
@@ -127,9 +140,9 @@ class InternalForce:
         self._energy[0] = 0.0
         estimate = self.estimate_every_step or not self._estimated
         self.params.estimate = estimate
-        self.step[5:] = (0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        self.step[5:] = _NOTES_CLEARED
         if estimate:
-            self.step[:5] = (np.inf, -1.0, 0.0, 0.0, 0.0)
+            self.step[:5] = _ESTIMATE_CLEARED
             self._estimated = True
         self._kernel()
         if self.step[11]:

@@ -28,6 +28,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+import operator
 import signal
 import threading
 import time
@@ -271,8 +272,7 @@ class CentralDifference:
         )  # fmt: skip
 
     def __call__(self, state: State) -> None:
-        arrays = self._state_arrays(state)
-        if not all(x is y for x, y in zip(arrays, self._bound, strict=True)):
+        if any(map(operator.is_not, self._state_arrays(state), self._bound)):
             self._bind(state)  # another state, or one whose arrays were replaced
         if self._part_sums is not None:
             self._part_sums[:] = 0.0
@@ -385,8 +385,8 @@ class Simulation:
             )
         s, update, history, step_size = self.state, self.update, self.history, self.step_size
         internal, forces, constraints = self.internal, self.forces, self.constraints
-        contacts = self.contacts
-        checkpoints = self.checkpoints
+        contacts, recorders = self.contacts, self.recorders
+        checkpoints, end_time = self.checkpoints, self.end_time
         # A resumed run goes on after its checkpoint's step, unless that step was the last.
         going = not (self.first_step and s.last)
         with contextlib.ExitStack() as closing:
@@ -404,7 +404,7 @@ class Simulation:
                 if self.first_step and going:
                     step_size.advance(s)
                 while going:
-                    s.last = s.t >= self.end_time - 1e-9 * s.dt_previous
+                    s.last = s.t >= end_time - 1e-9 * s.dt_previous
                     internal.accelerate(s)
                     for contact in contacts:
                         contact.accelerate(s)
@@ -413,7 +413,7 @@ class Simulation:
                         force.accelerate(s)
                     for constraint in constraints:
                         constraint.constrain(s)
-                    for recorder in self.recorders:
+                    for recorder in recorders:
                         if recorder.due(s):
                             recorder.record(self, s)
                     update(s)

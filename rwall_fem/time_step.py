@@ -123,10 +123,12 @@ class _StepSize:
         that eroded cells on some rank, the nodes they held are counted again."""
         step = self.force.step
         # Each contact interface's nodal step on this rank's nodes.
-        contact = min((c.dt_limit for c in self.contacts), default=math.inf)
+        contacts = self.contacts
+        contact = min(c.dt_limit for c in contacts) if contacts else math.inf
         if self.comm.size == 1:
-            smallest, inverted, listed, eroded = (float(step[0]), -float(step[5]),
-                                                  -float(step[10]), -float(step[11]))  # fmt: skip
+            values = step.tolist()
+            smallest, inverted, listed, eroded = (values[0], -values[5], -values[10],
+                                                  -values[11])  # fmt: skip
         else:
             self._local[:] = (step[0], -step[5], -step[10], -step[11], contact)
             self.comm.Allreduce(self._local, self._total, op=MPI.MIN)

@@ -137,6 +137,9 @@ void hex8_cell_sizes(int64_t n, const int32_t *cells, const double *x, double *v
     )
     + """
 void internal_acceleration(int64_t n, const double *f, const double *inv_mass, double *a);
+void shell_acceleration(int64_t n, const double *f, const double *inv_mass, double *a,
+                        const double *moments, const double *inv_inertia, const double *free,
+                        double *alpha);
 void central_difference(int64_t n, double dt_v, double dt, const double *mass, const double *a,
                         double *v, double *u, const double *f, double out[9],
                         double integral[3], double momentum[3], const int32_t *labels,

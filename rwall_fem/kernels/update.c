@@ -1,7 +1,8 @@
 /* The per-node parts of a central-difference step (docs/theory.md, "Time stepping").
  *
  * internal_acceleration: a = -f / m, the acceleration from the internal force f, before
- * body forces and constraints add to it or edit it.
+ * body forces and constraints add to it or edit it; shell_acceleration: the same for a
+ * shell body's translations and rotations in one sweep.
  *
  * central_difference: v^{n+1/2} = v^{n-1/2} + dt_v a^n, u^{n+1} = u^n + dt v^{n+1/2}, with
  * dt = dt^{n+1/2} and dt_v = (dt^{n-1/2} + dt^{n+1/2}) / 2 (a variable step), in one pass
@@ -43,6 +44,24 @@ void internal_acceleration(int64_t n, const double *restrict f, const double *re
   for (int64_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c)
       a[3 * i + c] = -f[3 * i + c] * inv_mass[i];
+}
+
+/* internal_acceleration of a shell body's translations and rotations in one sweep:
+ * a = -f / m and alpha = -M / I (moments M, inv_inertia 1/I), the latter times free (0
+ * where a rotation is held, 1 elsewhere; NULL: none held). */
+void shell_acceleration(int64_t n, const double *restrict f, const double *restrict inv_mass,
+                        double *restrict a, const double *restrict moments,
+                        const double *restrict inv_inertia, const double *restrict free,
+                        double *restrict alpha)
+{
+  for (int64_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+    {
+      const int64_t j = 3 * i + c;
+      const double turn = -moments[j] * inv_inertia[i];
+      a[j] = -f[j] * inv_mass[i];
+      alpha[j] = free ? turn * free[j] : turn;
+    }
 }
 
 /* One node of the update (f: NULL or the booked force); kept inline so that each loop

@@ -34,6 +34,10 @@ class Guards:
         the state ``s``: ``error`` is its balance error, ``finite`` whether every sum of
         the sample is finite, ``signals`` the stop signals any rank received ("SIGTERM",
         "SIGINT"), ``step_work`` the work of the step's changes over the energy scale."""
+        if finite and abs(error) <= self.max_energy_error and not signals and (
+            abs(step_work) <= self.max_energy_error
+        ):
+            return  # nothing trips: the message is not written
         where = f"step {s.step}, t = {s.t:.6g} s"
         if not finite:
             bad = ~(np.isfinite(s.u).all(axis=1) & np.isfinite(s.v).all(axis=1))

@@ -169,7 +169,9 @@ class History:
             return
         self.steps.taken(s)
         local = self._sums.local
-        local["kinetic"][...] = s.kinetic - sum(r.nodal_kinetic(s) for r in self.rigid)
+        rigid = self.rigid
+        local["kinetic"][...] = (s.kinetic - sum(r.nodal_kinetic(s) for r in rigid) if rigid
+                                 else s.kinetic)  # fmt: skip
         for name, value in sim.internal.energies(s).items():
             local[name][...] = value
         if sim.contacts:
@@ -232,7 +234,8 @@ class History:
         for i, contact in enumerate(sim.contacts):
             energy = float(total[f"contact[{i}]"])
             self._contacts_csv.append(contact.row(s.t, i, energy))
-        signals = tuple(name for name, n in zip(SIGNALS, total["signals"], strict=True) if n)
+        received = total["signals"].tolist()
+        signals = tuple(name for name, n in zip(SIGNALS, received, strict=True) if n)
         self.guards.check(
             s,
             self.balance.error,

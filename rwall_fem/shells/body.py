@@ -155,9 +155,9 @@ class ShellBody(PartedBody):
     # --- the step ----------------------------------------------------------------------
 
     def accelerate(self, state) -> None:
-        """Set ``state.a = -f(u^n) / m`` and :attr:`alpha` ``= -M / I`` on the owned nodes,
-        every part's kernel adding its forces and moments; combine what they noted of the
-        stable steps."""
+        """Set ``state.a = -f(u^n) / m`` and :attr:`alpha` ``= -M / I`` on the owned nodes
+        (0 about the held axes), in one compiled sweep after every part's kernel added its
+        forces and moments; combine what they noted of the stable steps."""
         for field in (self.u, self.v, self.w):
             field.scatter_forward()
         self.f.array.fill(0.0)
@@ -170,15 +170,10 @@ class ShellBody(PartedBody):
         self._end_nodal_stiffness()
         if not self._alone:
             self._combine_steps()
-        translations, rotations = self._acceleration or (None, None)
-        self._acceleration = (
-            acceleration_pass(translations, self.f.array, state.inv_mass, state.a),
-            acceleration_pass(rotations, self.m.array, self.inv_inertia, self.alpha),
-        )
-        for pass_ in self._acceleration:
-            pass_()
-        if self._free is not None:
-            self.alpha *= self._free
+        rotations = (self.m.array, self.inv_inertia, self._free, self.alpha)
+        self._acceleration = acceleration_pass(self._acceleration, self.f.array,
+                                               state.inv_mass, state.a, rotations)  # fmt: skip
+        self._acceleration()
 
     def scale_rotations(self, nodes: np.ndarray, ratio: np.ndarray) -> float:
         """Mass scaling gave the owned ``nodes`` ``ratio`` times their mass: their

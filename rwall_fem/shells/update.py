@@ -15,6 +15,7 @@ nodal triad is turned.
 from __future__ import annotations
 
 import functools
+import operator
 
 import numpy as np
 
@@ -61,15 +62,15 @@ class ShellUpdate(CentralDifference):
     def __call__(self, state) -> None:
         body = self.body
         arrays = self._state_arrays(state)
-        if getattr(body, "turning", None) is not self._bound_turning or not all(
-            x is y for x, y in zip(arrays, self._bound, strict=True)
+        if getattr(body, "turning", None) is not self._bound_turning or any(
+            map(operator.is_not, arrays, self._bound)
         ):
             self._bind(state)  # another state, or the body's turning given late
         if self._part_sums is not None:
             self._part_sums[:] = 0.0
         self._pass(state.dt_velocity, state.dt, *self._arrays)
         state.kinetic = self._out[0]
-        body.rotational_kinetic = float(self._turns[0])
-        body.rotational_sums = (float(self._turns[1]), float(self._turns[2]))
+        body.rotational_kinetic, *sums = self._turns.tolist()
+        body.rotational_sums = tuple(sums)
         if self._internal is not None:
             self._internal.book(state, self._out[1], self._out[2])

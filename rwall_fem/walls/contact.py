@@ -65,14 +65,16 @@ class ContactPasses:
         self._state = [_pointer(self.ffi, x) for x in (state.X, state.u, state.v, state.a)]
         self._mass = _pointer(self.ffi, state.mass)
         self._v, self._a = self._state[2:]
-        # offset, next offset and velocity of the wall (m, m, m/s), then the sums of apply
-        self._vectors = np.zeros(3 * 3 + 9)
+        # offset, next offset and velocity of the wall (m, m, m/s), the sums of apply, the
+        # main node's predicted velocity (m/s)
+        self._vectors = np.zeros(3 * 3 + 9 + 3)
         self._vectors_pointer = _pointer(self.ffi, self._vectors)
         # the sums of coupling; then the main node's matrix, right side and velocity; works
         self._coupling = np.zeros(12 + 9 + 3 + 3 + 2)
         self._coupling_pointer = _pointer(self.ffi, self._coupling)
         self._coupling_sums = self._coupling[:12]
         self._clearance = np.zeros(0)
+        self._rows = {}  # pointers to the arrays of some calls, by their use (_rows_pointer)
         self._reserve(0)
 
     def _reserve(self, n: int) -> None:
@@ -99,6 +101,15 @@ class ContactPasses:
             "slip": p("uint8_t[]", self.slip),
         }
 
+    def _rows_pointer(self, use: str, array: np.ndarray, kind: str = "int64_t[]"):
+        """The pointer to ``array`` (a node list by default), kept for the next call of the
+        same ``use`` while it is handed the same array (a near set lives for many steps; the
+        array is kept with it, so that no other can take its place)."""
+        kept = self._rows.get(use)
+        if kept is None or kept[0] is not array:
+            kept = self._rows[use] = (array, _pointer(self.ffi, array, kind))
+        return kept[1]
+
     def clearance(self, nodes: np.ndarray, offset) -> tuple[np.ndarray, float]:
         """The clearance (m) of ``nodes`` (node indices, int64) from the wall at ``offset``
         (m), as the shape's ``clearance``, and the largest absolute coordinate of their
@@ -123,7 +134,7 @@ class ContactPasses:
             self.lib.largest_range(3 * (end - first), self._v + 3 * first, self._a + 3 * first,
                                    sums)  # fmt: skip
         else:
-            rows = _pointer(self.ffi, nodes, "int64_t[]")
+            rows = self._rows_pointer("largest", nodes)
             self.lib.largest_components(len(nodes), rows, self._v, self._a, sums)
         speed, acceleration = self._vectors[9:11].tolist()
         return speed, acceleration
@@ -138,7 +149,7 @@ class ContactPasses:
         w = self._vectors_pointer
         X, u, v, a = self._state
         return self.lib.wall_find(
-            len(near), _pointer(self.ffi, near, "int64_t[]"), X, u, v, a, self._mass, dt_v,
+            len(near), self._rows_pointer("near", near), X, u, v, a, self._mass, dt_v,
             dt, self._shape, w, w + 3, w + 6, q["hits"], q["nodes"], q["mass"], q["normals"],
             q["predicted"], q["previous"], q["target"],
         )  # fmt: skip
@@ -170,7 +181,7 @@ class ContactPasses:
             w + 6, q["_scratch"], self._coupling_pointer + 27,
         )  # fmt: skip
         normal_work, tangential_work = self._coupling[27:29].tolist()
-        return self._vectors[9:].reshape(3, 3), (normal_work, tangential_work)
+        return self._vectors[9:18].reshape(3, 3), (normal_work, tangential_work)
 
     def coupling(self, k: int, tied: bool, slip: bool = False) -> np.ndarray:
         """The sums over the k nodes in contact of the equations of a main-node wall's
@@ -190,8 +201,8 @@ class ContactPasses:
         """:meth:`coupling` then :meth:`velocity` in one call, on one rank (its sums are the
         totals)."""
         q, c, null = self._pointers, self._coupling_pointer, self.ffi.NULL
-        p = self.ffi.from_buffer("double[]", predicted)
-        held = self.ffi.from_buffer("uint8_t[]", held)
+        self._vectors[18:21] = predicted
+        p, held = self._vectors_pointer + 18, self._rows_pointer("held", held, "uint8_t[]")
         if self.lib.wall_coupled(
             k, tied, q["slip"] if slip else null, q["mass"], q["normals"], q["predicted"],
             q["target"], q["tangential"] if slip else null, mass, p, held, c,
@@ -205,10 +216,11 @@ class ContactPasses:
         V*_j for the components ``held`` (a uint8 mask of 3; kg, m/s). A diagonal system
         (all nodes tied) is divided (what LAPACK's solve does to it, to the bit), another
         solved by NumPy."""
-        c, q, ffi = self._coupling, self._coupling_pointer, self.ffi
+        c, q = self._coupling, self._coupling_pointer
         if total is not self._coupling_sums:
             c[:12] = total
-        p, held = ffi.from_buffer("double[]", predicted), ffi.from_buffer("uint8_t[]", held)
+        self._vectors[18:21] = predicted
+        p, held = self._vectors_pointer + 18, self._rows_pointer("held", held, "uint8_t[]")
         if self.lib.wall_velocity(q, mass, p, held, q + 12, q + 21, q + 24):
             return c[24:27].copy()
         return np.linalg.solve(c[12:21].reshape(3, 3), c[21:24])
@@ -220,10 +232,17 @@ class ContactPasses:
         k = len(normal)
         self._reserve(k)
         self._vectors[6:9] = velocity
-        t = self.ffi.NULL if tangential is None else _pointer(self.ffi, tangential)
+        q = self._pointers
+        if nodes.base is self.nodes and normal.base is self.normal and (
+            tangential is None or tangential.base is self.tangential
+        ):  # the latest step's contacts, as find and impulses left them: pointers kept
+            n, f, t = q["nodes"], q["normal"], q["tangential"]
+        else:
+            n, f = _pointer(self.ffi, nodes, "int64_t[]"), _pointer(self.ffi, normal)
+            t = _pointer(self.ffi, tangential) if tangential is not None else None
         self.lib.wall_work(
-            k, _pointer(self.ffi, nodes, "int64_t[]"), _pointer(self.ffi, normal), t, self._v,
-            self._vectors_pointer + 6, self._pointers["_scratch"], self._coupling_pointer + 27,
+            k, n, f, self.ffi.NULL if tangential is None else t, self._v,
+            self._vectors_pointer + 6, q["_scratch"], self._coupling_pointer + 27,
         )  # fmt: skip
         normal_work, tangential_work = self._coupling[27:29].tolist()
         return normal_work, tangential_work
