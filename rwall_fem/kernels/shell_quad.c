@@ -744,21 +744,23 @@ INLINE void prefetch_rows(const element_params *p, const double *state, int64_t 
     __builtin_prefetch(state + r * stride + ahead, 1, 3);
 }
 
-INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict cells,
-                       const double *restrict X, const double *restrict u,
-                       const double *restrict v, const double *restrict w,
-                       const element_params *p, const shell_params *s, double *restrict state,
-                       int64_t stride, double *restrict f, double *restrict m,
-                       double *restrict energy, double *restrict step)
+/* shell_quad's work on the batch b of cells (the k0-th computed on): forces, state, steps;
+ * its energies added to totals[0 .. 2] (stored, hourglass, plastic), batch after batch. */
+INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t num_cells,
+                             const int32_t *restrict cells, const double *restrict X,
+                             const double *restrict u, const double *restrict v,
+                             const double *restrict w, const element_params *p,
+                             const shell_params *s, const qeph_constants_t *qcp,
+                             double *restrict state, int64_t stride, double *restrict f,
+                             double *restrict m, double *restrict energy,
+                             double *restrict step, double *restrict totals)
 {
+  const batch_t b = *bp;
+  const qeph_constants_t qc = *qcp;
   const double dt = p->dt;
   const int warping = s->warping;
-  const qeph_constants_t qc = qeph_constants(s);
   const int rows_ahead = s->qeph_physical ? s->hourglass_slot + 12 : 0; /* prefetch_rows */
-  double stored_total = 0.0, hourglass_total = 0.0, plastic_total = 0.0;
-  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
   {
-    const batch_t b = batch_at(p->live, k0, num_cells);
     if (rows_ahead)
       prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
     vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
@@ -825,18 +827,57 @@ INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict c
       dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
     const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
                                       &hourglass, du, fe, 8, energy, step);
-    stored_total += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    hourglass_total += lane_sum(hourglass, b.nb);
-    plastic_total += lane_sum(plastic_work, b.nb);
+    totals[0] += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+    totals[1] += lane_sum(hourglass, b.nb);
+    totals[2] += lane_sum(plastic_work, b.nb);
     scatter_add(cells, 4, &b, fe, f);
     scatter_add(cells, 4, &b, fe + 12, m);
     note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
     if (p->estimate)
       note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
   }
-  energy[0] += stored_total;
-  energy[1] += hourglass_total;
-  energy[2] += plastic_total;
+}
+
+/* The cells k0 .. k0 + LANES - 1 as a batch that the compiler knows to be consecutive. */
+INLINE batch_t run_at(int64_t k0)
+{
+  batch_t b;
+  b.nb = LANES, b.run = 1;
+  for (int k = 0; k < LANES; ++k)
+    b.id[k] = k0 + k;
+  return b;
+}
+
+/* The quadrilaterals' work batch after batch.  `runs` (a constant; only without p->live):
+ * the full batches are compiled apart as runs of consecutive cells (run_at), whose state
+ * rows and thicknesses load and store as vectors with no branches; the last, short batch
+ * goes through batch_at.  The energies add up batch after batch in the cells' order. */
+INLINE void shell_quad(int plastic, int runs, int64_t num_cells, const int32_t *restrict cells,
+                       const double *restrict X, const double *restrict u,
+                       const double *restrict v, const double *restrict w,
+                       const element_params *p, const shell_params *s, double *restrict state,
+                       int64_t stride, double *restrict f, double *restrict m,
+                       double *restrict energy, double *restrict step)
+{
+  const qeph_constants_t qc = qeph_constants(s);
+  double totals[3] = {0.0, 0.0, 0.0};
+  int64_t k0 = 0;
+  if (runs)
+    for (; k0 + LANES <= num_cells; k0 += LANES)
+    {
+      const batch_t b = run_at(k0);
+      shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride,
+                       f, m, energy, step, totals);
+    }
+  for (; k0 < num_cells; k0 += LANES)
+  {
+    const batch_t b = batch_at(p->live, k0, num_cells);
+    shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride, f,
+                     m, energy, step, totals);
+  }
+  energy[0] += totals[0];
+  energy[1] += totals[1];
+  energy[2] += totals[2];
 }
 
 /* f += internal forces (N), m += internal moments (N m) of the quadrilaterals `cells` (n x 4,
@@ -847,7 +888,7 @@ void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const 
                         const shell_params *s, double *state, int64_t stride, double *f,
                         double *m, double *energy, double *step)
 {
-  shell_quad(0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+  shell_quad(0, 0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
 /* QEPH's cells as Radioss decks give them (Ishell 24: its physical hourglass stresses with
@@ -886,7 +927,7 @@ INLINE void qeph_plain_kernel(int linear, int64_t n, const int32_t *cells, const
   sc.qeph_physical = 1, sc.qeph_hourglass = 1, sc.warping = 1, sc.points = 5;
   sc.hm = sc.hf = sc.hr = sc.hk = sc.kd = 0.0;
   sc.new_thickness = NULL;
-  shell_quad(1, n, cells, X, u, v, w, &pc, &sc, state, stride, f, m, energy, step);
+  shell_quad(1, 1, n, cells, X, u, v, w, &pc, &sc, state, stride, f, m, energy, step);
 }
 
 /* Each its own function (noinline): two instances of shell_quad in one function would
@@ -917,7 +958,7 @@ shell_quad_general(int64_t n, const int32_t *cells, const double *X, const doubl
                    const shell_params *s, double *state, int64_t stride, double *f, double *m,
                    double *energy, double *step)
 {
-  shell_quad(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+  shell_quad(1, 0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
 void shell_quad_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,
