@@ -862,7 +862,7 @@ INLINE void shell_quad(int plastic, int runs, int64_t num_cells, const int32_t *
   const qeph_constants_t qc = qeph_constants(s);
   double totals[3] = {0.0, 0.0, 0.0};
   int64_t k0 = 0;
-  if (runs)
+  if (runs && !p->live)
     for (; k0 + LANES <= num_cells; k0 += LANES)
     {
       const batch_t b = run_at(k0);
