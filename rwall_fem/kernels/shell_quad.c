@@ -760,82 +760,80 @@ INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t
   const double dt = p->dt;
   const int warping = s->warping;
   const int rows_ahead = s->qeph_physical ? s->hourglass_slot + 12 : 0; /* prefetch_rows */
+  if (rows_ahead)
+    prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
+  vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
+  shell_gather(cells, 4, &b, X, Xe);
+  shell_gather(cells, 4, &b, u, ue);
+  shell_gather(cells, 4, &b, v, ve);
+  shell_gather(cells, 4, &b, w, we);
+  for (int i = 0; i < 12; ++i)
   {
-    if (rows_ahead)
-      prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
-    vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
-    shell_gather(cells, 4, &b, X, Xe);
-    shell_gather(cells, 4, &b, u, ue);
-    shell_gather(cells, 4, &b, v, ve);
-    shell_gather(cells, 4, &b, w, we);
-    for (int i = 0; i < 12; ++i)
-    {
-      x[i] = Xe[i] + ue[i];
-      xm[i] = x[i] - (0.5 * dt) * ve[i];
-      du[i] = dt * ve[i];
-      du[12 + i] = dt * we[i];
-    }
-    for (int i = 0; i < 24; ++i)
-      fe[i] = VZERO;
-    const vec t = cell_values(s->thickness, &b);
-    quad_frame_t g;
-    quad_frame(xm, &g);
-    vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
-    to_local(&g, ve, vl);
-    to_local(&g, we, wl);
-    vec Ji[9], mz[4], drill = VZERO;
-    if (s->kd > 0.0)
-      drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
-    if (warping)
-    {
-      rigid_inverse(&g, Ji);
-      project_rigid(&g, Ji, vl);
-    }
-    quad_strain_rates(&g, vl, wl, d, k, gs);
-    const vec mid_area = g.area;
-    vec N[3], M[3], Q[2], elastic, dissipated, damage;
-    const vec before =
-        s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
-    /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
-     * MULAWC): the points' plastic strains before it */
-    const int qeph = plastic && s->qeph_hourglass && (s->hk > 0.0 || s->qeph_physical);
-    vec eps_before[SHELL_MAX_POINTS];
-    for (int pt = 0; qeph && pt < s->points; ++pt)
-      eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
-    shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
-                 &damage);
-    qeph_material_t material;
-    if (qeph)
-      qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
-    vec hourglass = VZERO;
-    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0 || s->qeph_physical)
-      hourglass = quad_hourglass(&g, s, &qc, p->density, dt, t, warping, Ji, vl, wl, state,
-                                 stride, &b, qeph ? &material : NULL, fe);
-    if (s->new_thickness)
-      shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
-    quad_frame(x, &g);
-    if (warping)
-      rigid_inverse(&g, Ji);
-    quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
-    if (s->kd > 0.0)
-      quad_drill_forces(&g, mz, fe);
-    elastic = elastic * g.area + drill;
-    const vec plastic_work = dissipated * mid_area;
-    const ivec inverted = ~(g.area > 0.0);
-    vec dte = VZERO + INFINITY;
-    if (p->estimate)
-      dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
-    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
-                                      &hourglass, du, fe, 8, energy, step);
-    totals[0] += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    totals[1] += lane_sum(hourglass, b.nb);
-    totals[2] += lane_sum(plastic_work, b.nb);
-    scatter_add(cells, 4, &b, fe, f);
-    scatter_add(cells, 4, &b, fe + 12, m);
-    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
+    x[i] = Xe[i] + ue[i];
+    xm[i] = x[i] - (0.5 * dt) * ve[i];
+    du[i] = dt * ve[i];
+    du[12 + i] = dt * we[i];
   }
+  for (int i = 0; i < 24; ++i)
+    fe[i] = VZERO;
+  const vec t = cell_values(s->thickness, &b);
+  quad_frame_t g;
+  quad_frame(xm, &g);
+  vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
+  to_local(&g, ve, vl);
+  to_local(&g, we, wl);
+  vec Ji[9], mz[4], drill = VZERO;
+  if (s->kd > 0.0)
+    drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
+  if (warping)
+  {
+    rigid_inverse(&g, Ji);
+    project_rigid(&g, Ji, vl);
+  }
+  quad_strain_rates(&g, vl, wl, d, k, gs);
+  const vec mid_area = g.area;
+  vec N[3], M[3], Q[2], elastic, dissipated, damage;
+  const vec before =
+      s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
+  /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
+   * MULAWC): the points' plastic strains before it */
+  const int qeph = plastic && s->qeph_hourglass && (s->hk > 0.0 || s->qeph_physical);
+  vec eps_before[SHELL_MAX_POINTS];
+  for (int pt = 0; qeph && pt < s->points; ++pt)
+    eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
+  shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
+               &damage);
+  qeph_material_t material;
+  if (qeph)
+    qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
+  vec hourglass = VZERO;
+  if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0 || s->qeph_physical)
+    hourglass = quad_hourglass(&g, s, &qc, p->density, dt, t, warping, Ji, vl, wl, state,
+                               stride, &b, qeph ? &material : NULL, fe);
+  if (s->new_thickness)
+    shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
+  quad_frame(x, &g);
+  if (warping)
+    rigid_inverse(&g, Ji);
+  quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
+  if (s->kd > 0.0)
+    quad_drill_forces(&g, mz, fe);
+  elastic = elastic * g.area + drill;
+  const vec plastic_work = dissipated * mid_area;
+  const ivec inverted = ~(g.area > 0.0);
+  vec dte = VZERO + INFINITY;
+  if (p->estimate)
+    dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
+  const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
+                                    &hourglass, du, fe, 8, energy, step);
+  totals[0] += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+  totals[1] += lane_sum(hourglass, b.nb);
+  totals[2] += lane_sum(plastic_work, b.nb);
+  scatter_add(cells, 4, &b, fe, f);
+  scatter_add(cells, 4, &b, fe + 12, m);
+  note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
+  if (p->estimate)
+    note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
 }
 
 /* The cells k0 .. k0 + LANES - 1 as a batch that the compiler knows to be consecutive. */
@@ -899,10 +897,12 @@ void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const 
  * settings as constants, once for linear hardening (the law a constant too) and once for the
  * other laws: the compiler folds them, so that the branches, the work only the options need
  * (the increments of erosion, the linear law's other forms in the return) and the runtime
- * loops over the points go.  The arithmetic is the same, in the same order: the results do
- * not change, bit for bit.  (The power law as a constant as well would gain about 1 % more
- * and change the last bits: some of its products by a factor 1 fold, and GCC then contracts
- * their neighbours into other fused multiply-adds.) */
+ * loops over the points go.  The arithmetic is the same, in the same order, but for the
+ * full batches, known there to be runs of consecutive cells (shell_quad's `runs`): without
+ * the branches of their loads and stores GCC contracts more products into fused
+ * multiply-adds, and the results change in their last bits.  (The power law as a constant
+ * as well would gain about 1 % more and change the last bits too: some of its products by a
+ * factor 1 fold, and GCC then contracts their neighbours into other fused multiply-adds.) */
 INLINE int qeph_plain(const element_params *p, const shell_params *s)
 {
   return s->qeph_physical && s->qeph_hourglass && s->warping && s->points == 5
