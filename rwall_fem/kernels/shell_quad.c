@@ -744,99 +744,138 @@ INLINE void prefetch_rows(const element_params *p, const double *state, int64_t 
     __builtin_prefetch(state + r * stride + ahead, 1, 3);
 }
 
-INLINE void shell_quad(int plastic, int64_t num_cells, const int32_t *restrict cells,
+/* shell_quad's work on the batch b of cells (the k0-th computed on): forces, state, steps;
+ * its energies added to totals[0 .. 2] (stored, hourglass, plastic), batch after batch. */
+INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t num_cells,
+                             const int32_t *restrict cells, const double *restrict X,
+                             const double *restrict u, const double *restrict v,
+                             const double *restrict w, const element_params *p,
+                             const shell_params *s, const qeph_constants_t *qcp,
+                             double *restrict state, int64_t stride, double *restrict f,
+                             double *restrict m, double *restrict energy,
+                             double *restrict step, double *restrict totals)
+{
+  const batch_t b = *bp;
+  const qeph_constants_t qc = *qcp;
+  const double dt = p->dt;
+  const int warping = s->warping;
+  const int rows_ahead = s->qeph_physical ? s->hourglass_slot + 12 : 0; /* prefetch_rows */
+  if (rows_ahead)
+    prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
+  vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
+  shell_gather(cells, 4, &b, X, Xe);
+  shell_gather(cells, 4, &b, u, ue);
+  shell_gather(cells, 4, &b, v, ve);
+  shell_gather(cells, 4, &b, w, we);
+  for (int i = 0; i < 12; ++i)
+  {
+    x[i] = Xe[i] + ue[i];
+    xm[i] = x[i] - (0.5 * dt) * ve[i];
+    du[i] = dt * ve[i];
+    du[12 + i] = dt * we[i];
+  }
+  for (int i = 0; i < 24; ++i)
+    fe[i] = VZERO;
+  const vec t = cell_values(s->thickness, &b);
+  quad_frame_t g;
+  quad_frame(xm, &g);
+  vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
+  to_local(&g, ve, vl);
+  to_local(&g, we, wl);
+  vec Ji[9], mz[4], drill = VZERO;
+  if (s->kd > 0.0)
+    drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
+  if (warping)
+  {
+    rigid_inverse(&g, Ji);
+    project_rigid(&g, Ji, vl);
+  }
+  quad_strain_rates(&g, vl, wl, d, k, gs);
+  const vec mid_area = g.area;
+  vec N[3], M[3], Q[2], elastic, dissipated, damage;
+  const vec before =
+      s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
+  /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
+   * MULAWC): the points' plastic strains before it */
+  const int qeph = plastic && s->qeph_hourglass && (s->hk > 0.0 || s->qeph_physical);
+  vec eps_before[SHELL_MAX_POINTS];
+  for (int pt = 0; qeph && pt < s->points; ++pt)
+    eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
+  shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
+               &damage);
+  qeph_material_t material;
+  if (qeph)
+    qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
+  vec hourglass = VZERO;
+  if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0 || s->qeph_physical)
+    hourglass = quad_hourglass(&g, s, &qc, p->density, dt, t, warping, Ji, vl, wl, state,
+                               stride, &b, qeph ? &material : NULL, fe);
+  if (s->new_thickness)
+    shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
+  quad_frame(x, &g);
+  if (warping)
+    rigid_inverse(&g, Ji);
+  quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
+  if (s->kd > 0.0)
+    quad_drill_forces(&g, mz, fe);
+  elastic = elastic * g.area + drill;
+  const vec plastic_work = dissipated * mid_area;
+  const ivec inverted = ~(g.area > 0.0);
+  vec dte = VZERO + INFINITY;
+  if (p->estimate)
+    dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
+  const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
+                                    &hourglass, du, fe, 8, energy, step);
+  totals[0] += lane_sum(vselect(failed, VZERO, elastic), b.nb);
+  totals[1] += lane_sum(hourglass, b.nb);
+  totals[2] += lane_sum(plastic_work, b.nb);
+  scatter_add(cells, 4, &b, fe, f);
+  scatter_add(cells, 4, &b, fe + 12, m);
+  note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
+  if (p->estimate)
+    note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
+}
+
+/* The cells k0 .. k0 + LANES - 1 as a batch that the compiler knows to be consecutive. */
+INLINE batch_t run_at(int64_t k0)
+{
+  batch_t b;
+  b.nb = LANES, b.run = 1;
+  for (int k = 0; k < LANES; ++k)
+    b.id[k] = k0 + k;
+  return b;
+}
+
+/* The quadrilaterals' work batch after batch.  `runs` (a constant; only without p->live):
+ * the full batches are compiled apart as runs of consecutive cells (run_at), whose state
+ * rows and thicknesses load and store as vectors with no branches; the last, short batch
+ * goes through batch_at.  The energies add up batch after batch in the cells' order. */
+INLINE void shell_quad(int plastic, int runs, int64_t num_cells, const int32_t *restrict cells,
                        const double *restrict X, const double *restrict u,
                        const double *restrict v, const double *restrict w,
                        const element_params *p, const shell_params *s, double *restrict state,
                        int64_t stride, double *restrict f, double *restrict m,
                        double *restrict energy, double *restrict step)
 {
-  const double dt = p->dt;
-  const int warping = s->warping;
   const qeph_constants_t qc = qeph_constants(s);
-  const int rows_ahead = s->qeph_physical ? s->hourglass_slot + 12 : 0; /* prefetch_rows */
-  double stored_total = 0.0, hourglass_total = 0.0, plastic_total = 0.0;
-  for (int64_t k0 = 0; k0 < num_cells; k0 += LANES)
+  double totals[3] = {0.0, 0.0, 0.0};
+  int64_t k0 = 0;
+  if (runs && !p->live)
+    for (; k0 + LANES <= num_cells; k0 += LANES)
+    {
+      const batch_t b = run_at(k0);
+      shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride,
+                       f, m, energy, step, totals);
+    }
+  for (; k0 < num_cells; k0 += LANES)
   {
     const batch_t b = batch_at(p->live, k0, num_cells);
-    if (rows_ahead)
-      prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
-    vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
-    shell_gather(cells, 4, &b, X, Xe);
-    shell_gather(cells, 4, &b, u, ue);
-    shell_gather(cells, 4, &b, v, ve);
-    shell_gather(cells, 4, &b, w, we);
-    for (int i = 0; i < 12; ++i)
-    {
-      x[i] = Xe[i] + ue[i];
-      xm[i] = x[i] - (0.5 * dt) * ve[i];
-      du[i] = dt * ve[i];
-      du[12 + i] = dt * we[i];
-    }
-    for (int i = 0; i < 24; ++i)
-      fe[i] = VZERO;
-    const vec t = cell_values(s->thickness, &b);
-    quad_frame_t g;
-    quad_frame(xm, &g);
-    vec vl[4][3], wl[4][3], d[3], k[3], gs[2];
-    to_local(&g, ve, vl);
-    to_local(&g, we, wl);
-    vec Ji[9], mz[4], drill = VZERO;
-    if (s->kd > 0.0)
-      drill = quad_drill_update(&g, s, dt, t, vl, wl, state, stride, &b, mz);
-    if (warping)
-    {
-      rigid_inverse(&g, Ji);
-      project_rigid(&g, Ji, vl);
-    }
-    quad_strain_rates(&g, vl, wl, d, k, gs);
-    const vec mid_area = g.area;
-    vec N[3], M[3], Q[2], elastic, dissipated, damage;
-    const vec before =
-        s->new_thickness ? shell_mean_stress(plastic, s, &b, state, stride, t) : VZERO;
-    /* QEPH's hourglass yield reads the material's update of the step (CZFINTN1 after
-     * MULAWC): the points' plastic strains before it */
-    const int qeph = plastic && s->qeph_hourglass && (s->hk > 0.0 || s->qeph_physical);
-    vec eps_before[SHELL_MAX_POINTS];
-    for (int pt = 0; qeph && pt < s->points; ++pt)
-      eps_before[pt] = load_slot(state, stride, &b, 2 + SHELL_POINT_SLOTS * pt + 3);
-    shell_update(plastic, p, s, &b, state, stride, t, d, k, gs, N, M, Q, &elastic, &dissipated,
-                 &damage);
-    qeph_material_t material;
-    if (qeph)
-      qeph_material(p, s, &b, state, stride, eps_before, t, N, M, &material);
-    vec hourglass = VZERO;
-    if (s->hm > 0.0 || s->hf > 0.0 || s->hr > 0.0 || s->hk > 0.0 || s->qeph_physical)
-      hourglass = quad_hourglass(&g, s, &qc, p->density, dt, t, warping, Ji, vl, wl, state,
-                                 stride, &b, qeph ? &material : NULL, fe);
-    if (s->new_thickness)
-      shell_thickness_change(s, &b, t, d, before, (N[0] + N[1]) / t);
-    quad_frame(x, &g);
-    if (warping)
-      rigid_inverse(&g, Ji);
-    quad_resultant_forces(&g, warping, Ji, N, M, Q, fe);
-    if (s->kd > 0.0)
-      quad_drill_forces(&g, mz, fe);
-    elastic = elastic * g.area + drill;
-    const vec plastic_work = dissipated * mid_area;
-    const ivec inverted = ~(g.area > 0.0);
-    vec dte = VZERO + INFINITY;
-    if (p->estimate)
-      dte = (p->calibration / s->bar_speed) * quad_length(s, &g);
-    const ivec failed = erode_plastic(p, &b, damage, inverted, dte, elastic, plastic_work,
-                                      &hourglass, du, fe, 8, energy, step);
-    stored_total += lane_sum(vselect(failed, VZERO, elastic), b.nb);
-    hourglass_total += lane_sum(hourglass, b.nb);
-    plastic_total += lane_sum(plastic_work, b.nb);
-    scatter_add(cells, 4, &b, fe, f);
-    scatter_add(cells, 4, &b, fe + 12, m);
-    note_inverted(inverted & ~failed, &b, x, NULL, 4, step);
-    if (p->estimate)
-      note_steps(p, vselect(inverted | failed, VZERO + INFINITY, dte), &b, cells, x, NULL, 4, step);
+    shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride, f,
+                     m, energy, step, totals);
   }
-  energy[0] += stored_total;
-  energy[1] += hourglass_total;
-  energy[2] += plastic_total;
+  energy[0] += totals[0];
+  energy[1] += totals[1];
+  energy[2] += totals[2];
 }
 
 /* f += internal forces (N), m += internal moments (N m) of the quadrilaterals `cells` (n x 4,
@@ -847,7 +886,7 @@ void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const 
                         const shell_params *s, double *state, int64_t stride, double *f,
                         double *m, double *energy, double *step)
 {
-  shell_quad(0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+  shell_quad(0, 0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
 /* QEPH's cells as Radioss decks give them (Ishell 24: its physical hourglass stresses with
@@ -858,10 +897,12 @@ void shell_quad_elastic(int64_t n, const int32_t *cells, const double *X, const 
  * settings as constants, once for linear hardening (the law a constant too) and once for the
  * other laws: the compiler folds them, so that the branches, the work only the options need
  * (the increments of erosion, the linear law's other forms in the return) and the runtime
- * loops over the points go.  The arithmetic is the same, in the same order: the results do
- * not change, bit for bit.  (The power law as a constant as well would gain about 1 % more
- * and change the last bits: some of its products by a factor 1 fold, and GCC then contracts
- * their neighbours into other fused multiply-adds.) */
+ * loops over the points go.  The arithmetic is the same, in the same order, but for the
+ * full batches, known there to be runs of consecutive cells (shell_quad's `runs`): without
+ * the branches of their loads and stores GCC contracts more products into fused
+ * multiply-adds, and the results change in their last bits.  (The power law as a constant
+ * as well would gain about 1 % more and change the last bits too: some of its products by a
+ * factor 1 fold, and GCC then contracts their neighbours into other fused multiply-adds.) */
 INLINE int qeph_plain(const element_params *p, const shell_params *s)
 {
   return s->qeph_physical && s->qeph_hourglass && s->warping && s->points == 5
@@ -886,7 +927,7 @@ INLINE void qeph_plain_kernel(int linear, int64_t n, const int32_t *cells, const
   sc.qeph_physical = 1, sc.qeph_hourglass = 1, sc.warping = 1, sc.points = 5;
   sc.hm = sc.hf = sc.hr = sc.hk = sc.kd = 0.0;
   sc.new_thickness = NULL;
-  shell_quad(1, n, cells, X, u, v, w, &pc, &sc, state, stride, f, m, energy, step);
+  shell_quad(1, 1, n, cells, X, u, v, w, &pc, &sc, state, stride, f, m, energy, step);
 }
 
 /* Each its own function (noinline): two instances of shell_quad in one function would
@@ -917,7 +958,7 @@ shell_quad_general(int64_t n, const int32_t *cells, const double *X, const doubl
                    const shell_params *s, double *state, int64_t stride, double *f, double *m,
                    double *energy, double *step)
 {
-  shell_quad(1, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
+  shell_quad(1, 0, n, cells, X, u, v, w, p, s, state, stride, f, m, energy, step);
 }
 
 void shell_quad_plastic(int64_t n, const int32_t *cells, const double *X, const double *u,

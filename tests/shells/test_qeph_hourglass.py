@@ -219,7 +219,10 @@ def test_the_plain_qeph_kernel_equals_the_general_one(hardening):
     as constants (shell_quad.c, qeph_plain); the same cells with a flow-stress cap that is
     never reached (1e30 Pa) run through the general kernel. Over 100 steps of a random
     motion that makes some points flow and leaves others elastic, the forces, moments,
-    energies, step notes and state are the same bit for bit."""
+    energies, step notes and state are the same to round-off: within 1e-13 of each
+    quantity's largest magnitude (measured: 2.3e-16; the plain kernel's full batches load
+    and store as runs of consecutive cells, and GCC contracts some of their products into
+    other fused multiply-adds)."""
     n = 6
     grid = np.arange(n + 1) * 2.5e-3
     X = np.array([[x, y, 0.0] for y in grid for x in grid])
@@ -248,4 +251,6 @@ def test_the_plain_qeph_kernel_equals_the_general_one(hardening):
         results.append((np.array(out), k.history.copy(), k.plastic_strains()))
     (plain, plain_state, eps), (general, general_state, _) = results
     assert 0.1 < np.mean(eps > 0) < 0.9  # some points flowed, others did not
-    assert np.array_equal(plain, general) and np.array_equal(plain_state, general_state)
+    assert np.all(np.abs(plain - general) <= 1e-13 * np.abs(general).max(axis=0))
+    assert np.all(np.abs(plain_state - general_state)
+                  <= 1e-13 * np.abs(general_state).max(axis=1, keepdims=True))
