@@ -94,6 +94,33 @@ INLINE void shell_gather(const int32_t *restrict cells, int npe, const batch_t *
 #endif
 }
 
+/* The motion of a batch's cells of npe nodes over the step dt (s): their nodes' initial
+ * positions Xe, displacements ue (m), velocities ve (m/s) and angular velocities we (rad/s)
+ * gathered (3 npe each), the positions x = X + u at the step's end and xm = x - dt/2 v at
+ * mid-step (m), the increments du = (dt v, dt w) (6 npe: translations, then rotations), and
+ * the cells' forces and moments fe (6 npe) zeroed. */
+INLINE void shell_motion(const int32_t *restrict cells, int npe, const batch_t *b, double dt,
+                         const double *X, const double *u, const double *v, const double *w,
+                         vec *restrict Xe, vec *restrict ue, vec *restrict ve,
+                         vec *restrict we, vec *restrict x, vec *restrict xm,
+                         vec *restrict du, vec *restrict fe)
+{
+  shell_gather(cells, npe, b, X, Xe);
+  shell_gather(cells, npe, b, u, ue);
+  shell_gather(cells, npe, b, v, ve);
+  shell_gather(cells, npe, b, w, we);
+  const int n = 3 * npe;
+  for (int i = 0; i < n; ++i)
+  {
+    x[i] = Xe[i] + ue[i];
+    xm[i] = x[i] - (0.5 * dt) * ve[i];
+    du[i] = dt * ve[i];
+    du[n + i] = dt * we[i];
+  }
+  for (int i = 0; i < 2 * n; ++i)
+    fe[i] = VZERO;
+}
+
 /* Plane-stress Hooke: (sxx, syy, sxy) += C (dxx, dyy, gxy) times `scale`. */
 INLINE void hooke_add(const shell_params *s, vec scale, const vec de[3], vec out[3])
 {

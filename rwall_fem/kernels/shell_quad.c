@@ -763,19 +763,7 @@ INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t
   if (rows_ahead)
     prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
   vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
-  shell_gather(cells, 4, &b, X, Xe);
-  shell_gather(cells, 4, &b, u, ue);
-  shell_gather(cells, 4, &b, v, ve);
-  shell_gather(cells, 4, &b, w, we);
-  for (int i = 0; i < 12; ++i)
-  {
-    x[i] = Xe[i] + ue[i];
-    xm[i] = x[i] - (0.5 * dt) * ve[i];
-    du[i] = dt * ve[i];
-    du[12 + i] = dt * we[i];
-  }
-  for (int i = 0; i < 24; ++i)
-    fe[i] = VZERO;
+  shell_motion(cells, 4, &b, dt, X, u, v, w, Xe, ue, ve, we, x, xm, du, fe);
   const vec t = cell_values(s->thickness, &b);
   quad_frame_t g;
   quad_frame(xm, &g);

@@ -178,19 +178,7 @@ INLINE void shell_tria(int plastic, int64_t num_cells, const int32_t *restrict c
     /* initialised: gather fills them lane by lane */
     vec Xe[9] = {VZERO}, ue[9] = {VZERO}, ve[9] = {VZERO}, we[9] = {VZERO}, x[9], xm[9], fe[18],
         du[18];
-    shell_gather(cells, 3, &b, X, Xe);
-    shell_gather(cells, 3, &b, u, ue);
-    shell_gather(cells, 3, &b, v, ve);
-    shell_gather(cells, 3, &b, w, we);
-    for (int i = 0; i < 9; ++i)
-    {
-      x[i] = Xe[i] + ue[i];
-      xm[i] = x[i] - (0.5 * dt) * ve[i];
-      du[i] = dt * ve[i];
-      du[9 + i] = dt * we[i];
-    }
-    for (int i = 0; i < 18; ++i)
-      fe[i] = VZERO;
+    shell_motion(cells, 3, &b, dt, X, u, v, w, Xe, ue, ve, we, x, xm, du, fe);
     const vec t = cell_values(s->thickness, &b);
     tria_frame_t g;
     tria_frame(xm, &g);
