@@ -60,34 +60,44 @@ typedef struct
                               rows from hourglass_slot (shell_quad.c, quad_hourglass_qeph) */
 } shell_params;
 
-/* any_lane of a comparison's mask (lanes all ones or all zeros) by the sign bits in one
- * instruction where the host has AVX (batch.h's loop over the lanes elsewhere). */
+/* any_lane of a comparison's mask (lanes all ones or all zeros) in one instruction where the
+ * host has AVX (4 lanes: their sign bits) or AVX-512 (8 lanes: a test), batch.h's loop over
+ * the lanes elsewhere. */
 INLINE int shell_any(ivec m)
 {
 #if defined(__AVX__) && LANES == 4
   return _mm256_movemask_pd((__m256d)m) != 0;
+#elif defined(__AVX512F__) && LANES == 8
+  return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
 #else
   return any_lane(m);
 #endif
 }
 
 /* batch.h's gather of the 3 components of the npe nodes of the batch's cells into
- * out[3 I + i][lane], node by node where the host has AVX-512 (VL): each lane's node as one
- * masked load of its x, y, z (the lane past z is not read) and a 4 x 4 transpose. */
+ * out[3 I + i][lane], node by node where the host has AVX-512 (VL; LANES 8): each lane's node
+ * as one masked load of its x, y, z (the lane past z is not read), two 4 x 4 transposes of
+ * four lanes each and their halves joined. */
 INLINE void shell_gather(const int32_t *restrict cells, int npe, const batch_t *b,
                          const double *restrict values, vec *restrict out)
 {
-#if defined(__AVX512VL__) && LANES == 4
+#if defined(__AVX512VL__) && LANES == 8
   for (int I = 0; I < npe; ++I)
   {
-    __m256d r[4];
-    for (int k = 0; k < 4; ++k)
-      r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[k] * npe + I]);
-    const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
-    const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
-    out[3 * I] = (vec)_mm256_permute2f128_pd(t0, t2, 0x20);
-    out[3 * I + 1] = (vec)_mm256_permute2f128_pd(t1, t3, 0x20);
-    out[3 * I + 2] = (vec)_mm256_permute2f128_pd(t0, t2, 0x31);
+    __m256d half[2][3];
+    for (int h = 0; h < 2; ++h)
+    {
+      __m256d r[4];
+      for (int k = 0; k < 4; ++k)
+        r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[4 * h + k] * npe + I]);
+      const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
+      const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
+      half[h][0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+      half[h][1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+      half[h][2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+    }
+    for (int i = 0; i < 3; ++i)
+      out[3 * I + i] = (vec)_mm512_insertf64x4(_mm512_castpd256_pd512(half[0][i]), half[1][i], 1);
   }
 #else
   gather(cells, npe, b, values, out);
