@@ -164,3 +164,16 @@ def test_after_erosion_the_segments_keep_their_lists_of_the_start():
     walked = strip_pass(left[::-1])
     walked.removed = removal._walk(walked)  # the walk over the shells left alone
     assert (node, before) in candidates(X, walked)
+    # A face the start did not have (as erosion bares in solids; here a triangle of the
+    # crack's first shell): its list is the walk's on the surface as it is.
+    bared = np.concatenate([quads[left[::-1]], [[*quads[crack[0], :3], -1]]])
+    grown = Pass(np.arange(n, dtype=np.int64), bared, np.full(len(bared), 1e6),
+                 np.full(len(bared), -1e-4), exclude=True)  # fmt: skip
+    grown.removed = removal.lists(grown, 0)
+    offsets, ids = removal._walk(grown)
+    last = len(bared) - 1
+    assert np.array_equal(grown.removed[1][grown.removed[0][last] :], ids[offsets[last] :])
+    assert len(ids[offsets[last] :]) > 0
+    for j in range(last):
+        assert np.array_equal(grown.removed[1][grown.removed[0][j] : grown.removed[0][j + 1]],
+                              after.removed[1][after.removed[0][j] : after.removed[0][j + 1]])
