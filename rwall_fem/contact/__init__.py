@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from mpi4py import MPI
@@ -165,7 +165,7 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                     exclude, _segment_sizes(seg, share),
                 ))  # fmt: skip
                 if removal is not None:
-                    out[-1].removed = removal.lists(out[-1])
+                    out[-1].removed = removal.lists(out[-1], len(out) - 1)
             return out
 
         common = dict(
@@ -233,7 +233,15 @@ class _Removal:
     (``kernels/contact_remove.c``), from the surface nodes' positions at the start
     ``positions`` (m), their thickness and size shares ``node_gap``, ``node_size`` (m) of a
     ``variable`` gap, the constant gap (or the variable one's floor) ``gap`` and its bound
-    ``most`` (m)."""
+    ``most`` (m).
+
+    Built once, as Radioss builds them in its starter: the first lists of each pass (its
+    surfaces at the start) are kept, by segment, and a pass built again after erosion
+    gives each segment it had at the start that segment's start list; only the faces that
+    erosion bared get lists of their own, by the same rule on the surface as it is then
+    (without the eroded cells' faces a walk along the mesh would find longer ways round
+    the holes, and a node across a crack would become a contact of the segments beside
+    it)."""
 
     positions: np.ndarray
     node_gap: np.ndarray
@@ -241,9 +249,38 @@ class _Removal:
     variable: bool
     gap: float
     most: float
+    start: list = field(default_factory=list)  # per pass: segment keys, offsets, nodes
 
-    def lists(self, ps: Pass) -> tuple[np.ndarray, np.ndarray]:
-        """The lists of pass ``ps`` (over the surface nodes), as :attr:`Pass.removed`."""
+    def lists(self, ps: Pass, which: int) -> tuple[np.ndarray, np.ndarray]:
+        """The lists of pass ``ps``, the ``which``-th of its interface (over the surface
+        nodes), as :attr:`Pass.removed`."""
+        keys = _segment_keys(ps.segments)
+        if which == len(self.start):  # the pass at the start
+            offsets, removed = self._walk(ps)
+            order = np.argsort(keys)
+            self.start.append((keys[order], order, offsets, removed))
+            return offsets, removed
+        known, order, start_offsets, start_removed = self.start[which]
+        at = np.minimum(np.searchsorted(known, keys), max(len(known) - 1, 0))
+        kept = known[at] == keys if len(known) else np.zeros(len(keys), dtype=bool)
+        where, counts = np.zeros(len(keys), dtype=np.int64), np.zeros(len(keys), dtype=np.int64)
+        was = order[at[kept]]
+        where[kept] = start_offsets[was]
+        counts[kept] = start_offsets[was + 1] - start_offsets[was]
+        pool = start_removed
+        if not kept.all():  # faces bared by erosion: their lists on the surface as it is
+            offsets, removed = self._walk(ps)
+            new = ~kept
+            where[new] = len(pool) + offsets[:-1][new]
+            counts[new] = np.diff(offsets)[new]
+            pool = np.concatenate([pool, removed])
+        ends = np.cumsum(counts)
+        rows = np.arange(int(ends[-1]) if len(ends) else 0) + np.repeat(where - ends + counts,
+                                                                         counts)
+        return np.concatenate([[0], ends]).astype(np.int64), pool[rows].copy()
+
+    def _walk(self, ps: Pass) -> tuple[np.ndarray, np.ndarray]:
+        """The lists of pass ``ps`` by the walk along its own segments."""
         from rwall_fem.kernels import load
 
         ffi, lib = load()
@@ -266,6 +303,13 @@ class _Removal:
             if count <= len(removed):
                 return offsets, removed[:count].copy()
             removed = np.zeros(count, dtype=np.int64)
+
+
+def _segment_keys(segments: np.ndarray) -> np.ndarray:
+    """Each segment (a row of 4 node indices, -1 as a triangle's 4th) as one value, the
+    same whatever the order of its nodes."""
+    rows = np.ascontiguousarray(np.sort(segments, axis=1), dtype=np.int64)
+    return rows.view(np.dtype((np.void, 32))).ravel()
 
 
 def _mirror(interface, nodes: np.ndarray, planes: list[tuple[Surface, np.ndarray]]) -> None:

@@ -174,3 +174,38 @@ def test_a_resumed_punch_with_eroding_shells_equals_the_uninterrupted_run(shared
     if comm.rank == 0:
         for name in ("energy.csv", "contacts.csv"):
             assert (out / name).read_text() == (shared_dir / "whole" / name).read_text()
+
+
+def _lists(share) -> dict[tuple, tuple]:
+    """The nodes (global numbers) each segment this rank owns in ``share`` leaves out of
+    its search, by the segment's sorted nodes."""
+    offsets, ids = share.removed
+    return {tuple(sorted(seg)): tuple(ids[offsets[j] : offsets[j + 1]])
+            for seg, j in zip(share.segments.tolist(), share.places.tolist())}  # fmt: skip
+
+
+def test_the_lists_of_exclude_within_gap_outlive_the_erosion(shared_dir):
+    """The punch with the plate in contact with itself as well (single surface, a gap of
+    1.5 mm over 1 mm shells, exclude_within_gap: Radioss Irem_gap 2): after shells eroded,
+    each segment left has the list it had at the start (Radioss builds them once; a walk
+    over the shells left would give the nodes across a crack to the segments before it:
+    tests/unit/test_contact_removal.py), the punch gets through and the books close."""
+    raw = punch_scene(shared_dir)
+    raw["contact"] = [{"self": True, "gap": 1.5e-3, "exclude_within_gap": True}]
+    sim = build_simulation(parse_scene(copy.deepcopy(raw), source="test"), comm, shared_dir)
+    contact = sim.contacts[0]
+    start = [_lists(share) for share in contact.shares]
+    assert sum(len(v) for lists in start for v in lists.values()) > 0
+    assert sim.run() == "done"
+    eroded = comm.allreduce(int((~contact.surfaces[0].alive).sum()))
+    assert eroded > 0 and contact.updates > 0
+    for before, share in zip(start, contact.shares, strict=True):
+        now = _lists(share)
+        assert now.keys() <= before.keys()
+        assert all(now[key] == before[key] for key in now)
+    names = [p.name for p in sim.internal.parts]
+    held = sim.internal.held[: len(sim.state.mass), names.index("punch")] > 0
+    lowest = comm.allreduce(float((sim.state.X + sim.state.u)[held, 2].min(initial=np.inf)),
+                            op=MPI.MIN)  # fmt: skip
+    assert lowest < -1e-3, lowest
+    assert sim.history.summary["energy"]["max_balance_error"] <= 1e-12

@@ -97,7 +97,7 @@ def test_the_lists_remove_the_pairs_within_the_gap_along_the_mesh():
     listed = strip_pass()
     removal = _Removal(np.ascontiguousarray(X), np.zeros(n), np.full(n, np.inf), False, GAP,
                        math.inf)  # fmt: skip
-    listed.removed = removal.lists(listed)
+    listed.removed = removal.lists(listed, 0)
     within = math.sqrt(2.0) * GAP
     rule = set()
     for j, q in enumerate(quads):
@@ -118,3 +118,62 @@ def test_the_lists_remove_the_pairs_within_the_gap_along_the_mesh():
     assert along_the_mesh(X, quads, quads[below[0]])[node] >= 11 * H - 1e-12
     assert (node, below[0]) in with_lists  # the far fold stays
     assert (node, beside[0]) in without and (node, beside[0]) not in with_lists
+
+
+def test_after_erosion_the_segments_keep_their_lists_of_the_start():
+    """The strip's bottom leg cut across by erosion (its row of 3 shells from x = 4 to 5
+    mm): a pass built again without them gives each shell left the list it had at the
+    start, as Radioss builds its lists once (the Dijkstra rule on the whole strip at the
+    start); a walk over the shells left would not: a node across the crack, 1 mm from the
+    shells before it, has no way to them along the shells left, and would become their
+    contact (gap 2.5 mm)."""
+    X, quads = u_strip()
+    n = len(X)
+    crack = np.flatnonzero((X[quads[:, 0], 2] == 0.0) & (X[quads].min(axis=1)[:, 0] == 4 * H)
+                           & (X[quads].max(axis=1)[:, 0] == 5 * H))  # fmt: skip
+    assert len(crack) == WIDE
+    left = np.setdiff1d(np.arange(len(quads)), crack)
+
+    def strip_pass(rows):
+        return Pass(np.arange(n, dtype=np.int64), quads[rows], np.full(len(rows), 1e6),
+                    np.full(len(rows), -1e-4), exclude=True)  # fmt: skip
+
+    removal = _Removal(np.ascontiguousarray(X), np.zeros(n), np.full(n, np.inf), False, GAP,
+                       math.inf)  # fmt: skip
+    start = strip_pass(np.arange(len(quads)))
+    start.removed = removal.lists(start, 0)
+    after = strip_pass(left[::-1])  # in another order, as a rebuilt surface may be
+    after.removed = removal.lists(after, 0)
+    within = math.sqrt(2.0) * GAP
+    rule = set()
+    for j, q in enumerate(quads[left[::-1]]):
+        dist = along_the_mesh(X, quads, q)  # the whole strip
+        rule |= {(int(s), j) for s in np.flatnonzero(dist <= within) if s not in q}
+    without, with_lists = candidates(X, strip_pass(left[::-1])), candidates(X, after)
+    assert with_lists == without - rule
+    # Each shell left has its start list.
+    for j, k in enumerate(left[::-1]):
+        a, b = after.removed[0][j : j + 2], start.removed[0][k : k + 2]
+        assert np.array_equal(after.removed[1][a[0] : a[1]], start.removed[1][b[0] : b[1]])
+    # A node across the crack (x = 5 mm, y = 1 mm) and the shell before it (x 3-4 mm)
+    node = 5 * (WIDE + 1) + 1
+    before = int(np.flatnonzero((X[quads[left[::-1]], 2].max(axis=1) == 0.0)
+                                & (X[quads[left[::-1]]].min(axis=1)[:, 0] == 3 * H)
+                                & (X[quads[left[::-1]]].min(axis=1)[:, 1] == 0.0))[0])  # fmt: skip
+    assert (node, before) in without and (node, before) not in with_lists
+    walked = strip_pass(left[::-1])
+    walked.removed = removal._walk(walked)  # the walk over the shells left alone
+    assert (node, before) in candidates(X, walked)
+    # A face the start did not have (as erosion bares in solids; here a triangle of the
+    # crack's first shell): its list is the walk's on the surface as it is.
+    bared = np.concatenate([quads[left[::-1]], [[*quads[crack[0], :3], -1]]])
+    grown = Pass(np.arange(n, dtype=np.int64), bared, np.full(len(bared), 1e6),
+                 np.full(len(bared), -1e-4), exclude=True)  # fmt: skip
+    grown.removed = removal.lists(grown, 0)
+    offsets, ids = removal._walk(grown)
+    last = len(bared) - 1
+    assert np.array_equal(grown.removed[1][grown.removed[0][last] :], ids[offsets[last] :])
+    assert len(ids[offsets[last] :]) > 0
+    for j in range(last):
+        assert np.array_equal(grown.removed[1][grown.removed[0][j] : grown.removed[0][j + 1]],
+                              after.removed[1][after.removed[0][j] : after.removed[0][j + 1]])
