@@ -1,7 +1,14 @@
 #!/bin/bash
 # Build OpenRadioss (starter + engine, gfortran, 1 thread) from a snapshot of its public
-# sources, for bench/openradioss_timing.py. Usage: bash build.sh SRC
-#   SRC: a checkout of github.com/OpenRadioss/OpenRadioss (checked with bd4557ba7).
+# sources, for bench/openradioss_timing.py. Usage: bash build.sh SRC [EXTLIB]
+#   SRC: a checkout of github.com/OpenRadioss/OpenRadioss (checked with bd4557ba7);
+#   EXTLIB: a checkout of github.com/OpenRadioss/OpenRadioss_extlib (checked with acb56d7,
+#     its version 73), copied to SRC/extlib when SRC has none: the build would otherwise
+#     download extlib.zip, and this machine has no network. Its static LAPACK may be absent
+#     from a snapshot (a large file): Debian's (liblapack-dev, libblas-dev) takes its place.
+#     Needs gfortran. The reader must first be built with SRC/extlib in place: Boost's
+#     headers in /usr/include (1.74) do not match extlib's 1.70 library (a reader built
+#     without extlib leaves undefined boost::filesystem symbols: rm -rf SRC/reader/cbuild_*).
 # The starter links the open reader built from SRC/reader; two edits make them agree:
 #  1. the starter writes format 2612 (its CODVERS) while the open reader stops at 2026:
 #     the reader is taught 2612 the way upstream taught it 2026 (five places below);
@@ -14,6 +21,17 @@
 #   LD_LIBRARY_PATH=SRC/exec RAD_CFG_PATH=SRC/hm_cfg_files OMP_STACKSIZE=400m; ulimit -s unlimited
 set -euo pipefail
 SRC=$(realpath "$1"); HERE=$(dirname "$(realpath "$0")")
+if [ ! -f "$SRC/extlib/EXTLIB_VERSION.json" ]; then
+  [ $# -ge 2 ] || { echo "no $SRC/extlib: give a checkout of OpenRadioss_extlib as EXTLIB"; exit 1; }
+  rm -rf "$SRC/extlib" && cp -r "$2/extlib" "$SRC/extlib" && cp "$2/EXTLIB_VERSION.json" "$SRC/extlib/"
+  LAPACK=$SRC/extlib/lapack-3.10.0/lib_linux64_gf
+  if [ ! -s "$LAPACK/liblapack.a" ]; then
+    mkdir -p "$LAPACK" && T=$(mktemp -d) && mkdir "$T/l" "$T/b"
+    (cd "$T/l" && ar x /usr/lib/x86_64-linux-gnu/lapack/liblapack.a)
+    (cd "$T/b" && ar x /usr/lib/x86_64-linux-gnu/blas/libblas.a)
+    rm -f "$LAPACK/liblapack.a" && ar rcs "$LAPACK/liblapack.a" "$T"/l/*.o "$T"/b/*.o && rm -rf "$T"
+  fi
+fi
 K=$SRC/reader/source/cfgkernel/KERNEL
 if ! grep -q FF_D00_2612 "$K/mv_file_format.h"; then
   sed -i 's/^\(\s*\)FF_D00_2026,$/&\n\1FF_D00_2612,/' "$K/mv_file_format.h"
