@@ -727,26 +727,9 @@ INLINE vec quad_length(const shell_params *s, const quad_frame_t *g)
   return vsqrt(vmax(dynamic, shortest));
 }
 
-/* How far ahead of its batch a QEPH kernel prefetches the state rows: in cells. */
-#define PREFETCH_CELLS 32
-
-/* Prefetch the first `rows` state rows (for writing) of the cell PREFETCH_CELLS after the
- * k0-th computed one, once per 8 cells (a cache line of each row).  QEPH's 12 hourglass
- * rows after a 5-point cell's 27 make 39 streams of the state alone; prefetched, its kernel
- * runs about 5 % faster (bench/shell_kernels.md); the results do not change. */
-INLINE void prefetch_rows(const element_params *p, const double *state, int64_t stride,
-                          int rows, int64_t k0, int64_t num_cells)
-{
-  if ((k0 & 7) != 0 || k0 + PREFETCH_CELLS >= num_cells)
-    return;
-  const int64_t ahead = p->live ? p->live[k0 + PREFETCH_CELLS] : k0 + PREFETCH_CELLS;
-  for (int r = 0; r < rows; ++r)
-    __builtin_prefetch(state + r * stride + ahead, 1, 3);
-}
-
-/* shell_quad's work on the batch b of cells (the k0-th computed on): forces, state, steps;
+/* shell_quad's work on the batch b of cells: forces, state, steps;
  * its energies added to totals[0 .. 2] (stored, hourglass, plastic), batch after batch. */
-INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t num_cells,
+INLINE void shell_quad_batch(int plastic, const batch_t *bp,
                              const int32_t *restrict cells, const double *restrict X,
                              const double *restrict u, const double *restrict v,
                              const double *restrict w, const element_params *p,
@@ -759,9 +742,6 @@ INLINE void shell_quad_batch(int plastic, const batch_t *bp, int64_t k0, int64_t
   const qeph_constants_t qc = *qcp;
   const double dt = p->dt;
   const int warping = s->warping;
-  const int rows_ahead = s->qeph_physical ? s->hourglass_slot + 12 : 0; /* prefetch_rows */
-  if (rows_ahead)
-    prefetch_rows(p, state, stride, rows_ahead, k0, num_cells);
   vec Xe[12], ue[12], ve[12], we[12], x[12], xm[12], fe[24], du[24];
   shell_motion(cells, 4, &b, dt, X, u, v, w, Xe, ue, ve, we, x, xm, du, fe);
   const vec t = cell_values(s->thickness, &b);
@@ -852,13 +832,13 @@ INLINE void shell_quad(int plastic, int runs, int64_t num_cells, const int32_t *
     for (; k0 + LANES <= num_cells; k0 += LANES)
     {
       const batch_t b = run_at(k0);
-      shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride,
+      shell_quad_batch(plastic, &b, cells, X, u, v, w, p, s, &qc, state, stride,
                        f, m, energy, step, totals);
     }
   for (; k0 < num_cells; k0 += LANES)
   {
     const batch_t b = batch_at(p->live, k0, num_cells);
-    shell_quad_batch(plastic, &b, k0, num_cells, cells, X, u, v, w, p, s, &qc, state, stride, f,
+    shell_quad_batch(plastic, &b, cells, X, u, v, w, p, s, &qc, state, stride, f,
                      m, energy, step, totals);
   }
   energy[0] += totals[0];
