@@ -71,9 +71,8 @@ def material(name):
 
 def technology(cell, tech, plastic):
     options = case.TECHNOLOGIES[tech]
-    return Technology.choose(
-        cell, options.get("integration"), options.get("hourglass", "physical"), plastic=plastic
-    )
+    return Technology.choose(cell, options.get("integration"), options.get("hourglass"),
+                             plastic=plastic)  # fmt: skip
 
 
 class Probe:
