@@ -19,7 +19,9 @@ import time
 import case
 from mpi4py import MPI
 
+import rwall_fem.body as body
 import rwall_fem.build as build
+import rwall_fem.mechanics as mechanics
 from rwall_fem import _compat, build_simulation
 
 comm = MPI.COMM_WORLD
@@ -80,10 +82,10 @@ def main():
     note("imports")
     watched(_compat, "model_to_mesh", "meshing: distributed by DOLFINx", "meshing: gmsh model")
     watched(build, "body_mesh", "meshing: gmsh finalized")
-    watched(build, "lumped_mass", "space and mass")
-    watched(build, "ElementForce", "element force (kernels)")
+    watched(mechanics, "lumped_mass", "space and mass")  # imported by body at its call
+    watched(body, "ElementForce", "element force (kernels)")
     watched(build, "critical_time_step", "stable step: SLEPc")
-    watched(build, "element_time_step", "stable step: shortest edge")
+    watched(build, "shortest_edge", "stable step: shortest edge")
     watched(build, "boundary_nodes", "wall: boundary nodes")
     watched(build, "History", "history")
     if a.fixed_step:

@@ -58,6 +58,7 @@ t0 = time.perf_counter()
 import rwall_fem.build as build  # noqa: E402
 import rwall_fem.cli as cli  # noqa: E402
 import rwall_fem.elements as elements  # noqa: E402
+import rwall_fem.mechanics as mechanics  # noqa: E402
 import rwall_fem.scene as scene_module  # noqa: E402
 import rwall_fem.solver as solver  # noqa: E402
 from rwall_fem import _compat  # noqa: E402
@@ -82,10 +83,10 @@ timed(scene_module, "load_scene", "scene")
 timed(build, "body_mesh", "meshing")
 timed(_compat, "model_to_mesh", "meshing: distribution (DOLFINx)")
 timed(_compat, "vector_space", "space and mass")
-timed(build, "lumped_mass", "space and mass")
+timed(mechanics, "lumped_mass", "space and mass")  # imported by body at its call
 timed(elements, "load", "kernels")
 timed(build, "critical_time_step", "stable step: SLEPc")
-timed(build, "element_time_step", "stable step: edges")
+timed(build, "shortest_edge", "stable step: edges")
 timed(build, "build_simulation", "set-up (all)")
 
 first_step = {}
