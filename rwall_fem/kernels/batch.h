@@ -24,6 +24,9 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#if defined(__AVX512VL__)
+#include <immintrin.h>
+#endif
 
 #define LANES 8
 #define INLINE static inline __attribute__((always_inline))
@@ -111,10 +114,33 @@ INLINE batch_t batch_at(const int32_t *restrict live, int64_t k0, int64_t n)
   return b;
 }
 
-/* Gather the 3 components of the npe nodes of the batch's cells into out[3 I + i][lane]. */
+/* Gather the 3 components of the npe nodes of the batch's cells into out[3 I + i][lane]:
+ * where the host has AVX-512 (VL; LANES 8) node by node, each lane's node as one masked load
+ * of its x, y, z (the lane past z is not read), two 4 x 4 transposes of four lanes each and
+ * their halves joined (element by element into the vectors, 8 lanes cost the kernels 20-35
+ * ns more per cell: docs/performance.md). */
 INLINE void gather(const int32_t *restrict cells, int npe, const batch_t *b,
                    const double *restrict values, vec *restrict out)
 {
+#if defined(__AVX512VL__) && LANES == 8
+  for (int I = 0; I < npe; ++I)
+  {
+    __m256d half[2][3];
+    for (int h = 0; h < 2; ++h)
+    {
+      __m256d r[4];
+      for (int k = 0; k < 4; ++k)
+        r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[4 * h + k] * npe + I]);
+      const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
+      const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
+      half[h][0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+      half[h][1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+      half[h][2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+    }
+    for (int i = 0; i < 3; ++i)
+      out[3 * I + i] = (vec)_mm512_insertf64x4(_mm512_castpd256_pd512(half[0][i]), half[1][i], 1);
+  }
+#else
   for (int k = 0; k < LANES; ++k)
   {
     const int32_t *cell = cells + b->id[k] * npe;
@@ -122,6 +148,7 @@ INLINE void gather(const int32_t *restrict cells, int npe, const batch_t *b,
       for (int i = 0; i < 3; ++i)
         out[3 * I + i][k] = values[3 * (int64_t)cell[I] + i];
   }
+#endif
 }
 
 /* Add the nodal forces in[3 I + i][lane] of the batch's nb valid lanes to f. */

@@ -74,36 +74,6 @@ INLINE int shell_any(ivec m)
 #endif
 }
 
-/* batch.h's gather of the 3 components of the npe nodes of the batch's cells into
- * out[3 I + i][lane], node by node where the host has AVX-512 (VL; LANES 8): each lane's node
- * as one masked load of its x, y, z (the lane past z is not read), two 4 x 4 transposes of
- * four lanes each and their halves joined. */
-INLINE void shell_gather(const int32_t *restrict cells, int npe, const batch_t *b,
-                         const double *restrict values, vec *restrict out)
-{
-#if defined(__AVX512VL__) && LANES == 8
-  for (int I = 0; I < npe; ++I)
-  {
-    __m256d half[2][3];
-    for (int h = 0; h < 2; ++h)
-    {
-      __m256d r[4];
-      for (int k = 0; k < 4; ++k)
-        r[k] = _mm256_maskz_loadu_pd(0x7, values + 3 * (int64_t)cells[b->id[4 * h + k] * npe + I]);
-      const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
-      const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
-      half[h][0] = _mm256_permute2f128_pd(t0, t2, 0x20);
-      half[h][1] = _mm256_permute2f128_pd(t1, t3, 0x20);
-      half[h][2] = _mm256_permute2f128_pd(t0, t2, 0x31);
-    }
-    for (int i = 0; i < 3; ++i)
-      out[3 * I + i] = (vec)_mm512_insertf64x4(_mm512_castpd256_pd512(half[0][i]), half[1][i], 1);
-  }
-#else
-  gather(cells, npe, b, values, out);
-#endif
-}
-
 /* The motion of a batch's cells of npe nodes over the step dt (s): their nodes' initial
  * positions Xe, displacements ue (m), velocities ve (m/s) and angular velocities we (rad/s)
  * gathered (3 npe each), the positions x = X + u at the step's end and xm = x - dt/2 v at
@@ -115,10 +85,10 @@ INLINE void shell_motion(const int32_t *restrict cells, int npe, const batch_t *
                          vec *restrict we, vec *restrict x, vec *restrict xm,
                          vec *restrict du, vec *restrict fe)
 {
-  shell_gather(cells, npe, b, X, Xe);
-  shell_gather(cells, npe, b, u, ue);
-  shell_gather(cells, npe, b, v, ve);
-  shell_gather(cells, npe, b, w, we);
+  gather(cells, npe, b, X, Xe);
+  gather(cells, npe, b, u, ue);
+  gather(cells, npe, b, v, ve);
+  gather(cells, npe, b, w, we);
   const int n = 3 * npe;
   for (int i = 0; i < n; ++i)
   {

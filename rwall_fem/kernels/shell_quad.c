@@ -951,7 +951,7 @@ void shell_quad_sizes(const shell_params *s, int64_t n, const int32_t *cells, co
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
   {
     const batch_t b = batch_at(NULL, k0, n);
-    shell_gather(cells, 4, &b, x, xe);
+    gather(cells, 4, &b, x, xe);
     quad_frame_t g;
     quad_frame(xe, &g);
     const vec l = quad_length(s, &g);

@@ -243,7 +243,7 @@ void shell_tria_sizes(const shell_params *s, int64_t n, const int32_t *cells, co
   for (int64_t k0 = 0; k0 < n; k0 += LANES)
   {
     const batch_t b = batch_at(NULL, k0, n);
-    shell_gather(cells, 3, &b, x, xe);
+    gather(cells, 3, &b, x, xe);
     tria_frame_t g;
     tria_frame(xe, &g);
     const vec l = tria_length(&g);
