@@ -8,9 +8,10 @@
  * hosts), and scatters the nodal forces back.  A short last batch repeats its
  * first cell in the unused lanes, whose results are dropped.
  *
- * LANES is 8 (512 bits) on hosts with AVX-512, 4 elsewhere.  On this project's
- * machine (AMD Zen 5, full-width 512-bit units) 8 lanes against 4 take the shell
- * kernels' time per cell down by 25-45 % and the hexahedra's by 10-35 %
+ * LANES is 8 (512 bits) on hosts with AVX-512, 4 (256 bits) elsewhere.  With
+ * AVX-512, 8 lanes against 4 take the time per cell down on an AMD Zen 5
+ * (full-width 512-bit units) by 25-45 % for the shells and 10-35 % for the
+ * hexahedra, on a Zen 4 (512-bit operations in two halves) by 14-26 % and 17 %
  * (docs/performance.md); a cell's results do not depend on the lane count, its
  * energies' sums over a batch change in their last bits.
  *
@@ -28,7 +29,11 @@
 #include <immintrin.h>
 #endif
 
+#if defined(__AVX512F__)
 #define LANES 8
+#else
+#define LANES 4
+#endif
 #define INLINE static inline __attribute__((always_inline))
 
 typedef double vec __attribute__((vector_size(LANES * sizeof(double))));
