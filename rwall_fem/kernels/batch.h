@@ -11,7 +11,7 @@
  * LANES is 8 (512 bits) on hosts with AVX-512, 4 (256 bits) elsewhere.  With
  * AVX-512, 8 lanes against 4 take the time per cell down on an AMD Zen 5
  * (full-width 512-bit units) by 25-45 % for the shells and 10-35 % for the
- * hexahedra, on a Zen 4 (512-bit operations in two halves) by 14-26 % and 17 %
+ * hexahedra, on a Zen 4 (512-bit operations in two halves) by 7-16 % and 1-8 %
  * (docs/performance.md); a cell's results do not depend on the lane count, its
  * energies' sums over a batch change in their last bits.
  *
