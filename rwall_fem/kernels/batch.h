@@ -12,8 +12,9 @@
  * AVX-512, 8 lanes against 4 take the time per cell down on an AMD Zen 5
  * (full-width 512-bit units) by 25-45 % for the shells and 10-35 % for the
  * hexahedra, on a Zen 4 (512-bit operations in two halves) by 7-16 % and 1-8 %
- * (docs/performance.md); a cell's results do not depend on the lane count, its
- * energies' sums over a batch change in their last bits.
+ * (docs/performance.md); a cell's results do not depend on the lane count but for
+ * round-off where a plastic return iterates until all the batch's lanes converge, its
+ * energies' sums over a batch change in their last bits (tests/unit/test_kernel_lanes.py).
  *
  * Node arrays are (num_nodes, 3) row-major float64: node i's x, y, z are at
  * 3i, 3i + 1, 3i + 2.  Cells are (num_cells, nodes_per_cell) int32 rows of node
