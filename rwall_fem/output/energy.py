@@ -36,9 +36,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["EnergyBalance", "initial_kinetic_energy"]
+__all__ = ["WORKS", "EnergyBalance", "initial_kinetic_energy"]
 
 TINY = float(np.finfo(float).tiny)  # the smallest normal double: E_ref is never below it
+# The works a balance may book (J), in the order of their columns: a run books those its
+# effects do (:class:`~rwall_fem.output.history.History`).
+WORKS = ("external_work", "wall_work", "damping_work", "mass_scaling_work", "step_change_work")
 
 
 def initial_kinetic_energy(state, walls, comm, rigid=()) -> float:

@@ -39,7 +39,7 @@ import numpy as np
 
 from rwall_fem import interrupts
 from rwall_fem.output import OutputError
-from rwall_fem.output.energy import TINY, EnergyBalance, initial_kinetic_energy
+from rwall_fem.output.energy import TINY, WORKS, EnergyBalance, initial_kinetic_energy
 from rwall_fem.output.guards import Guards
 from rwall_fem.output.schedule import Every, Interval
 from rwall_fem.output.summary import momentum, reserve_summary, run_summary, write_summary
@@ -87,11 +87,10 @@ class History:
         scaled = self.mass_scaling is not None
         self.erosion = getattr(sim.internal, "erosion", None)  # cells that may erode
         self.step_changes = getattr(sim.internal, "corrects", False)  # a varying step's
-        works = ["external_work", "wall_work"]
         self.damping = [f for f in sim.forces if getattr(f, "column", None) == "damping_work"]
-        works += ["damping_work"] if self.damping else []
-        works += ["mass_scaling_work"] if scaled else []
-        works += ["step_change_work"] if self.step_changes else []
+        booked = {"external_work": True, "wall_work": True, "damping_work": bool(self.damping),
+                  "mass_scaling_work": scaled, "step_change_work": self.step_changes}  # fmt: skip
+        works = [name for name in WORKS if booked[name]]
         # A body of [[part]]s: the energies of each part, which add up to the body's.
         explicit = getattr(sim.internal, "explicit", False)
         self.part_columns = sim.internal.part_columns() if explicit else ()

@@ -7,8 +7,17 @@ from pathlib import Path
 import numpy as np
 
 from rwall_fem.output.atomic import whole
+from rwall_fem.output.energy import WORKS
 
-__all__ = ["plot_histories"]
+__all__ = ["balance_curve", "plot_histories"]
+
+
+def balance_curve(energy: np.ndarray) -> np.ndarray:
+    """The energy balance over time (J) from the rows of ``energy.csv`` (a structured
+    array): every stored energy (``total_energy``: hourglass, rotational, contact and rigid
+    bodies' too) less every work booked; the initial energy, to the balance error."""
+    works = [name for name in WORKS if name in energy.dtype.names]
+    return energy["total_energy"] - sum(energy[name] for name in works)
 
 
 def plot_histories(directory: str | Path) -> Path:
@@ -31,10 +40,7 @@ def plot_histories(directory: str | Path) -> Path:
     rigid = ("rigid_body",) if "rigid_body" in energy.dtype.names else ()
     for name in ("kinetic", *rigid, "internal", "external_work", "wall_work"):
         ax.plot(t, energy[name], label=name.replace("_", " "))
-    total = energy["kinetic"] + energy["internal"] - energy["external_work"] - energy["wall_work"]
-    if rigid:
-        total = total + energy["rigid_body"]
-    ax.plot(t, total, "k--", label="K + U - W_ext - W_wall")
+    ax.plot(t, balance_curve(energy), "k--", label="stored energies - works")
     ax.set_ylabel("energy (J)")
     ax.legend(fontsize=8, loc="best")
     ax.set_title(f"max |balance error| {np.abs(energy['balance_error']).max():.1e}", fontsize=9)
