@@ -26,8 +26,6 @@ from rwall_fem.build import build_simulation, run_in_folder
 from rwall_fem.radioss import load_deck
 from rwall_fem.shells.elements import ShellForce
 
-POINT_SLOTS = 5  # state rows per point (kernels/shell.h, SHELL_POINT_SLOTS), eps_p the 4th
-
 
 def lanes() -> int:
     """The kernels' lanes on this host (kernels/batch.h): 8 with AVX-512, else 4."""
@@ -37,8 +35,6 @@ def lanes() -> int:
 
 def watch(element: ShellForce, width: int, counts: dict) -> None:
     """Wrap ``element``'s kernel call so that each call adds its shares to ``counts``."""
-    rows = [2 + POINT_SLOTS * k + 3 for k in range(element.points)]
-    history = element.history
     X = np.asarray(element.X).reshape(-1, 3)
     centre = X[np.asarray(element.cells).reshape(element.num_cells, -1)].mean(axis=1)
     angle = np.arctan2(*(centre[:, :2] - centre[:, :2].mean(axis=0)).T[::-1])
@@ -47,15 +43,15 @@ def watch(element: ShellForce, width: int, counts: dict) -> None:
     kernel = element._kernel
 
     def counted(*args, **kwargs):
-        before = history[rows].copy()
+        before = element.plastic_strains()
         out = kernel(*args, **kwargs)
-        flowed = history[rows] != before  # (points, cells)
-        batches = flowed[:, :full].reshape(len(rows), -1, width)
+        flowed = element.plastic_strains() != before  # (points, cells)
+        batches = flowed[:, :full].reshape(len(flowed), -1, width)
         counts["steps"] += 1
         counts["cells"] += int(flowed.any(axis=0).sum())
         counts["in flowing batches"] += width * int(batches.any(axis=(0, 2)).sum())
         counts["in flowing batches, rings"] += width * int(
-            flowed[:, rings][:, :full].reshape(len(rows), -1, width).any(axis=(0, 2)).sum())
+            flowed[:, rings][:, :full].reshape(len(flowed), -1, width).any(axis=(0, 2)).sum())
         counts["lanes"] += int(batches.sum())
         counts["vectors"] += int(batches.any(axis=2).sum())
         return out
