@@ -20,8 +20,8 @@
    in 0.55 mm shells, finer than its 1.5 mm thickness, runs with ``--large-from`` above
    its cells: its variable gap is capped by the shells' size, :mod:`rwall_fem.contact`).
 2. **Search**: the bucket sort of ``kernels/contact.c`` as the interface calls it
-   (``ContactInterface._sort``: one self-contact pass, all nodes secondary, own and
-   neighbouring segments excluded) on a pleated sheet of n x n quadrilaterals of 1 mm
+   (``ContactInterface._sort``: one self-contact pass, all nodes secondary, each node's
+   own segments excluded) on a pleated sheet of n x n quadrilaterals of 1 mm
    (``sheet``: folds 0 to 2.4 mm apart, as in a crushed tube), gap 0.75 mm, margin 1 mm,
    from 10k to 1M nodes; ns per node, median of ``--repeats`` sorts; and one pass of the contact
    forces (``contact_forces``: the closest points among the candidates) per node. Writes
@@ -224,7 +224,7 @@ def search(nodes: int, repeats: int) -> dict:
     state = SimpleNamespace(X=X, u=np.zeros_like(X), v=np.zeros_like(X),
                             mass=np.full(n, 1e-3), a=np.zeros_like(X), dt_previous=1e-7)  # fmt: skip
     ps = Pass(np.arange(n, dtype=np.int64), quads, np.full(len(quads), 1e8),
-              np.full(len(quads), -0.5 * gap), exclude=True)  # fmt: skip
+              np.full(len(quads), -0.5 * gap))  # fmt: skip
     interface = ContactInterface("bench", np.arange(n, dtype=np.int64), [ps], gap=gap,
                                  friction=0.0, alpha=1.0, margin=margin, state=state,
                                  comm=MPI.COMM_SELF, owned_global=np.arange(n))  # fmt: skip

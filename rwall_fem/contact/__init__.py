@@ -5,7 +5,7 @@
 segments are the boundary faces of the main parts (:mod:`~rwall_fem.contact.surface`),
 the secondary nodes the nodes of the secondary parts' boundary faces; a symmetric
 interface also runs the other way; a self-contact (``self = true``) runs the main parts'
-nodes against their own faces, each node kept off its own faces and their neighbours.
+nodes against their own faces, each node kept off the faces that hold it.
 In a body whose cells may erode, the surfaces of the parts that may erode follow the
 erosion (:mod:`~rwall_fem.contact.erosion`): faces of eroded solid cells leave and bared
 faces join; eroded shells leave.
@@ -132,19 +132,19 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
         if spec.single_surface:
             main = spec.main or tuple(names)
             side("main", main)
-            sides = [(main, main, True)]
+            sides = [(main, main)]
         else:
             main, secondary = spec.main, spec.secondary
             side("main", main), side("secondary", secondary)
-            sides = [(secondary, main, False)] + ([(main, secondary, False)] if spec.symmetric else [])
+            sides = [(secondary, main)] + ([(main, secondary)] if spec.symmetric else [])
         parts = {name: None for pair in sides for name in pair[0] + pair[1]}  # both sides
         here = [eroding[name] for name in parts if name in eroding]
-        start = [(_total(a), _total(b), exclude) for a, b, exclude in sides]
-        nodes = np.unique(np.concatenate([s.nodes for pair in start for s in pair[:2]]
+        start = [(_total(a), _total(b)) for a, b in sides]
+        nodes = np.unique(np.concatenate([s.nodes for pair in start for s in pair]
                                          + [s.nodes for s in here]))  # fmt: skip
-        edge = float(min(s.edge.min() for pair in start for s in pair[:2]))
-        half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair[:2]))
-        node_gap, node_size = _node_gaps(nodes, [s for pair in start for s in pair[:2]], share)
+        edge = float(min(s.edge.min() for pair in start for s in pair))
+        half = float(max(-s.depth.min(initial=0.0) for pair in start for s in pair))
+        node_gap, node_size = _node_gaps(nodes, [s for pair in start for s in pair], share)
         gap = spec.gap if spec.gap is not None else _gap_floor(start, edge, share.scale)
         variable = spec.gap is None and half > 0.0
         removal = None
@@ -156,13 +156,13 @@ def build_contacts(scene, solid, state, internal=None) -> list[ContactInterface]
                    removal=removal) -> list[Pass]:  # fmt: skip
             """The passes of the interface from its sides' surfaces as they are."""
             out = []
-            for sec_parts, seg_parts, exclude in sides:
+            for sec_parts, seg_parts in sides:
                 sec, seg = _total(sec_parts), _total(seg_parts)
                 out.append(Pass(
                     np.searchsorted(nodes, sec.nodes).astype(np.int64),
                     np.where(seg.segments >= 0, np.searchsorted(nodes, seg.segments), -1),
                     _bounded_stiffness(spec, seg.stiffness), _scaled_depth(seg, share),
-                    exclude, _segment_sizes(seg, share),
+                    _segment_sizes(seg, share),
                 ))  # fmt: skip
                 if removal is not None:
                     out[-1].removed = removal.lists(out[-1], len(out) - 1)
@@ -367,7 +367,7 @@ def _gap_floor(sides, edge: float, scale: float = 1.0) -> float:
     min(thinnest shell x ``scale``, half the shortest side) with shells (``i7sti3.F``:
     the thickness scaled by Fscalegap, the floor not bounded by Gap_max), 0.1 x the
     shortest edge of solids' faces."""
-    thickness = [2.0 * -s.depth[s.depth < 0.0] for pair in sides for s in pair[:2]]
+    thickness = [2.0 * -s.depth[s.depth < 0.0] for pair in sides for s in pair]
     thickness = np.concatenate(thickness)
     return min(scale * float(thickness.min()), 0.5 * edge) if len(thickness) else 0.1 * edge
 

@@ -75,8 +75,7 @@ class Pass:
     """Secondary nodes (indices into the interface's surface nodes, or a rank's local
     nodes) against segments (rows of 4 indices, -1 as the 4th of a triangle) with their
     stiffness k0 (N/m), depth (m) and size share of a variable gap (m, ``kernels/contact.c``
-    pair_gap; default inf: none); ``exclude``: a node is kept off its own segments'
-    neighbours (self-contact); ``removed``: the nodes each segment leaves out of its search
+    pair_gap; default inf: none); ``removed``: the nodes each segment leaves out of its search
     (Radioss Irem_gap 2, ``kernels/contact_remove.c``), as offsets (segments + 1) and node
     indices (sorted per segment), or None.
     """
@@ -85,24 +84,12 @@ class Pass:
     segments: np.ndarray
     stiffness: np.ndarray
     depth: np.ndarray
-    exclude: bool = False
     size: np.ndarray | None = None
     removed: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self):
         if self.size is None:
             self.size = np.full(len(self.segments), np.inf)
-        # The segments of each surface node (CSR), for the exclusion of neighbours.
-        nodes = self.segments.ravel()
-        seg = np.repeat(np.arange(len(self.segments), dtype=np.int64), 4)
-        valid = nodes >= 0
-        nodes, seg = nodes[valid], seg[valid]
-        order = np.argsort(nodes, kind="stable")
-        self.node_segs = np.ascontiguousarray(seg[order])
-        size = int(max(nodes.max(initial=-1), self.secondary.max(initial=-1))) + 2
-        self.node_offsets = np.zeros(size, dtype=np.int64)
-        np.add.at(self.node_offsets, nodes + 1, 1)
-        self.node_offsets = np.cumsum(self.node_offsets)
         self.offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)
         self.candidates = np.zeros(max(16, 4 * len(self.secondary)), dtype=np.int64)
         self.used = np.zeros(0, dtype=np.int64)  # the segments that are candidates (a sort's)
@@ -131,7 +118,6 @@ class _Share:
     places: np.ndarray
     stiffness: np.ndarray
     depth: np.ndarray
-    exclude: bool
     size: np.ndarray
     removed: tuple[np.ndarray, np.ndarray] | None = None
 
@@ -251,7 +237,7 @@ class ContactInterface:
             removed = (ps.removed[0], nodes[ps.removed[1]].astype(np.int64))
         return _Share(secondary, tangential, gaps, segments[owned].astype(np.int64),
                       np.flatnonzero(owned).astype(np.int64), ps.stiffness[owned].copy(),
-                      ps.depth[owned].copy(), ps.exclude, ps.size[owned].copy(),
+                      ps.depth[owned].copy(), ps.size[owned].copy(),
                       removed)  # fmt: skip
 
     def start(self, s) -> None:
@@ -449,7 +435,7 @@ class ContactInterface:
             here = here[np.argsort(ints[here, 1])]  # in their order in the whole pass
             ps = Pass(np.searchsorted(self.ids, sh.secondary).astype(np.int64),
                       self._to_local(ints[here, 2:]), received[here, 6].copy(),
-                      received[here, 7].copy(), sh.exclude, received[here, 8].copy())  # fmt: skip
+                      received[here, 7].copy(), received[here, 8].copy())  # fmt: skip
             ps.tangential, ps.gaps = sh.tangential, sh.gaps
             if sh.removed is not None:
                 ps.removed = self._removed_here(sh.removed, ints[here, 1])
@@ -464,8 +450,7 @@ class ContactInterface:
                 work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
                 count = lib.contact_sort(
                     len(ps.secondary), p(ps.secondary, "int64_t[]"), len(ps.segments),
-                    p(ps.segments, "int64_t[]"), p(reach), p(self.x), int(ps.exclude),
-                    p(ps.node_offsets, "int64_t[]"), p(ps.node_segs, "int64_t[]"),
+                    p(ps.segments, "int64_t[]"), p(reach), p(self.x),
                     *removed, len(ps.candidates), p(ps.offsets, "int64_t[]"),
                     p(ps.candidates, "int64_t[]"), p(work, "int64_t[]"),
                 )  # fmt: skip

@@ -7,10 +7,10 @@
  * contact_moved: the largest squared distance a node moved since the last sort.
  * contact_sort: the candidate segments of each secondary node, by buckets (spatial hashing):
  *   the secondary nodes go into a grid of cubes, each segment is tested against the nodes
- *   of the cubes its box (widened by its reach) overlaps; a node's own segments and their
- *   neighbours are left out when `exclude` (self-contact), and the nodes each segment's
- *   list leaves out (`removed`, Radioss Irem_gap 2: contact_remove.c).  The lists come
- *   sorted by segment, whatever the grid.
+ *   of the cubes its box (widened by its reach) overlaps; a node's own segments (those
+ *   holding it: self-contact) are left out, as OpenRadioss's sort leaves them
+ *   (i7trivox.F), and the nodes each segment's list leaves out (`removed`, Radioss
+ *   Irem_gap 2: contact_remove.c).  The lists come sorted by segment, whatever the grid.
  * contact_near: the candidates near enough to their node to be met before the nodes have
  *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
@@ -95,23 +95,6 @@ double contact_moved(int64_t n, const double *restrict x, const double *restrict
   return largest;
 }
 
-/* Whether node s shares a node with a segment that holds s or a neighbour of it: segment
- * `seg` holds a node of some segment holding s (node_segs: CSR of the segments of each
- * node). */
-static int excluded(int64_t s, const int64_t *seg, const int64_t *node_offsets,
-                    const int64_t *node_segs, const int64_t *segs)
-{
-  for (int64_t k = node_offsets[s]; k < node_offsets[s + 1]; ++k)
-  {
-    const int64_t *own = segs + 4 * node_segs[k];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        if (seg[a] >= 0 && seg[a] == own[b])
-          return 1;
-  }
-  return 0;
-}
-
 /* Whether node s is in the sorted list [from, to). */
 static int listed(int64_t s, const int64_t *from, const int64_t *to)
 {
@@ -136,8 +119,7 @@ static int listed(int64_t s, const int64_t *from, const int64_t *to)
  * int64.  Returns the number of candidates (more than capacity: call again with room). */
 int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t nseg,
                      const int64_t *restrict segs, const double *restrict reach,
-                     const double *restrict x, int exclude, const int64_t *restrict node_offsets,
-                     const int64_t *restrict node_segs, const int64_t *restrict removed_offsets,
+                     const double *restrict x, const int64_t *restrict removed_offsets,
                      const int64_t *restrict removed, int64_t capacity,
                      int64_t *restrict offsets, int64_t *restrict candidates,
                      int64_t *restrict work)
@@ -257,7 +239,7 @@ int64_t contact_sort(int64_t nsec, const int64_t *restrict secondary, int64_t ns
             int own = 0;
             for (int k = 0; k < 4; ++k)
               own |= seg[k] == s;
-            if (own || (exclude && excluded(s, seg, node_offsets, node_segs, segs)))
+            if (own)
               continue;
             if (removed && listed(s, removed + removed_offsets[j], removed + removed_offsets[j + 1]))
               continue;

@@ -1276,8 +1276,8 @@ class ContactSpec:
         Flag(),
         False,
         toml="self",
-        doc="self-contact of the main parts (a node against every segment but its own and "
-        "their neighbours')",
+        doc="self-contact of the main parts (a node against every segment but those that "
+        "hold it, as Radioss's TYPE7)",
     )
     symmetric: bool = key(
         Flag(), True, doc="two passes: each side's nodes against the other's segments"
@@ -1316,7 +1316,7 @@ class ContactSpec:
         False,
         doc="Radioss Irem_gap 2: each segment leaves out of its search the nodes within "
         "sqrt(2) x their pair gap of it along the mesh, at the start (self-contact of a mesh "
-        "finer than the gap; beyond a node's own segments and their neighbours)",
+        "finer than the gap; beyond a node's own segments)",
     )
     stiffness_scale: float = key(
         Real(low=0.0),

@@ -6,8 +6,8 @@ References independent of the code:
 
 - until the first node comes within the gap of a segment the contact adds nothing: the
   run with self-contact is the run without it, to round-off;
-- no node gets through a shell: every node's distance to every segment that is not its
-  own or a neighbour's (measured here in NumPy, the quadrilaterals as two triangles)
+- no node gets through a shell: every node's distance to every segment that does not hold
+  it (measured here in NumPy, the quadrilaterals as two triangles)
   stays above half the gap (half the sum of the thicknesses, 1.5 mm), at every
   sampled step (every 5th);
 - folds that bear on each other instead of passing through carry load: after the first
@@ -72,7 +72,7 @@ def point_triangle_distance(p, a, b, c):
 
 class Clearance:
     """Every 5th step: the smallest distance (m) of a surface node from the shells it is
-    not excluded from (its own and their neighbours' left out, as the contact does)."""
+    not excluded from (those that hold it left out, as the contact does)."""
 
     def __init__(self, sim):
         interface = sim.contacts[0]
@@ -82,11 +82,9 @@ class Clearance:
         self.ids = np.unique(segments)
         self.interface, self.segments = interface, np.searchsorted(self.ids, segments)
         n, m = len(self.ids), len(segments)
-        holds = np.zeros((n, m), dtype=bool)  # node i is a corner of segment j
+        self.excluded = np.zeros((n, m), dtype=bool)  # node i is a corner of segment j
         for k in range(4):
-            holds[self.segments[:, k], np.arange(m)] = True
-        near = (holds.astype(np.int32) @ holds.T.astype(np.int32)) > 0  # share a segment
-        self.excluded = (near.astype(np.int32) @ holds.astype(np.int32)) > 0
+            self.excluded[self.segments[:, k], np.arange(m)] = True
         self.smallest = []
         sim.recorders.append(self)
 

@@ -4,7 +4,7 @@ automatic contacts).
 
 A steel sheet 1.5 mm thick meshed in 0.5 mm quadrilaterals with ``self = true``: half
 the sum of the thicknesses (1.5 mm) is three elements, so without the cap every node is
-within the gap of the coplanar segments of its own sheet beyond its excluded neighbours.
+within the gap of the coplanar segments of its own sheet beyond those that hold it.
 With each shell's share of the gap at most 0.4 x its shortest side (0.2 mm), the pair gap
 is 0.4 mm, less than the 0.5 mm from a node to the nearest segment it may meet.
 
@@ -117,8 +117,8 @@ def test_without_the_cap_the_fine_sheet_touches_itself(shared_dir, monkeypatch):
 
 
 # A constant gap larger than the mesh: Radioss Irem_gap 2 (``exclude_within_gap``). With
-# gap = 1.2 mm (2.4 cells) every node is within the gap of its sheet's coplanar shells two
-# cells away (1 mm), beyond the neighbours it is kept off. Worked by hand: each segment
+# gap = 1.2 mm (2.4 cells) every node is within the gap of its sheet's coplanar shells one
+# and two cells away (0.5 and 1 mm), beyond the shells that hold it. Worked by hand: each segment
 # leaves out the nodes within sqrt 2 x 1.2 = 1.70 mm of it along the mesh; a coplanar shell
 # within 1.2 mm of a node in the plane has its nearest node at most (2, 1) cells away, 1.21
 # mm along the mesh (a diagonal and a side): left out, every one. So with the lists no node

@@ -74,7 +74,7 @@ def test_the_near_lists_give_the_forces_of_all_candidates(shape):
     state = SimpleNamespace(X=X, u=np.zeros_like(X), v=rng.normal(0.0, 1.0, X.shape),
                             mass=np.full(n, 1e-4), a=np.zeros_like(X), dt_previous=1e-7)  # fmt: skip
     ps = Pass(np.arange(n, dtype=np.int64), quads, np.full(len(quads), 1e6),
-              np.full(len(quads), -0.5 * GAP), exclude=True)  # fmt: skip
+              np.full(len(quads), -0.5 * GAP))  # fmt: skip
     interface = ContactInterface("near", np.arange(n, dtype=np.int64), [ps], gap=GAP,
                                  friction=0.2, alpha=1.0, margin=MARGIN, state=state,
                                  comm=MPI.COMM_SELF, owned_global=np.arange(n))  # fmt: skip

@@ -5,7 +5,7 @@ exclude_within_gap; OpenRadioss ``get_list_remnode.F90``, applied in the sort as
 A strip of 1 mm quadrilaterals, 3 wide, folded into a U: a bottom leg of 10 cells at z = 0,
 a wall of 2 cells, a top leg of 10 cells back over the bottom one at z = 2 mm; a
 self-contact of constant gap 2.5 mm (more than the cells: a node is within the gap of its
-own leg's shells two cells away, beyond the neighbours it is kept off). The rule, worked
+own leg's shells one and two cells away, beyond the shells that hold it). The rule, worked
 here independently of the code: segment j leaves out every node whose distance to j along
 the mesh (the shortest path from j's nodes over the sides and diagonals of the shells,
 Dijkstra) is at most sqrt 2 x the gap, 3.54 mm. So:
@@ -92,7 +92,7 @@ def test_the_lists_remove_the_pairs_within_the_gap_along_the_mesh():
 
     def strip_pass():
         return Pass(np.arange(n, dtype=np.int64), quads, np.full(len(quads), 1e6),
-                    np.full(len(quads), -1e-4), exclude=True)  # fmt: skip
+                    np.full(len(quads), -1e-4))  # fmt: skip
 
     listed = strip_pass()
     removal = _Removal(np.ascontiguousarray(X), np.zeros(n), np.full(n, np.inf), False, GAP,
@@ -136,7 +136,7 @@ def test_after_erosion_the_segments_keep_their_lists_of_the_start():
 
     def strip_pass(rows):
         return Pass(np.arange(n, dtype=np.int64), quads[rows], np.full(len(rows), 1e6),
-                    np.full(len(rows), -1e-4), exclude=True)  # fmt: skip
+                    np.full(len(rows), -1e-4))  # fmt: skip
 
     removal = _Removal(np.ascontiguousarray(X), np.zeros(n), np.full(n, np.inf), False, GAP,
                        math.inf)  # fmt: skip
@@ -168,7 +168,7 @@ def test_after_erosion_the_segments_keep_their_lists_of_the_start():
     # crack's first shell): its list is the walk's on the surface as it is.
     bared = np.concatenate([quads[left[::-1]], [[*quads[crack[0], :3], -1]]])
     grown = Pass(np.arange(n, dtype=np.int64), bared, np.full(len(bared), 1e6),
-                 np.full(len(bared), -1e-4), exclude=True)  # fmt: skip
+                 np.full(len(bared), -1e-4))  # fmt: skip
     grown.removed = removal.lists(grown, 0)
     offsets, ids = removal._walk(grown)
     last = len(bared) - 1

@@ -390,7 +390,7 @@ def test_a_resumed_run_with_contact_equals_the_uninterrupted_one(shared_dir):
 
 def test_self_contact_keeps_a_folded_pair_of_parts_apart(shared_dir):
     """self = true over both bars: the same impact as the two-sided interface (each node
-    against every face but its own and their neighbours'), to 2 % in impulse."""
+    against every face but those that hold it), to 2 % in impulse."""
     raw = two_bars(shared_dir)
     raw["contact"] = [{"self": True}]
     sim = run(raw, shared_dir)
