@@ -26,7 +26,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
-#if defined(__AVX512VL__)
+#if defined(__AVX__)
 #include <immintrin.h>
 #endif
 
@@ -264,12 +264,20 @@ INLINE vec vselect(ivec m, vec a, vec b)
   return (vec)(((ivec)a & m) | ((ivec)b & ~m));
 }
 
+/* Whether some lane of m is non-zero: one test instruction where the host has AVX-512 (8
+ * lanes) or AVX (4 lanes), a loop over the lanes elsewhere. */
 INLINE int any_lane(ivec m)
 {
+#if defined(__AVX512F__) && LANES == 8
+  return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
+#elif defined(__AVX__) && LANES == 4
+  return !_mm256_testz_si256((__m256i)m, (__m256i)m);
+#else
   int r = 0;
   for (int k = 0; k < LANES; ++k)
     r |= m[k] != 0;
   return r;
+#endif
 }
 
 /* The per-cell values a[id] of the batch's cells. */

@@ -25,9 +25,6 @@
 
 #include "failure.h"
 
-#if defined(__AVX__)
-#include <immintrin.h>
-#endif
 
 #define SHELL_MAX_POINTS 10
 #define SHELL_POINT_SLOTS 5 /* sxx, syy, sxy (Pa), eps_p, temperature (K) */
@@ -59,20 +56,6 @@ typedef struct
   int qeph_physical;       /* quadrilaterals, 1: QEPH's physical hourglass stiffness, 12 state
                               rows from hourglass_slot (shell_quad.c, quad_hourglass_qeph) */
 } shell_params;
-
-/* any_lane of a comparison's mask (lanes all ones or all zeros) in one instruction where the
- * host has AVX (4 lanes: their sign bits) or AVX-512 (8 lanes: a test), batch.h's loop over
- * the lanes elsewhere. */
-INLINE int shell_any(ivec m)
-{
-#if defined(__AVX__) && LANES == 4
-  return _mm256_movemask_pd((__m256d)m) != 0;
-#elif defined(__AVX512F__) && LANES == 8
-  return _mm512_test_epi64_mask((__m512i)m, (__m512i)m) != 0;
-#else
-  return any_lane(m);
-#endif
-}
 
 /* The motion of a batch's cells of npe nodes over the step dt (s): their nodes' initial
  * positions Xe, displacements ue (m), velocities ve (m/s) and angular velocities we (rad/s)
@@ -275,7 +258,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     }
     if (of_eps_p)
       maybe[j] &= q2[j] > q_old2[j];
-    if (shell_any(maybe[j]))
+    if (any_lane(maybe[j]))
       which[m++] = j;
   }
   if (m == 0)
@@ -294,7 +277,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
   {
     const int j = which[a];
     const ivec flowing = maybe[j] & (q_trial[a] > y0[a]);
-    if (!shell_any(flowing))
+    if (!any_lane(flowing))
       continue;
     const int b = flowing_points++;
     which[b] = j;
@@ -325,12 +308,12 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
     /* from eps_p = 0 a power law's slope is infinite and the residual no guide to the next
      * step's: iterate until it is itself at round-off */
     tolerance[a] = vselect(virgin, VZERO + 1e-13, VZERO + 1e-7);
-    near[a] = power_law && !shell_any(virgin);
+    near[a] = power_law && !any_lane(virgin);
     const vec safe_q = vselect(flowing, q_trial[a], VZERO + 1.0);
     lo[a] = VZERO;
     hi[a] = (safe_q / vmax(y, VZERO + 1e-300) - 1.0) * (1.0 / k1);
     vec start = slope[a];
-    if (shell_any(virgin))
+    if (any_lane(virgin))
     {
       const vec d0 = vmax((safe_q - y) * (1.0 / (1.5 * g2)), VZERO + 1e-300);
       vec unused;
@@ -361,7 +344,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       q[a] = root * r;
       dq[a] = -(P1[a] * k1 * ra * ra * ra + P2[a] * g2 * rb * rb * rb) * rq[a];
       increment[a] = (2.0 / 3.0) * g[a] * q[a];
-      use_series[a] = near[a] && !shell_any(plastic[a] & (increment[a] > 0.05 * eps_p[which[a]]));
+      use_series[a] = near[a] && !any_lane(plastic[a] & (increment[a] > 0.05 * eps_p[which[a]]));
       all_near &= use_series[a];
     }
     if (all_near)
@@ -385,7 +368,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       /* outside the bracket: its midpoint, geometric while it spans decades (the root of
        * a power law's infinite slope at eps_p = 0 may be many decades below the start) */
       const ivec outside = (next <= lo[a]) | (next >= hi[a]);
-      if (shell_any(outside))
+      if (any_lane(outside))
       {
         const vec middle = vselect(lo[a] < 1e-3 * hi[a],
                                    vsqrt(vmax(lo[a], 1e-30 * hi[a]) * hi[a]),
@@ -394,7 +377,7 @@ INLINE void plane_stress_returns(const element_params *p, const shell_params *s,
       }
       const vec change = vabs(next - g[a]);
       g[a] = vselect(plastic[a], next, VZERO);
-      more |= shell_any(plastic[a] & (vabs(R) > tolerance[a])
+      more |= any_lane(plastic[a] & (vabs(R) > tolerance[a])
                         & (change > 1e-15 * g[a] + 1e-300));
     }
     if (!more)

@@ -300,7 +300,7 @@ INLINE void qeph_material(const element_params *p, const shell_params *s, const 
     vec tangent = VZERO + linear_tangent;
     if (!linear)
     {
-      if (shell_any(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
+      if (any_lane(flowed)) /* the slope of the points that flowed only (1 elsewhere) */
         capped_flow_stress(p, eps_before[pt] + 1e-7, factor, &slope); /* M2CPLR's SMALL */
       tangent = slope / (slope + s->young);
     }
