@@ -37,7 +37,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import importlib.util
-import io
 import logging
 import os
 import platform
@@ -370,7 +369,10 @@ def _build(extension: Extension, name: str, flags: list[str], folder: Path
 
 
 def _compile(extension: Extension, name: str, flags: list[str], work: Path) -> Path:
-    """Compile ``extension`` as module ``name`` in the folder ``work``."""
+    """Compile ``extension`` as module ``name`` in the folder ``work``. What setuptools and
+    the compiler say (each command; the compiler's warnings; the errors of a flag set it
+    refuses, before the next set is tried) stays out of the run's output, in
+    ``work/compiler.log``; a failure's message ends with the compiler's first error."""
     import cffi
 
     ffi = cffi.FFI()
@@ -378,9 +380,34 @@ def _compile(extension: Extension, name: str, flags: list[str], work: Path) -> P
     here = Path(__file__).parent
     source = "".join(f'#include "{n}"\n' for n in extension.sources if n.endswith(".c"))
     ffi.set_source(name, source, include_dirs=[str(here)], extra_compile_args=flags)
-    # setuptools reports each compiler command on stdout: keep it out of the run's output.
-    with contextlib.redirect_stdout(io.StringIO()):
-        return Path(ffi.compile(tmpdir=str(work), verbose=False))
+    log = work / "compiler.log"
+    try:
+        with _output_to(log):
+            return Path(ffi.compile(tmpdir=str(work), verbose=False))
+    except Exception as err:
+        said = [line.strip() for line in log.read_text(errors="replace").splitlines()
+                if "error" in line]  # fmt: skip
+        detail = str(err).strip().splitlines()[-1:] or [type(err).__name__]
+        raise RuntimeError(" ".join(detail + said[:1])) from err
+
+
+@contextlib.contextmanager
+def _output_to(path: Path):
+    """Python's standard output and error, and the file descriptors 1 and 2 that a
+    compiler started meanwhile inherits, written to ``path`` for the duration."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(path, "w") as out:
+            os.dup2(out.fileno(), 1)
+            os.dup2(out.fileno(), 2)
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+                yield
+    finally:
+        for fd, kept in zip((1, 2), saved, strict=True):
+            os.dup2(kept, fd)
+            os.close(kept)
 
 
 def compiler_error(what: str, detail: str) -> KernelBuildError:
