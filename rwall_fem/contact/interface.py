@@ -60,7 +60,7 @@ CAP = 0.99
 # The skin of the near lists, as a share of the margin: a pass goes through the candidates
 # whose box is within the reach and the skin of their node, listed again once some node
 # has moved a third of the skin (kernels/contact.c, contact_near).
-SKIN = 0.25
+SKIN = 0.15
 
 CONTACT_COLUMNS = (
     ["time", "contact"]
