@@ -198,8 +198,9 @@ typedef struct {
 } contact_params;
 double contact_moved(int64_t n, const double *x, const double *x0);
 int64_t contact_sort(int64_t nsec, const int64_t *secondary, int64_t nseg, const int64_t *segs,
-                     const double *reach, const double *x, const int64_t *removed_offsets, const int64_t *removed, int64_t capacity,
-                     int64_t *offsets, int64_t *candidates, int64_t *work);
+                     const double *reach, const double *x, const int64_t *removed_offsets,
+                     const int64_t *removed, int64_t capacity, int64_t *offsets,
+                     int64_t *candidates, int64_t *work);
 int64_t contact_remove_lists(int64_t nseg, const int64_t *segs, int64_t nnodes, const double *x,
                              const int8_t *secondary, const double *seg_gap,
                              const double *seg_size, const double *node_gap,

@@ -25,7 +25,6 @@
 
 #include "failure.h"
 
-
 #define SHELL_MAX_POINTS 10
 #define SHELL_POINT_SLOTS 5 /* sxx, syy, sxy (Pa), eps_p, temperature (K) */
 
