@@ -58,8 +58,8 @@ __all__ = ["CONTACT_COLUMNS", "ContactInterface", "Pass"]
 # The penetration ratio p / gap beyond which the penalty stiffness stays at k0 / (1 - CAP).
 CAP = 0.99
 # The skin of the near lists, as a share of the margin: a pass goes through the candidates
-# whose box is within the reach and the skin of their node, listed again once some node
-# has moved a third of the skin (kernels/contact.c, contact_near).
+# within the reach and the skin of their node, listed again once some node has moved half
+# the skin (kernels/contact.c, contact_near).
 SKIN = 0.15
 
 CONTACT_COLUMNS = (
@@ -95,8 +95,8 @@ class Pass:
         self.used = np.zeros(0, dtype=np.int64)  # the segments that are candidates (a sort's)
         self.boxes = np.zeros((len(self.segments), 6))  # their boxes, m (kernels/contact.c)
         self.near_offsets = np.zeros(len(self.secondary) + 1, dtype=np.int64)  # the near
-        self.near = np.zeros(0, dtype=np.int64)  # list (contact_near) and its segments
-        self.near_used = np.zeros(0, dtype=np.int64)
+        self.near = np.zeros(0, dtype=np.int64)  # list (contact_near) and the distances
+        self.near_distance = np.zeros(0)  # of its candidates then, m
         self.tangential = np.zeros((len(self.secondary), 3))  # friction force, N
         self.gaps = np.full(len(self.secondary), np.inf)  # own gap (m) of a node that started
         # inside the gap, growing back (kernels/contact.c); inf for the others
@@ -252,9 +252,8 @@ class ContactInterface:
             p = self._pointer
             self.lib.contact_initial_gaps(
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
-                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
-                p(ps.used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
-                p(ps.size), self._surface[0], self._params, p(ps.gaps), p(out),
+                p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), p(ps.stiffness),
+                p(ps.depth), p(ps.size), self._surface[0], self._params, p(ps.gaps), p(out),
             )  # fmt: skip
             inside, behind = inside + int(out[0]), behind + int(out[1])
             deepest = max(deepest, float(out[2]))
@@ -312,9 +311,8 @@ class ContactInterface:
         x, v, mass, force, stiffness = self._surface[:5]
         return (
             p(ps.secondary, "int64_t[]"), p(ps.near_offsets, "int64_t[]"),
-            p(ps.near, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.near_used),
-            p(ps.near_used, "int64_t[]"), p(ps.boxes), p(ps.stiffness), p(ps.depth),
-            p(ps.size), x, v, mass,
+            p(ps.near, "int64_t[]"), p(ps.near_distance), p(ps.segments, "int64_t[]"),
+            p(ps.stiffness), p(ps.depth), p(ps.size), x, v, mass,
             self._params, p(ps.tangential), p(ps.gaps), force,
             stiffness, p(ps.out),
         )  # fmt: skip
@@ -482,38 +480,42 @@ class ContactInterface:
                 np.ascontiguousarray(local))  # fmt: skip
 
     def _list_near(self) -> None:
-        """The near lists of the passes (``contact_near``): the candidates whose box is
-        within the reach and the skin of their node now (this rank's own: the passes skip
-        the same candidates with them as without, whenever they are listed)."""
+        """The near lists of the passes (``contact_near``): the candidates within the
+        reach and the skin of their node now, with their distances (this rank's own: the
+        passes skip the same candidates with them as without, whenever they are listed)."""
         p, skin = self._pointer, SKIN * self.margin
         limit = 1.000001 * self.reach + skin  # FAR reach (kernels/contact.c) and the skin
         for ps in self.passes:
             if len(ps.near) < len(ps.candidates):
                 ps.near = np.zeros(len(ps.candidates), dtype=np.int64)
+                ps.near_distance = np.zeros(len(ps.candidates))
             count = self.lib.contact_near(
                 len(ps.secondary), p(ps.secondary, "int64_t[]"), p(ps.offsets, "int64_t[]"),
                 p(ps.candidates, "int64_t[]"), p(ps.segments, "int64_t[]"), len(ps.used),
                 p(ps.used, "int64_t[]"), p(ps.boxes), self._surface[0], limit,
                 p(ps.near_offsets, "int64_t[]"), p(ps.near, "int64_t[]"),
+                p(ps.near_distance),
             )  # fmt: skip
-            ps.near_used = np.unique(ps.near[:count])
         self._passes = [self._pass_pointers(ps) for ps in self.passes]
         self._near_at = self.x.copy()  # the local nodes' positions at the lists
         self._near_pointer = self._pointer(self._near_at)
-        self._near_moved = (skin / 3.0) ** 2  # m^2: 1/3 > 1 / (1 + sqrt 3) of the skin
+        self._near_moved = (skin / 2.0) ** 2  # m^2: a distance changes by 2 moves at most
+        self._params.moved = 0.0
 
     def _near_stale(self, moved: float) -> bool:
-        """Whether some local node moved more than a third of the skin since the near lists
-        (this rank's own test: no exchange), the owned surface nodes' largest squared move
-        (m^2) being ``moved`` (``_read``)."""
+        """Whether some local node moved more than half the skin since the near lists (this
+        rank's own test: no exchange), the owned surface nodes' largest squared move (m^2)
+        being ``moved`` (``_read``); if not, the passes' bound on the moves (m) is the local
+        nodes' largest."""
+        g = len(self.x) - self.n  # the ghosts'
+        if g and moved <= self._near_moved:
+            p = self._pointer
+            ghosts = self.lib.contact_moved(g, p(self.x[self.n :]), p(self._near_at[self.n :]))
+            moved = ghosts if not ghosts <= moved else moved  # NaN stays
         if not moved <= self._near_moved:
             return True
-        g = len(self.x) - self.n  # the ghosts'
-        if not g:
-            return False
-        p = self._pointer
-        moved = self.lib.contact_moved(g, p(self.x[self.n :]), p(self._near_at[self.n :]))
-        return not moved <= self._near_moved
+        self._params.moved = math.sqrt(moved)
+        return False
 
     def _moved(self, moved: float) -> bool:
         """Whether some surface node moved more than half the margin since the latest sort

@@ -190,7 +190,7 @@ double wall_clearance(int64_t n, const int64_t *nodes, const double *X, const do
 void largest_components(int64_t n, const int64_t *nodes, const double *v, const double *a,
                         double out[2]);
 typedef struct {
-  double gap, cap, friction, damping, alpha, dt, reach, gap_max;
+  double gap, cap, friction, damping, alpha, dt, reach, moved, gap_max;
   const double *half_thickness;
   const double *node_size;
   const double *share;
@@ -209,16 +209,16 @@ int64_t contact_remove_lists(int64_t nseg, const int64_t *segs, int64_t nnodes, 
 int64_t contact_near(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
                      const int64_t *candidates, const int64_t *segs, int64_t nused,
                      const int64_t *used, double *boxes, const double *x, double limit,
-                     int64_t *near_offsets, int64_t *near);
+                     int64_t *near_offsets, int64_t *near, double *near_distance);
 void contact_forces(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
-                    const int64_t *candidates, const int64_t *segs, int64_t nused,
-                    const int64_t *used, double *boxes, const double *stiffness0,
+                    const int64_t *candidates, const double *listed, const int64_t *segs,
+                    const double *stiffness0,
                     const double *depth, const double *size, const double *x, const double *v,
                     const double *mass, const contact_params *prm, double *tangential,
                     double *node_gap, double *force, double *stiffness, double out[11]);
 void contact_initial_gaps(int64_t nsec, const int64_t *secondary, const int64_t *offsets,
-                          const int64_t *candidates, const int64_t *segs, int64_t nused,
-                          const int64_t *used, double *boxes, const double *stiffness0, const double *depth,
+                          const int64_t *candidates, const int64_t *segs,
+                          const double *stiffness0, const double *depth,
                           const double *size, const double *x,
                           const contact_params *prm, double *node_gap, double out[3]);
 void contact_read(int64_t n, const int64_t *rows, const double *X, const double *u,

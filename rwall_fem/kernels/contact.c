@@ -14,8 +14,9 @@
  * contact_near: the candidates near enough to their node to be met before the nodes have
  *   moved a skin (a list within the sort's list, which the passes then go through).
  * contact_initial_gaps: the gaps of the nodes that start inside the gap (Radioss Inacti 6).
- * Both passes over the candidates take the list of the segments that are candidates of some
- * node (`used`) and room for their boxes (`boxes`, 6 a segment), found once a call.
+ * The near lists and the passes find the distance of a node to its candidates LANES pairs
+ * at once without a branch (candidate_distances), and only those within reach get their
+ * closest point.
  * contact_forces: one pass of the secondary nodes against their candidates: the closest
  *   point on the surface (closest_on_surface: the segments within a band of the closest
  *   distance blended, a quadrilateral as 4 triangles about its centre, the side from the
@@ -50,6 +51,7 @@ typedef struct
   double alpha;    /* the friction filter's weight of the new force (1: no filter) */
   double dt;       /* dt^{n-1/2}, s: the step of the velocities v^{n-1/2} */
   double reach;    /* m: the segments this near a node compete for it (max of gap, depths) */
+  double moved;    /* m: the farthest a node has moved since the near lists (contact_near) */
   double gap_max;  /* m: a pair's variable gap at most this (Radioss Gap_max; inf: none) */
   const double *half_thickness; /* m per surface node (half its thickest shell), or NULL:
                                   a constant gap (see pair_gap) */
@@ -520,44 +522,176 @@ INLINE double box_distance2(const double p[3], const double *restrict box)
   return d2;
 }
 
-/* The near list: of the candidates of the nsec secondary nodes (offsets, candidates, from
- * the sort), those whose box is within `limit` (m) of their node at positions x, into
- * near_offsets (nsec + 1) and near (in the candidates' order); the boxes of the nused
- * segments `used` (all the candidates') into `boxes`.  Between two lists, while no node
- * has moved more than limit - FAR reach over 1 + sqrt 3 (a node and its segment's box
- * faces, each up to that far along each axis), a candidate left out stays farther than
- * FAR reach: the pass over the list skips exactly what it would skip over the candidates
- * (ContactInterface, the skin).  Returns the length of the list. */
-int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
-                     const int64_t *restrict offsets, const int64_t *restrict candidates,
-                     const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
-                     double *restrict boxes, const double *restrict x, double limit,
-                     int64_t *restrict near_offsets, int64_t *restrict near)
-{
-  segment_boxes(nused, used, segs, x, boxes);
-  const double limit2 = limit * limit;
-  int64_t count = 0;
-  near_offsets[0] = 0;
-  for (int64_t i = 0; i < nsec; ++i)
-  {
-    const double *xs = x + 3 * secondary[i];
-    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
-      if (!(box_distance2(xs, boxes + 6 * candidates[k]) > limit2)) /* NaN stays */
-        near[count++] = candidates[k];
-    near_offsets[i + 1] = count;
-  }
-  return count;
-}
-
 /* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
  * is then beyond the reach (it cannot be the closest) and beyond the band of any closest
  * distance below the reach (d - best > 1e-6 reach > BAND best: its share would be < 0),
  * with room for the round-off of both distances, so that skipping it changes nothing. */
 #define FAR (1.0 + 1e-6)
 
+/* The squared distance (m^2) of p to segment s-e, LANES pairs at once. */
+INLINE vec edge_distance2(const vec p[3], const vec s[3], const vec e[3])
+{
+  vec d[3], r[3];
+  for (int c = 0; c < 3; ++c)
+  {
+    d[c] = e[c] - s[c];
+    r[c] = p[c] - s[c];
+  }
+  const vec t = vmin(vmax(dot3(r, d) / vmax(dot3(d, d), VZERO + 1e-300), VZERO), VZERO + 1.0);
+  for (int c = 0; c < 3; ++c)
+    r[c] -= t * d[c];
+  return dot3(r, r);
+}
+
+/* The squared distance (m^2) of p to the segment of corners y (a quadrilateral's 4
+ * triangles about its centre, a triangle's 3 corners with the 3rd again as 4th), LANES
+ * pairs at once and without a branch: the least of the distances to the triangles' edges
+ * and, where p projects inside a triangle (on the inner side of its 3 edges), to its
+ * plane.  It is closest_on_segment's distance (squared) to round-off (a relative 1e-13;
+ * a triangle as a quadrilateral is the same 3 triangles about a point inside it and one
+ * of no area), at a fifth of its time on 4 lanes (closest_on_segment's branches, per
+ * region of each triangle, are taken at random across the pairs). */
+INLINE vec segment_distance2(const vec p[3], const vec y[4][3])
+{
+  vec centre[3], r[3], s[4][3];
+  for (int c = 0; c < 3; ++c)
+  {
+    centre[c] = 0.25 * (((y[0][c] + y[1][c]) + y[2][c]) + y[3][c]);
+    r[c] = p[c] - centre[c];
+    for (int k = 0; k < 4; ++k)
+      s[k][c] = y[k][c] - centre[c];
+  }
+  vec best = VZERO + INFINITY;
+  for (int k = 0; k < 4; ++k)
+  {
+    const int l = (k + 1) % 4;
+    best = vmin(best, vmin(edge_distance2(p, centre, y[k]), edge_distance2(p, y[k], y[l])));
+    vec normal[3], rim[3], from_k[3], t[3];
+    cross(s[k], s[l], normal);
+    for (int c = 0; c < 3; ++c)
+    {
+      rim[c] = s[l][c] - s[k][c];
+      from_k[c] = r[c] - s[k][c];
+    }
+    cross(s[k], r, t);
+    const vec u0 = dot3(t, normal);
+    cross(rim, from_k, t);
+    const vec u1 = dot3(t, normal);
+    cross(r, s[l], t);
+    const vec u2 = dot3(t, normal);
+    const vec area2 = dot3(normal, normal), h = dot3(r, normal);
+    const ivec inside = (u0 >= 0.0) & (u1 >= 0.0) & (u2 >= 0.0) & (area2 > 0.0);
+    best = vmin(best, vselect(inside, h * h / vmax(area2, VZERO + 1e-300), VZERO + INFINITY));
+  }
+  return best;
+}
+
+/* segment_distance2 of the first n pairs of the LANES in p, y into d2[pair[0 .. n)] (the
+ * lanes from n on get the first pair again). */
+INLINE void batch_distances(vec p[3], vec y[4][3], const int64_t *restrict pair, int n,
+                            double *restrict d2)
+{
+  for (int m = n; m < LANES; ++m)
+    for (int c = 0; c < 3; ++c)
+    {
+      p[c][m] = p[c][0];
+      for (int l = 0; l < 4; ++l)
+        y[l][c][m] = y[l][c][0];
+    }
+  const vec found = segment_distance2(p, y);
+  for (int m = 0; m < n; ++m)
+    d2[pair[m]] = found[m];
+}
+
+/* The squared distances d2 (m^2) of the nsec secondary nodes to their candidates
+ * candidates[offsets[0] .. offsets[nsec]) (d2 indexed as the candidates) at positions x,
+ * segment_distance2's, LANES pairs at a time, but INFINITY for a candidate surely farther
+ * than `far` (m): its box (`boxes`, segment_boxes, unless NULL) is, or its distance at the
+ * near lists (`listed`, m, per candidate, unless NULL) was farther than far + slack (m).
+ * NaN positions give NaN, never INFINITY. */
+static void candidate_distances(int64_t nsec, const int64_t *restrict secondary,
+                                const int64_t *restrict offsets,
+                                const int64_t *restrict candidates,
+                                const int64_t *restrict segs, const double *restrict x,
+                                const double *restrict boxes, const double *restrict listed,
+                                double slack, double far, double *restrict d2)
+{
+  const double far2 = far * far, beyond = far + slack;
+  vec p[3], y[4][3];
+  int64_t pair[LANES];
+  int n = 0;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    const double *xs = x + 3 * secondary[i];
+    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
+    {
+      const int64_t *seg = segs + 4 * candidates[k];
+      if ((listed && listed[k] > beyond) ||
+          (boxes && box_distance2(xs, boxes + 6 * candidates[k]) > far2))
+      {
+        d2[k] = INFINITY;
+        continue;
+      }
+      for (int c = 0; c < 3; ++c)
+      {
+        p[c][n] = xs[c];
+        for (int m = 0; m < 4; ++m) /* a triangle's 3rd corner again as its 4th */
+          y[m][c][n] = x[3 * seg[seg[3] >= 0 || m < 3 ? m : 2] + c];
+      }
+      pair[n++] = k;
+      if (n == LANES)
+      {
+        batch_distances(p, y, pair, n, d2);
+        n = 0;
+      }
+    }
+  }
+  if (n > 0)
+    batch_distances(p, y, pair, n, d2);
+}
+
+/* The near list: of the candidates of the nsec secondary nodes (offsets, candidates, from
+ * the sort), those within `limit` (m) of their node at positions x, into near_offsets
+ * (nsec + 1), near (in the candidates' order) and near_distance (their distances, m); the
+ * boxes of the nused segments `used` (all the candidates') into `boxes`, which rule out
+ * most candidates first.  A node and every point of a segment (a weighted mean of its
+ * corners) having moved at most r since, the node's distance to the segment has changed
+ * by at most 2 r: while no node has moved more than (limit - FAR reach) / 2, a candidate
+ * left out stays farther than FAR reach, and the pass over the list skips exactly what it
+ * would skip over the candidates (ContactInterface, the skin).  Returns the length of the
+ * list. */
+int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
+                     const int64_t *restrict offsets, const int64_t *restrict candidates,
+                     const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
+                     double *restrict boxes, const double *restrict x, double limit,
+                     int64_t *restrict near_offsets, int64_t *restrict near,
+                     double *restrict near_distance)
+{
+  segment_boxes(nused, used, segs, x, boxes);
+  double *d2 = (double *)malloc((offsets[nsec] + 1) * sizeof(double));
+  candidate_distances(nsec, secondary, offsets, candidates, segs, x, boxes, NULL, 0.0, limit,
+                      d2);
+  const double limit2 = limit * limit;
+  int64_t count = 0;
+  near_offsets[0] = 0;
+  for (int64_t i = 0; i < nsec; ++i)
+  {
+    for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
+      if (!(d2[k] > limit2)) /* NaN stays */
+      {
+        near[count] = candidates[k];
+        near_distance[count++] = sqrt(d2[k]);
+      }
+    near_offsets[i + 1] = count;
+  }
+  free(d2);
+  return count;
+}
+
 /* The closest point of node xs among candidates[from..to) (within `reach`, m), into *pt;
- * 0 if none is within reach.  `boxes` are the candidates' boxes (segment_boxes); `near`
- * holds to - from closest points (scratch).
+ * 0 if none is within reach.  `d2` are the candidates' squared distances
+ * (candidate_distances, indexed as the candidates); `near` holds to - from closest points
+ * (scratch).
  *
  * The segments whose distance is within BAND of the closest one's share the point, in
  * shares falling linearly from 1 to 0 over that band, as the triangles of a quadrilateral
@@ -574,7 +708,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
                               const int64_t *restrict candidates, const int64_t *restrict segs,
                               const double *restrict stiffness0, const double *restrict depth,
                               const double *restrict size, const double *restrict x,
-                              const double *restrict boxes,
+                              const double *restrict d2,
                               double reach, segment_point *restrict near, surface_point *pt)
 {
   double best = INFINITY;
@@ -583,7 +717,7 @@ static int closest_on_surface(const double xs[3], int64_t from, int64_t to,
   {
     const int64_t j = candidates[k];
     segment_point *sp = near + (k - from);
-    if (box_distance2(xs, boxes + 6 * j) > far2)
+    if (d2[k] > far2)
     {
       sp->d = INFINITY; /* out of reach and out of any band: as the exact distance would be
                            (see FAR) */
@@ -690,6 +824,27 @@ INLINE double mirror(const contact_params *prm, int64_t s, surface_point *pt)
   return prm->share[s];
 }
 
+/* What a pass over the candidates of the nsec secondary nodes (positions x) finds first:
+ * the candidates' squared distances within FAR reach (candidate_distances, with their
+ * distances at the near lists `listed` unless NULL, nodes having moved at most `moved` (m)
+ * since; returned: the caller frees it) and room for the closest points of a node's
+ * candidates (*near: the caller frees it). */
+static double *pass_scratch(int64_t nsec, const int64_t *restrict secondary,
+                            const int64_t *restrict offsets, const int64_t *restrict candidates,
+                            const double *restrict listed, double moved,
+                            const int64_t *restrict segs, const double *restrict x,
+                            double reach, segment_point **near)
+{
+  int64_t most = 1;
+  for (int64_t i = 0; i < nsec; ++i)
+    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
+  *near = (segment_point *)malloc(most * sizeof(segment_point));
+  double *d2 = (double *)malloc((offsets[nsec] + 1) * sizeof(double));
+  candidate_distances(nsec, secondary, offsets, candidates, segs, x, NULL, listed, 2.0 * moved,
+                      FAR * reach, d2);
+  return d2;
+}
+
 /* Nodes that start inside the gap (Radioss TYPE7 Inacti = 6): a node at distance d0 < gap
  * from the surface at the start gets its own gap 0.95 d0 (Radioss: gap0 = Gap - P0 - 5 %
  * of (Gap - P0), P0 = Gap - d0 the initial penetration), so that it is not pushed out at
@@ -716,25 +871,21 @@ INLINE double grown_gap(double *node_gap, double d, double gap)
  * largest initial penetration gap - d0 (m). */
 void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
                           const int64_t *restrict offsets, const int64_t *restrict candidates,
-                          const int64_t *restrict segs, int64_t nused,
-                          const int64_t *restrict used, double *restrict boxes,
-                          const double *restrict stiffness0,
+                          const int64_t *restrict segs, const double *restrict stiffness0,
                           const double *restrict depth, const double *restrict size,
                           const double *restrict x, const contact_params *prm,
                           double *restrict node_gap, double out[3])
 {
   out[0] = out[1] = out[2] = 0.0;
-  int64_t most = 1;
-  for (int64_t i = 0; i < nsec; ++i)
-    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
-  segment_boxes(nused, used, segs, x, boxes);
+  segment_point *near;
+  double *d2 = pass_scratch(nsec, secondary, offsets, candidates, NULL, 0.0, segs, x,
+                            prm->reach, &near);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
     node_gap[i] = INFINITY;
     if (!closest_on_surface(x + 3 * secondary[i], offsets[i], offsets[i + 1], candidates,
-                            segs, stiffness0, depth, size, x, boxes, prm->reach, near, &pt))
+                            segs, stiffness0, depth, size, x, d2, prm->reach, near, &pt))
       continue;
     const double g = pair_gap(prm, secondary[i], pt.depth, pt.size);
     if (!(pt.d < g && (two_sided(pt.depth) || -pt.d < pt.depth)))
@@ -745,22 +896,24 @@ void contact_initial_gaps(int64_t nsec, const int64_t *restrict secondary,
     out[2] = g - pt.d > out[2] ? g - pt.d : out[2];
   }
   free(near);
+  free(d2);
 }
 
-/* One pass: the nsec secondary nodes against their candidate segments.  `used` are the
- * nused segments that are someone's candidate (each once), whose boxes (6 values a
- * segment of `boxes`, scratch) are found first.  `stiffness0`,
+/* One pass: the nsec secondary nodes against their candidate segments, with `listed` their
+ * distances at the near lists (m, contact_near, nodes having moved at most prm->moved
+ * since), or NULL: all of them sought.  `stiffness0`,
  * `depth` (m: how deep behind a segment a node is still pushed out) and `size` (m, the
  * segment's size share of a variable gap, pair_gap; NULL: none) are per segment;
  * `tangential` (nsec rows) is each secondary node's friction force of the previous step
- * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.  out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
+ * (N), updated; `node_gap` each node's gap (m, contact_initial_gaps), grown as it leaves.
+ * out: [0..2] the force on the secondary nodes (N), [3..5] its tangential
  * part, [6] the number of nodes in contact, [7] the stored normal energy (J), [8] the
  * tangential springs' energy (J), [9] what friction and damping dissipated over the step (J),
  * [10] the sum of the normal forces' sizes (N). */
 void contact_forces(int64_t nsec, const int64_t *restrict secondary,
                     const int64_t *restrict offsets, const int64_t *restrict candidates,
-                    const int64_t *restrict segs, int64_t nused, const int64_t *restrict used,
-                    double *restrict boxes, const double *restrict stiffness0,
+                    const double *restrict listed, const int64_t *restrict segs,
+                    const double *restrict stiffness0,
                     const double *restrict depth, const double *restrict size,
                     const double *restrict x, const double *restrict v,
                     const double *restrict mass,
@@ -770,11 +923,9 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
 {
   for (int c = 0; c < 11; ++c)
     out[c] = 0.0;
-  int64_t most = 1;
-  for (int64_t i = 0; i < nsec; ++i)
-    most = offsets[i + 1] - offsets[i] > most ? offsets[i + 1] - offsets[i] : most;
-  segment_point *near = (segment_point *)malloc(most * sizeof(segment_point));
-  segment_boxes(nused, used, segs, x, boxes);
+  segment_point *near;
+  double *d2 = pass_scratch(nsec, secondary, offsets, candidates, listed, prm->moved, segs, x,
+                            prm->reach, &near);
   surface_point pt;
   for (int64_t i = 0; i < nsec; ++i)
   {
@@ -784,7 +935,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     /* (a node without candidates, most of them, has no closest point: not looked for) */
     if (offsets[i] == offsets[i + 1] ||
         !closest_on_surface(xs, offsets[i], offsets[i + 1], candidates, segs, stiffness0,
-                            depth, size, x, boxes, prm->reach, near, &pt))
+                            depth, size, x, d2, prm->reach, near, &pt))
     {
       ft[0] = ft[1] = ft[2] = 0.0;
       node_gap[i] = INFINITY;
@@ -874,6 +1025,7 @@ void contact_forces(int64_t nsec, const int64_t *restrict secondary,
     out[10] += fn;
   }
   free(near);
+  free(d2);
 }
 
 /* Whether the force f (N) on a node of velocity v (m/s) counts in a sum of f . v: not when

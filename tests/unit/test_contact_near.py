@@ -1,11 +1,13 @@
 """The near lists of a contact pass (``kernels/contact.c``, contact_near;
-``ContactInterface._list_near``): until some node has moved a third of the skin, the pass
-over them gives the same forces, to the bit, as the pass over all of the sort's candidates.
+``ContactInterface._list_near``): until some node has moved half the skin, the pass over
+them (skipping the candidates whose distance at the lists was beyond the reach and twice
+the move) gives the same forces, to the bit, as the pass over all of the sort's candidates.
 
-Reference: the bound of docs/theory.md ("Search"): a candidate left out of the list was
-farther than 1.000001 reach + skin from its node, and a node and a segment's box, each
-moving less than skin / 3 per axis, bring it at most (1 + sqrt 3) skin / 3 nearer, so it
-is still beyond the distance at which the pass skips it by its box.
+Reference: the bound of docs/theory.md ("Search"): every point of a segment is a weighted
+mean of its corners, so a node and a segment each moving less than r bring them at most
+2 r nearer; a candidate left out of the list was farther than 1.000001 reach + skin from
+its node, and is still beyond the distance at which the pass skips it after moves of less
+than skin / 2.
 """
 
 from types import SimpleNamespace
@@ -32,18 +34,19 @@ def folded_sheet(m: int, rng) -> tuple[np.ndarray, np.ndarray]:
     return X, np.stack([a, a + m + 1, a + m + 2, a + 1], axis=1).astype(np.int64)
 
 
-def pass_forces(interface: ContactInterface, ps: Pass, offsets, candidates) -> np.ndarray:
+def pass_forces(interface: ContactInterface, ps: Pass, offsets, candidates,
+                listed=None) -> np.ndarray:  # fmt: skip
     """The forces (N), the contact stiffness (N/m), the friction forces and own gaps and
-    the books of one pass over the candidate lists given."""
+    the books of one pass over the candidate lists given, with their distances at the near
+    lists ``listed`` (m) or without (None: all sought)."""
     p, lib = interface._pointer, interface.lib
-    used = np.unique(candidates[: offsets[-1]])
     x, v, mass, force, stiffness = interface._surface[:5]
     interface.force[:] = 0.0
     tangential, gaps, out = ps.tangential.copy(), ps.gaps.copy(), np.zeros(11)
     lib.contact_forces(len(ps.secondary), p(ps.secondary, "int64_t[]"),
                        p(offsets, "int64_t[]"), p(candidates, "int64_t[]"),
-                       p(ps.segments, "int64_t[]"), len(used), p(used, "int64_t[]"),
-                       p(np.zeros((len(ps.segments), 6))), p(ps.stiffness), p(ps.depth),
+                       interface.ffi.NULL if listed is None else p(listed),
+                       p(ps.segments, "int64_t[]"), p(ps.stiffness), p(ps.depth),
                        p(ps.size), x, v,
                        mass, interface._params, p(tangential), p(gaps), force, stiffness,
                        p(out))  # fmt: skip
@@ -83,7 +86,7 @@ def test_the_near_lists_give_the_forces_of_all_candidates(shape):
     ps = interface.passes[0]
     listed = int(ps.near_offsets[-1])
     assert 0 < listed < 0.5 * ps.offsets[-1]  # the lists are shorter than the candidates
-    step = SKIN * MARGIN / 3.0 * 0.999  # the most a node may move before the lists go stale
+    step = SKIN * MARGIN / 2.0 * 0.999  # the most a node may move before the lists go stale
     if shape == "folded sheet":  # the legs move toward their neighbours on one side
         leg = (X[:, 0] // (4 * 0.8e-3)).astype(int)
         toward = np.where(leg % 2 == 0, 1.0, -1.0)[:, None] * [1.0, 0.0, 0.0]
@@ -95,9 +98,9 @@ def test_the_near_lists_give_the_forces_of_all_candidates(shape):
         state.u[:] = fraction * step * direction  # in place: the interface reads it
         moved = interface._read(state)[2]  # since the lists
         assert not interface._near_stale(moved)
-        near = pass_forces(interface, ps, ps.near_offsets, ps.near)
+        near = pass_forces(interface, ps, ps.near_offsets, ps.near, ps.near_distance)
         every = pass_forces(interface, ps, ps.offsets, ps.candidates)
         assert np.array_equal(near, every)
     assert near[-5] > 0  # some nodes in contact at the end (out[6])
-    state.u[:] = 1.01 * SKIN * MARGIN / 3.0 * direction
+    state.u[:] = 1.01 * SKIN * MARGIN / 2.0 * direction
     assert interface._near_stale(interface._read(state)[2])

@@ -39,8 +39,7 @@ def forces(x, segments, node, *, depth=5e-4):
     depths = np.full(len(segments), depth)
     v, mass, tangential, gaps = np.zeros((n, 3)), np.ones(n), np.zeros((1, 3)), np.full(1, GAP)
     lib.contact_forces(1, p(secondary, "int64_t[]"), p(offsets, "int64_t[]"),
-                       p(candidates, "int64_t[]"), p(segments, "int64_t[]"), len(segments),
-                       p(candidates, "int64_t[]"), p(np.zeros((len(segments), 6))), p(k0),
+                       p(candidates, "int64_t[]"), ffi.NULL, p(segments, "int64_t[]"), p(k0),
                        p(depths), ffi.NULL, p(x), p(v), p(mass), prm, p(tangential), p(gaps), p(force),
                        p(stiffness), p(out))  # fmt: skip
     return force

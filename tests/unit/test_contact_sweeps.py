@@ -60,10 +60,8 @@ class Surface:
         """The pass of node 4 against the segment (contact_forces); its out."""
         p, one = self.p, np.array([0, 1], dtype=np.int64)
         self.lib.contact_forces(1, p(np.array([4], np.int64), "int64_t[]"), p(one, "int64_t[]"),
-                                p(np.zeros(1, np.int64), "int64_t[]"),
-                                p(self.segments, "int64_t[]"), 1,
-                                p(np.zeros(1, np.int64), "int64_t[]"), p(np.zeros((1, 6))),
-                                p(np.full(1, K0)), p(np.full(1, 5e-4)), self.ffi.NULL,
+                                p(np.zeros(1, np.int64), "int64_t[]"), self.ffi.NULL,
+                                p(self.segments, "int64_t[]"), p(np.full(1, K0)), p(np.full(1, 5e-4)), self.ffi.NULL,
                                 p(self.x), p(self.vs),
                                 p(self.ms), self.prm, p(self.tangential), p(self.gaps),
                                 p(self.force), p(self.stiffness), p(self.pass_out))  # fmt: skip
