@@ -16,15 +16,16 @@ from rwall_fem.kernels import load
 K0, GAP = 1e7, 1e-4
 
 
-def forces(x, segments, node, *, depth=5e-4):
+def forces(x, segments, node, *, depth=5e-4, stiffness=False):
     """The contact force (N, rows of 3 on every surface node) of node ``node`` at the
     positions ``x`` (m) against every segment (rows of 4 nodes, -1 for a triangle),
-    undamped and frictionless."""
+    undamped and frictionless; with ``stiffness``, the contact stiffness (N/m, per node)
+    too."""
     ffi, lib = load()
     x = np.ascontiguousarray(x, dtype=float)
     n = len(x)
     segments = np.ascontiguousarray(segments, dtype=np.int64)
-    force, stiffness, out = np.zeros((n, 3)), np.zeros(n), np.zeros(11)
+    force, springs, out = np.zeros((n, 3)), np.zeros(n), np.zeros(11)
     prm = ffi.new("contact_params *")
     prm.gap, prm.cap, prm.friction, prm.damping, prm.alpha = GAP, 0.99, 0.0, 0.0, 1.0
     prm.dt, prm.reach = 1e-8, max(GAP, depth)
@@ -41,8 +42,8 @@ def forces(x, segments, node, *, depth=5e-4):
     lib.contact_forces(1, p(secondary, "int64_t[]"), p(offsets, "int64_t[]"),
                        p(candidates, "int64_t[]"), ffi.NULL, p(segments, "int64_t[]"), p(k0),
                        p(depths), ffi.NULL, p(x), p(v), p(mass), prm, p(tangential), p(gaps), p(force),
-                       p(stiffness), p(out))  # fmt: skip
-    return force
+                       p(springs), p(out))  # fmt: skip
+    return (force, springs) if stiffness else force
 
 
 def spring(d):
@@ -112,3 +113,54 @@ def test_the_force_of_a_node_crossing_the_common_edge_of_two_warped_segments_is_
     fine, _ = largest_change(0.5e-12, count=400)
     assert coarse <= 1e-4 * size
     assert fine <= 0.6 * coarse
+
+
+def flat_segment(rng, corners):
+    """A random convex quadrilateral (4 corners) or triangle (3) of about 1 mm, flat,
+    turned at random in space: its corners (m, rows of 3), unit normal and, per side (from
+    corner k to k + 1), its unit outward normal in the segment's plane."""
+    angles = np.sort(rng.uniform(0.0, 2.0 * np.pi, corners))
+    while np.diff(np.append(angles, angles[0] + 2.0 * np.pi)).max() >= 0.9 * np.pi:
+        angles = np.sort(rng.uniform(0.0, 2.0 * np.pi, corners))  # a corner near 180 deg
+    radius = rng.uniform(0.6e-3, 1.0e-3, corners)
+    plane = np.stack([radius * np.cos(angles), radius * np.sin(angles)], axis=1)
+    turn, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    y = np.column_stack([plane, np.zeros(corners)]) @ turn.T + rng.uniform(-1e-3, 1e-3, 3)
+    side = np.roll(y, -1, axis=0) - y
+    normal = turn[:, 2]
+    outward = np.cross(side, normal)
+    return y, normal, outward / np.linalg.norm(outward, axis=1, keepdims=True)
+
+
+@pytest.mark.parametrize("corners", [4, 3])
+def test_a_node_is_within_reach_of_a_segment_exactly_to_its_distance(corners):
+    """Nodes placed at a known distance d from a flat segment (over its inside along its
+    normal; off a side, between its outward normal and the segment's; off a corner, in the
+    cone of its two sides' outward normals and the segment's: there the closest point is
+    the foot, the side's point, the corner), on either side: within reach (d = (1 - 1e-9)
+    reach) each gets a contact stiffness (k0 in front, farther than the gap; behind, within
+    the segment's depth, its spring's: the pass's branch-free distances skip no pair within
+    reach), just beyond it (1 + 1e-9) none (only pairs within reach compete for the
+    node)."""
+    rng = np.random.default_rng(corners)
+    reach = 5e-4  # the segment's depth: max(gap, depth)
+    for _ in range(30):
+        y, normal, outward = flat_segment(rng, corners)
+        k = rng.integers(corners)
+        w = rng.dirichlet(np.ones(corners))
+        up = rng.choice([-1.0, 1.0]) * normal
+        a, b = rng.uniform(0.0, 1.0, 2)
+        t = rng.uniform(0.05, 0.95)
+        places = {
+            "inside": (w @ y, up),
+            "side": ((1 - t) * y[k] + t * y[(k + 1) % corners], np.cos(a) * outward[k]
+                     + np.sin(a) * up),
+            "corner": (y[k], a * outward[k - 1] + b * outward[k] + rng.uniform() * up),
+        }  # fmt: skip
+        for where, (foot, direction) in places.items():
+            direction = direction / np.linalg.norm(direction)
+            segment = [[0, 1, 2, 3 if corners == 4 else -1]]
+            for ratio in (1 - 1e-9, 1 + 1e-9):
+                x = np.vstack([y, foot + ratio * reach * direction])
+                _, springs = forces(x, segment, corners, depth=reach, stiffness=True)
+                assert (springs[corners] > 0.0) == (ratio < 1.0), (where, ratio)
