@@ -15,8 +15,8 @@ nodes it owns, against the segments that can reach them; each step it
    box of another rank's secondary nodes to that rank, and lists its ghosts again; then it
    sorts its secondary nodes' candidate segments (buckets, ``kernels/contact.c``); and
    lists again, within them, the candidates near enough to be met before some node has
-   moved a skin (``_list_near``: at each sort, and when some local node has moved a third
-   of the skin since the last list; the same forces with or without);
+   moved a skin (``_list_near``: at each sort, and when some local node has moved half
+   the skin since the last list; the same forces with or without);
 3. runs its passes (secondary nodes against main segments; two, each side against the
    other, by default) in compiled code over its own secondary nodes, adds the forces on
    its own nodes to a^n, and sends those on its ghosts back to their owners, who add them

@@ -475,7 +475,7 @@ typedef struct
 
 /* The boxes of the segments `used` (nused of them, indices into segs) at positions x: 6
  * values a segment in `boxes` (its corners' lowest x, y, z, then highest), the others'
- * left as they are.  Once a pass, so that each candidate's test reads one row. */
+ * left as they are.  Once a list, so that each candidate's test reads one row. */
 static void segment_boxes(int64_t nused, const int64_t *restrict used,
                           const int64_t *restrict segs, const double *restrict x,
                           double *restrict boxes)
@@ -522,8 +522,8 @@ INLINE double box_distance2(const double p[3], const double *restrict box)
   return d2;
 }
 
-/* A candidate whose box is farther than FAR reach from the node is skipped: its distance d
- * is then beyond the reach (it cannot be the closest) and beyond the band of any closest
+/* A candidate farther than FAR reach from the node is skipped: its distance d is then
+ * beyond the reach (it cannot be the closest) and beyond the band of any closest
  * distance below the reach (d - best > 1e-6 reach > BAND best: its share would be < 0),
  * with room for the round-off of both distances, so that skipping it changes nothing. */
 #define FAR (1.0 + 1e-6)
