@@ -652,7 +652,8 @@ static void candidate_distances(int64_t nsec, const int64_t *restrict secondary,
 
 /* The near list: of the candidates of the nsec secondary nodes (offsets, candidates, from
  * the sort), those within `limit` (m) of their node at positions x, into near_offsets
- * (nsec + 1), near (in the candidates' order) and near_distance (their distances, m); the
+ * (nsec + 1), near (in the candidates' order) and near_distance (their distances, m; both
+ * as long as the candidates); the
  * boxes of the nused segments `used` (all the candidates') into `boxes`, which rule out
  * most candidates first.  A node and every point of a segment (a weighted mean of its
  * corners) having moved at most r since, the node's distance to the segment has changed
@@ -668,23 +669,23 @@ int64_t contact_near(int64_t nsec, const int64_t *restrict secondary,
                      double *restrict near_distance)
 {
   segment_boxes(nused, used, segs, x, boxes);
-  double *d2 = (double *)malloc((offsets[nsec] + 1) * sizeof(double));
+  /* the squared distances into near_distance (as long as the candidates), then the list
+   * packed in place (count <= k) */
   candidate_distances(nsec, secondary, offsets, candidates, segs, x, boxes, NULL, 0.0, limit,
-                      d2);
+                      near_distance);
   const double limit2 = limit * limit;
   int64_t count = 0;
   near_offsets[0] = 0;
   for (int64_t i = 0; i < nsec; ++i)
   {
     for (int64_t k = offsets[i]; k < offsets[i + 1]; ++k)
-      if (!(d2[k] > limit2)) /* NaN stays */
+      if (!(near_distance[k] > limit2)) /* NaN stays */
       {
         near[count] = candidates[k];
-        near_distance[count++] = sqrt(d2[k]);
+        near_distance[count++] = sqrt(near_distance[k]);
       }
     near_offsets[i + 1] = count;
   }
-  free(d2);
   return count;
 }
 
