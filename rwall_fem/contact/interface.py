@@ -185,6 +185,8 @@ class ContactInterface:
         self._read_out, self._apply_out = np.zeros(3), np.zeros(2)
         self._read_pointers = (p(self._read_out), p(self._apply_out))
         self.shares: list[_Share] = []
+        self.passes: list[Pass] = []  # this rank's, made at each sort
+        self._sort_work = np.zeros(0, np.int64)  # contact_sort's scratch
         self.use(passes, nodes)
         self._local(np.zeros(0, dtype=np.int64))
         self.gap_max = gap  # the largest pair gap (vary_gap)
@@ -435,6 +437,10 @@ class ContactInterface:
                       self._to_local(ints[here, 2:]), received[here, 6].copy(),
                       received[here, 7].copy(), received[here, 8].copy())  # fmt: skip
             ps.tangential, ps.gaps = sh.tangential, sh.gaps
+            if k < len(self.passes):  # the previous sort's room for the lists: one bucket
+                before = self.passes[k]  # sort, not two
+                ps.candidates, ps.near = before.candidates, before.near
+                ps.near_distance = before.near_distance
             if sh.removed is not None:
                 ps.removed = self._removed_here(sh.removed, ints[here, 1])
             passes.append(ps)
@@ -445,7 +451,10 @@ class ContactInterface:
             removed = ((p(ps.removed[0], "int64_t[]"), p(ps.removed[1], "int64_t[]"))
                        if ps.removed is not None else (self.ffi.NULL, self.ffi.NULL))
             while True:
-                work = np.zeros(2 * len(ps.secondary) + 2 * len(ps.candidates) + 1, np.int64)
+                size = 2 * len(ps.secondary) + 2 * len(ps.candidates) + 1
+                if len(self._sort_work) < size:  # scratch, kept from sort to sort
+                    self._sort_work = np.empty(size, np.int64)
+                work = self._sort_work
                 count = lib.contact_sort(
                     len(ps.secondary), p(ps.secondary, "int64_t[]"), len(ps.segments),
                     p(ps.segments, "int64_t[]"), p(reach), p(self.x),
@@ -455,7 +464,9 @@ class ContactInterface:
                 if count <= len(ps.candidates):
                     break
                 ps.candidates = np.zeros(2 * count, dtype=np.int64)
-            ps.used = np.unique(ps.candidates[:count])
+            # the segments that are candidates, each once, in order (O(n), no sort)
+            ps.used = np.flatnonzero(np.bincount(ps.candidates[:count],
+                                                 minlength=len(ps.segments)))
         self._sorted_at = self.x[: self.n].copy()
         self._sorted_pointer = self._pointer(self._sorted_at)
         self.sorts += 1
